@@ -1,0 +1,227 @@
+/* mixsph - run a case file.
+ *
+ *   mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]
+ *
+ * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
+ * on stdout and summary.json in the output folder. Exit codes: 0 ok, 2 bad usage or input,
+ * 3 unstable run, 4 out of memory or output failure. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "mixsph.h"
+
+#define MAX_SETS 64
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+            "usage: mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]\n"
+            "  --set key=value   override a numeric case value, e.g. --set numerics.dx=0.01\n"
+            "  --out DIR         output folder (default: out/<case name>)\n"
+            "  --threads N       OpenMP threads (default: all cores)\n"
+            "  --quiet           no progress line\n");
+}
+
+static int exit_code(mixsph_status st)
+{
+    switch (st) {
+    case MIXSPH_OK: return 0;
+    case MIXSPH_ERR_ARG:
+    case MIXSPH_ERR_CASE: return 2;
+    case MIXSPH_ERR_UNSTABLE: return 3;
+    default: return 4;
+    }
+}
+
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return ts.tv_sec + 1e-9 * ts.tv_nsec;
+}
+
+static void fmt_duration(double s, char *buf, size_t n)
+{
+    if (!isfinite(s) || s < 0) snprintf(buf, n, "--");
+    else if (s < 60) snprintf(buf, n, "%.0fs", s);
+    else if (s < 3600) snprintf(buf, n, "%dm%02ds", (int)(s / 60), (int)fmod(s, 60));
+    else snprintf(buf, n, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
+}
+
+static void json_number(FILE *f, double v)
+{
+    if (isfinite(v)) fprintf(f, "%.9g", v);
+    else fprintf(f, "null");
+}
+
+static int write_summary(const char *dir, const mixsph_sim *s, const char *case_path, int threads, double wall,
+                         const char *status_text)
+{
+    char path[1100];
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    FILE *f = fopen(path, "w");
+    if (!f) return -1;
+    const double psteps = (double)mixsph_sim_particles(s) * (double)mixsph_sim_steps(s);
+    fprintf(f, "{\n  \"case\": \"%s\",\n  \"case_file\": \"%s\",\n  \"status\": \"%s\",\n", mixsph_sim_name(s), case_path,
+            status_text);
+    fprintf(f, "  \"particles\": %zu,\n  \"wall_particles\": %zu,\n  \"steps\": %llu,\n", mixsph_sim_particles(s),
+            mixsph_sim_wall_particles(s), (unsigned long long)mixsph_sim_steps(s));
+    fprintf(f, "  \"threads\": %d,\n  \"simulated_time_s\": ", threads);
+    json_number(f, mixsph_sim_time(s));
+    fprintf(f, ",\n  \"wall_time_s\": ");
+    json_number(f, wall);
+    fprintf(f, ",\n  \"particle_steps_per_s\": ");
+    json_number(f, wall > 0 ? psteps / wall : NAN);
+    fprintf(f, ",\n  \"wall_s_per_simulated_s\": ");
+    json_number(f, mixsph_sim_time(s) > 0 ? wall / mixsph_sim_time(s) : NAN);
+    fprintf(f, ",\n  \"outputs\": {\n");
+    const size_t n = mixsph_sim_output_count(s);
+    for (size_t k = 0; k < n; k++) {
+        double mx, tmx, mn, tmn;
+        mixsph_sim_output_extremes(s, k, &mx, &tmx, &mn, &tmn);
+        fprintf(f, "    \"%s\": {\"final\": ", mixsph_sim_output_name(s, k));
+        json_number(f, mixsph_sim_output_value(s, k));
+        fprintf(f, ", \"max\": ");
+        json_number(f, mx);
+        fprintf(f, ", \"t_max\": ");
+        json_number(f, tmx);
+        fprintf(f, ", \"min\": ");
+        json_number(f, mn);
+        fprintf(f, ", \"t_min\": ");
+        json_number(f, tmn);
+        fprintf(f, "}%s\n", k + 1 < n ? "," : "");
+    }
+    fprintf(f, "  }\n}\n");
+    return fclose(f) == 0 ? 0 : -1;
+}
+
+static int cmd_run(int argc, char **argv)
+{
+    const char *case_path = NULL, *out_dir = NULL;
+    mixsph_override sets[MAX_SETS];
+    size_t n_sets = 0;
+    int threads = 0, quiet = 0;
+    char err[1024];
+    for (int a = 0; a < argc; a++) {
+        const char *arg = argv[a];
+        if (strcmp(arg, "--set") == 0 || strcmp(arg, "--out") == 0 || strcmp(arg, "--threads") == 0) {
+            if (a + 1 >= argc) {
+                fprintf(stderr, "mixsph: %s needs a value\n", arg);
+                return 2;
+            }
+            char *val = argv[++a];
+            if (strcmp(arg, "--out") == 0) {
+                out_dir = val;
+            } else if (strcmp(arg, "--threads") == 0) {
+                char *end;
+                long v = strtol(val, &end, 10);
+                if (*end || v < 1 || v > 1024) {
+                    fprintf(stderr, "mixsph: --threads: '%s' is not a thread count (1..1024)\n", val);
+                    return 2;
+                }
+                threads = (int)v;
+            } else {
+                if (n_sets == MAX_SETS) {
+                    fprintf(stderr, "mixsph: at most %d --set options\n", MAX_SETS);
+                    return 2;
+                }
+                if (mixsph_override_parse(val, &sets[n_sets], err, sizeof err) != MIXSPH_OK) {
+                    fprintf(stderr, "mixsph: --set: %s\n", err);
+                    return 2;
+                }
+                n_sets++;
+            }
+        } else if (strcmp(arg, "--quiet") == 0) {
+            quiet = 1;
+        } else if (arg[0] == '-') {
+            fprintf(stderr, "mixsph: unknown option '%s'\n", arg);
+            usage(stderr);
+            return 2;
+        } else if (!case_path) {
+            case_path = arg;
+        } else {
+            fprintf(stderr, "mixsph: more than one case file ('%s', '%s')\n", case_path, arg);
+            return 2;
+        }
+    }
+    if (!case_path) {
+        fprintf(stderr, "mixsph: run: no case file given\n");
+        usage(stderr);
+        return 2;
+    }
+    mixsph_sim *s = NULL;
+    mixsph_status st = mixsph_sim_create(case_path, sets, n_sets, &s, err, sizeof err);
+    if (st != MIXSPH_OK) {
+        fprintf(stderr, "mixsph: %s\n", err);
+        return exit_code(st);
+    }
+    char dir[1024];
+    if (out_dir) snprintf(dir, sizeof dir, "%s", out_dir);
+    else snprintf(dir, sizeof dir, "out/%s", mixsph_sim_name(s));
+    if ((st = mixsph_sim_set_threads(s, threads)) != MIXSPH_OK || (st = mixsph_sim_set_output_dir(s, dir)) != MIXSPH_OK) {
+        fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));
+        mixsph_sim_destroy(s);
+        return exit_code(st);
+    }
+    const int tty = !quiet && isatty(STDERR_FILENO);
+    if (!quiet)
+        fprintf(stderr, "mixsph: %s: %zu particles + %zu wall particles, t_end = %g s, output in %s\n", mixsph_sim_name(s),
+                mixsph_sim_particles(s), mixsph_sim_wall_particles(s), mixsph_sim_end_time(s), dir);
+    const double t_end = mixsph_sim_end_time(s), t0 = now();
+    double last_print = 0.0;
+    const int chunks = 1000;
+    for (int c = 1; c <= chunks && st == MIXSPH_OK; c++) {
+        st = mixsph_sim_advance_to(s, t_end * c / chunks);
+        const double el = now() - t0;
+        if (tty && (el - last_print > 0.5 || c == chunks)) {
+            last_print = el;
+            const double ts = mixsph_sim_time(s);
+            char eta[32];
+            fmt_duration(ts > 0 ? el * (t_end - ts) / ts : NAN, eta, sizeof eta);
+            fprintf(stderr, "\r  t = %.4f / %.4f s  steps %llu  %.0f steps/s  dt %.3g s  ETA %s   ", ts, t_end,
+                    (unsigned long long)mixsph_sim_steps(s), mixsph_sim_steps(s) / (el > 0 ? el : 1), mixsph_sim_dt(s), eta);
+        }
+    }
+    if (tty) fprintf(stderr, "\n");
+    const double wall = now() - t0;
+    if (st != MIXSPH_OK) fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));
+    if (write_summary(dir, s, case_path, threads, wall, st == MIXSPH_OK ? "ok" : mixsph_status_string(st)) != 0) {
+        fprintf(stderr, "mixsph: %s/summary.json: cannot write\n", dir);
+        if (st == MIXSPH_OK) st = MIXSPH_ERR_IO;
+    }
+    const double psteps = (double)mixsph_sim_particles(s) * (double)mixsph_sim_steps(s);
+    printf("%s: %s, %zu particles, %llu steps, %.2f s wall, %.3g particle-steps/s, t = %.4g s\n", mixsph_sim_name(s),
+           st == MIXSPH_OK ? "done" : "FAILED", mixsph_sim_particles(s), (unsigned long long)mixsph_sim_steps(s), wall,
+           wall > 0 ? psteps / wall : 0.0, mixsph_sim_time(s));
+    for (size_t k = 0; k < mixsph_sim_output_count(s); k++) {
+        double mx, tmx, mn, tmn;
+        mixsph_sim_output_extremes(s, k, &mx, &tmx, &mn, &tmn);
+        printf("  %-18s final %-12.6g max %-12.6g (t = %.4g s)  min %-12.6g (t = %.4g s)\n", mixsph_sim_output_name(s, k),
+               mixsph_sim_output_value(s, k), mx, tmx, mn, tmn);
+    }
+    printf("  summary: %s/summary.json, monitors: %s/monitors.csv\n", dir, dir);
+    mixsph_sim_destroy(s);
+    return exit_code(st);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc >= 2 && (strcmp(argv[1], "--help") == 0 || strcmp(argv[1], "-h") == 0)) {
+        usage(stdout);
+        return 0;
+    }
+    if (argc >= 2 && strcmp(argv[1], "--version") == 0) {
+        printf("mixsph 0.1.0\n");
+        return 0;
+    }
+    if (argc < 2 || strcmp(argv[1], "run") != 0) {
+        if (argc >= 2) fprintf(stderr, "mixsph: unknown command '%s'\n", argv[1]);
+        usage(stderr);
+        return 2;
+    }
+    return cmd_run(argc - 2, argv + 2);
+}

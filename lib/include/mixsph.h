@@ -1,0 +1,130 @@
+/**
+ * @file mixsph.h
+ * @brief Public C API of mixsph: a 2D weakly compressible SPH (WCSPH) simulator of water and
+ *        granular mixtures (Manenti et al. 2018, the SPHERA mixture model with limiting viscosity).
+ *
+ * Everything a simulation needs lives in one opaque ::mixsph_sim object: create it from a JSON
+ * case file (plus numeric key=value overrides), advance it to a time, read its outputs, destroy
+ * it. The library keeps no mutable global state (several simulations may live in one process and
+ * be stepped in any order), never prints and never exits: every call returns a ::mixsph_status
+ * and the simulation keeps a readable message of the last error.
+ */
+#ifndef MIXSPH_H
+#define MIXSPH_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** Status codes, from one list, ordered by severity. */
+#define MIXSPH_STATUS_LIST(X)                                                         \
+    X(MIXSPH_OK, "ok")                                                                \
+    X(MIXSPH_ERR_ARG, "invalid argument")                                             \
+    X(MIXSPH_ERR_CASE, "invalid case file")                                           \
+    X(MIXSPH_ERR_IO, "input/output error")                                            \
+    X(MIXSPH_ERR_UNSTABLE, "unstable run (non-finite value or collapsed time step)")  \
+    X(MIXSPH_ERR_NOMEM, "out of memory")
+
+typedef enum {
+#define MIXSPH_X_ENUM(name, text) name,
+    MIXSPH_STATUS_LIST(MIXSPH_X_ENUM)
+#undef MIXSPH_X_ENUM
+} mixsph_status;
+
+/** Short description of a status code (static string). */
+const char *mixsph_status_string(mixsph_status st);
+
+/** A numeric override of a case-file value: `key` is a dotted path such as
+ *  "numerics.dx", "media.water.rho" or "motions.plate.vx.3" (array index). */
+typedef struct {
+    const char *key;
+    double value;
+} mixsph_override;
+
+/** Parse "key=value" into an override (key points into `text`, which must outlive it;
+ *  the '=' is replaced by a NUL). Returns MIXSPH_ERR_ARG with a message on bad syntax. */
+mixsph_status mixsph_override_parse(char *text, mixsph_override *out, char *err, size_t err_len);
+
+typedef struct mixsph_sim mixsph_sim;
+
+/**
+ * Create a simulation from a case file.
+ * @param case_path JSON case file.
+ * @param ov, n_ov  numeric overrides applied to the case before validation (may be NULL/0).
+ * @param out       receives the simulation (NULL on failure).
+ * @param err       buffer for the error message on failure (may be NULL).
+ */
+mixsph_status mixsph_sim_create(const char *case_path, const mixsph_override *ov, size_t n_ov,
+                                mixsph_sim **out, char *err, size_t err_len);
+
+/** As mixsph_sim_create, from JSON text held in memory; `origin` names it in messages. */
+mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *origin,
+                                          const mixsph_override *ov, size_t n_ov,
+                                          mixsph_sim **out, char *err, size_t err_len);
+
+/** Destroy a simulation and close its files (NULL-safe). */
+void mixsph_sim_destroy(mixsph_sim *s);
+
+/** Number of OpenMP threads used by this simulation (0 = OpenMP default). */
+mixsph_status mixsph_sim_set_threads(mixsph_sim *s, int n_threads);
+
+/** Write monitors (monitors.csv) and particle snapshots (snap_NNNN.csv) into `dir`, which is
+ *  created if missing. Checked immediately: an unwritable folder is an error here. */
+mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir);
+
+/**
+ * Advance the simulation until its time reaches `t` (the solver takes its own explicit steps
+ * and never shortens one to land on `t`, so the trajectory does not depend on how a run is cut
+ * into calls; on return the time is in [t, t + dt)). Returns MIXSPH_ERR_UNSTABLE with a message
+ * naming the particle, place and time if a non-finite value appears or the time step collapses;
+ * the simulation must then be destroyed.
+ */
+mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t);
+
+/** Advance by exactly one explicit time step. */
+mixsph_status mixsph_sim_step(mixsph_sim *s);
+
+/** Message of the last error of this simulation ("" if none). */
+const char *mixsph_sim_last_error(const mixsph_sim *s);
+
+double mixsph_sim_time(const mixsph_sim *s);      /**< simulated time [s] */
+double mixsph_sim_end_time(const mixsph_sim *s);  /**< end time of the case [s] */
+double mixsph_sim_dt(const mixsph_sim *s);        /**< last time step [s] */
+uint64_t mixsph_sim_steps(const mixsph_sim *s);   /**< steps taken */
+size_t mixsph_sim_particles(const mixsph_sim *s); /**< fluid + granular particles */
+size_t mixsph_sim_wall_particles(const mixsph_sim *s);
+const char *mixsph_sim_name(const mixsph_sim *s);
+
+/** Number of scalar outputs (monitors and diagnostics). */
+size_t mixsph_sim_output_count(const mixsph_sim *s);
+/** Name of output `k` (e.g. "kinetic_energy", "mass", or a monitor's name). */
+const char *mixsph_sim_output_name(const mixsph_sim *s, size_t k);
+/** Current value of output `k`, evaluated at the current state. */
+double mixsph_sim_output_value(const mixsph_sim *s, size_t k);
+/** Largest and smallest value of output `k` over the samples taken so far, and their times. */
+void mixsph_sim_output_extremes(const mixsph_sim *s, size_t k, double *max, double *t_max,
+                                double *min, double *t_min);
+/** Index of an output by name, or -1. */
+long mixsph_sim_output_find(const mixsph_sim *s, const char *name);
+
+/** Read-only view of the particles (for tools and tests): arrays of length n (fluid, granular
+ *  and wall particles, told apart by `state`); the order changes every step (sorted by cell),
+ *  `id` is stable. For wall particles `medium` is the wall's index. */
+typedef struct {
+    size_t n, n_fluid;
+    const double *x, *z, *vx, *vz, *rho, *p, *mu; /* m, m/s, kg/m3, Pa, Pa s */
+    const uint8_t *medium, *state;                /* medium index, MIXSPH_STATE_* */
+    const uint32_t *id;
+} mixsph_particles_view;
+
+enum { MIXSPH_STATE_MOBILE = 0, MIXSPH_STATE_FIXED = 1, MIXSPH_STATE_WALL = 2, MIXSPH_STATE_LOST = 3 };
+
+mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

@@ -1,0 +1,575 @@
+/* case.c - JSON case files (cJSON): overrides, reading, validation. See case.h and
+ * cases/README.md for the schema. Every message has the form
+ *   "<file>: <key path>: <what was expected>". */
+#include "case.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "status.h"
+
+struct reader {
+    const char *origin;
+    char *err;
+    size_t err_len;
+};
+
+#define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
+
+/* ---- files ------------------------------------------------------------------------------ */
+
+mixsph_status case_read_file(const char *path, char **text, char *err, size_t err_len)
+{
+    *text = NULL;
+    FILE *f = fopen(path, "rb");
+    if (!f) return status_set(err, err_len, MIXSPH_ERR_IO, "%s: cannot open case file: %s", path, strerror(errno));
+    if (fseek(f, 0, SEEK_END) != 0) {
+        fclose(f);
+        return status_set(err, err_len, MIXSPH_ERR_IO, "%s: cannot read case file", path);
+    }
+    long len = ftell(f);
+    rewind(f);
+    if (len < 0 || len > (1L << 28)) {
+        fclose(f);
+        return status_set(err, err_len, MIXSPH_ERR_IO, "%s: cannot read case file (size)", path);
+    }
+    char *buf = malloc((size_t)len + 1);
+    if (!buf) {
+        fclose(f);
+        return status_set(err, err_len, MIXSPH_ERR_NOMEM, "%s: out of memory", path);
+    }
+    size_t got = fread(buf, 1, (size_t)len, f);
+    fclose(f);
+    if (got != (size_t)len) {
+        free(buf);
+        return status_set(err, err_len, MIXSPH_ERR_IO, "%s: short read", path);
+    }
+    buf[len] = '\0';
+    *text = buf;
+    return MIXSPH_OK;
+}
+
+/* ---- overrides ---------------------------------------------------------------------------- */
+
+mixsph_status mixsph_override_parse(char *text, mixsph_override *out, char *err, size_t err_len)
+{
+    char *eq = text ? strchr(text, '=') : NULL;
+    if (!eq || eq == text)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "override '%s': expected key=value", text ? text : "(null)");
+    *eq = '\0';
+    char *end = NULL;
+    errno = 0;
+    double v = strtod(eq + 1, &end);
+    if (eq[1] == '\0' || *end != '\0' || errno == ERANGE || !isfinite(v)) {
+        status_set(err, err_len, MIXSPH_ERR_ARG, "override '%s': value '%s' is not a finite number", text, eq + 1);
+        *eq = '=';
+        return MIXSPH_ERR_ARG;
+    }
+    out->key = text;
+    out->value = v;
+    return MIXSPH_OK;
+}
+
+static mixsph_status apply_override(struct reader *r, cJSON *root, const mixsph_override *ov)
+{
+    char path[256];
+    if (!ov->key || strlen(ov->key) >= sizeof path) return FAIL(r, "%s: override key missing or too long", r->origin);
+    if (!isfinite(ov->value)) return FAIL(r, "%s: override %s: value is not finite", r->origin, ov->key);
+    strcpy(path, ov->key);
+    cJSON *node = root;
+    for (char *save = NULL, *tok = strtok_r(path, ".", &save); tok; tok = strtok_r(NULL, ".", &save)) {
+        char *rest = save && *save ? save : NULL;
+        if (!rest && cJSON_IsObject(node) && !cJSON_GetObjectItemCaseSensitive(node, tok)) {
+            /* a key with a default, absent from the file: add it (validation rejects unknown keys) */
+            if (!cJSON_AddNumberToObject(node, tok, ov->value))
+                return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+            return MIXSPH_OK;
+        }
+        if (cJSON_IsArray(node)) {
+            char *end;
+            long idx = strtol(tok, &end, 10);
+            node = (*end == '\0' && idx >= 0) ? cJSON_GetArrayItem(node, (int)idx) : NULL;
+        } else if (cJSON_IsObject(node)) {
+            node = cJSON_GetObjectItemCaseSensitive(node, tok);
+        } else {
+            node = NULL;
+        }
+        if (!node) return FAIL(r, "%s: override %s: no such key in the case (at '%s')", r->origin, ov->key, tok);
+    }
+    if (cJSON_IsNumber(node)) {
+        cJSON_SetNumberValue(node, ov->value);
+    } else if (cJSON_IsBool(node)) {
+        if (ov->value != 0.0 && ov->value != 1.0)
+            return FAIL(r, "%s: override %s: a Boolean key takes 0 or 1", r->origin, ov->key);
+        node->type = ov->value != 0.0 ? cJSON_True : cJSON_False;
+    } else {
+        return FAIL(r, "%s: override %s: the key is not a number or a Boolean", r->origin, ov->key);
+    }
+    return MIXSPH_OK;
+}
+
+/* ---- typed getters ------------------------------------------------------------------------ */
+
+/* Reject keys an object does not know: a misspelt key would otherwise be silently ignored. */
+static mixsph_status check_keys(struct reader *r, const cJSON *obj, const char *path, const char *const *allowed)
+{
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        int ok = 0;
+        for (const char *const *a = allowed; *a; a++) ok |= strcmp(it->string, *a) == 0;
+        if (!ok) return FAIL(r, "%s: %s%s%s: unknown key", r->origin, path, *path ? "." : "", it->string);
+    }
+    return MIXSPH_OK;
+}
+
+/* A number in [lo, hi] (lo_open: > lo). A missing optional key keeps *out. */
+static mixsph_status get_num(struct reader *r, const cJSON *obj, const char *path, const char *key, int required,
+                             double lo, int lo_open, double hi, double *out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return required ? FAIL(r, "%s: %s.%s: missing (expected a number)", r->origin, path, key) : MIXSPH_OK;
+    if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
+        return FAIL(r, "%s: %s.%s: expected a number", r->origin, path, key);
+    const double v = it->valuedouble;
+    if ((lo_open ? v <= lo : v < lo) || v > hi) {
+        if (isinf(hi)) return FAIL(r, "%s: %s.%s: %g is out of range (expected %s %g)", r->origin, path, key, v, lo_open ? ">" : ">=", lo);
+        return FAIL(r, "%s: %s.%s: %g is out of range (expected %g %s x <= %g)", r->origin, path, key, v, lo, lo_open ? "<" : "<=", hi);
+    }
+    *out = v;
+    return MIXSPH_OK;
+}
+
+static mixsph_status get_str(struct reader *r, const cJSON *obj, const char *path, const char *key, int required,
+                             const char **out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return required ? FAIL(r, "%s: %s.%s: missing (expected a string)", r->origin, path, key) : MIXSPH_OK;
+    if (!cJSON_IsString(it)) return FAIL(r, "%s: %s.%s: expected a string", r->origin, path, key);
+    *out = it->valuestring;
+    return MIXSPH_OK;
+}
+
+static mixsph_status get_obj(struct reader *r, const cJSON *parent, const char *path, const char *key, int required,
+                             const cJSON **out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(parent, key);
+    *out = NULL;
+    if (!it) return required ? FAIL(r, "%s: %s%s%s: missing (expected an object)", r->origin, path, *path ? "." : "", key) : MIXSPH_OK;
+    if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s%s%s: expected an object", r->origin, path, *path ? "." : "", key);
+    *out = it;
+    return MIXSPH_OK;
+}
+
+/* An array of n finite numbers (n >= min_n). */
+static mixsph_status get_numbers(struct reader *r, const cJSON *obj, const char *path, const char *key, size_t min_n,
+                                 double **out, size_t *n)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return FAIL(r, "%s: %s.%s: missing (expected an array of numbers)", r->origin, path, key);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s.%s: expected an array of numbers", r->origin, path, key);
+    size_t len = (size_t)cJSON_GetArraySize(it);
+    if (len < min_n) return FAIL(r, "%s: %s.%s: expected at least %zu numbers", r->origin, path, key, min_n);
+    double *v = calloc(len, sizeof *v);
+    if (!v) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (const cJSON *e = it->child; e; e = e->next, k++) {
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
+            free(v);
+            return FAIL(r, "%s: %s.%s[%zu]: expected a number", r->origin, path, key, k);
+        }
+        v[k] = e->valuedouble;
+    }
+    *out = v;
+    *n = len;
+    return MIXSPH_OK;
+}
+
+/* An array of [x, z] points. */
+static mixsph_status get_points(struct reader *r, const cJSON *obj, const char *path, const char *key, size_t min_n,
+                                struct polyline *pl)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return FAIL(r, "%s: %s.%s: missing (expected an array of [x, z] points)", r->origin, path, key);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s.%s: expected an array of [x, z] points", r->origin, path, key);
+    size_t len = (size_t)cJSON_GetArraySize(it);
+    if (len < min_n) return FAIL(r, "%s: %s.%s: expected at least %zu [x, z] points", r->origin, path, key, min_n);
+    pl->x = calloc(len, sizeof(double));
+    pl->z = calloc(len, sizeof(double));
+    pl->n = len;
+    if (!pl->x || !pl->z) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (const cJSON *e = it->child; e; e = e->next, k++) {
+        const cJSON *a = cJSON_IsArray(e) && cJSON_GetArraySize(e) == 2 ? e->child : NULL;
+        if (!a || !cJSON_IsNumber(a) || !cJSON_IsNumber(a->next) || !isfinite(a->valuedouble) ||
+            !isfinite(a->next->valuedouble))
+            return FAIL(r, "%s: %s.%s[%zu]: expected a point [x, z] of two numbers", r->origin, path, key, k);
+        pl->x[k] = a->valuedouble;
+        pl->z[k] = a->next->valuedouble;
+        if (k > 0 && pl->x[k] == pl->x[k - 1] && pl->z[k] == pl->z[k - 1])
+            return FAIL(r, "%s: %s.%s[%zu]: repeats the previous point", r->origin, path, key, k);
+    }
+    return MIXSPH_OK;
+}
+
+static mixsph_status copy_name(struct reader *r, const char *path, const char *name, char *dst)
+{
+    if (strlen(name) == 0 || strlen(name) >= CASE_NAME_LEN)
+        return FAIL(r, "%s: %s: name must have 1 to %d characters", r->origin, path, CASE_NAME_LEN - 1);
+    strcpy(dst, name);
+    return MIXSPH_OK;
+}
+
+static int find_medium(const struct case_def *c, const char *name)
+{
+    for (size_t i = 0; i < c->n_media; i++)
+        if (strcmp(c->media[i].name, name) == 0) return (int)i;
+    return -1;
+}
+
+static int find_motion(const struct case_def *c, const char *name)
+{
+    for (size_t i = 0; i < c->n_motions; i++)
+        if (strcmp(c->motions[i].name, name) == 0) return (int)i;
+    return -1;
+}
+
+#define TRY(expr)                                  \
+    do {                                           \
+        mixsph_status st_ = (expr);                \
+        if (st_ != MIXSPH_OK) return st_;          \
+    } while (0)
+
+/* ---- sections ----------------------------------------------------------------------------- */
+
+static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", NULL};
+    const cJSON *n;
+    TRY(get_obj(r, root, "", "numerics", 1, &n));
+    TRY(check_keys(r, n, "numerics", keys));
+    c->h_over_dx = 1.3;
+    c->cfl = 0.1;
+    c->cfl_visc = 0.05;
+    double layers = 3;
+    TRY(get_num(r, n, "numerics", "dx", 1, 0.0, 1, 10.0, &c->dx));
+    TRY(get_num(r, n, "numerics", "h_over_dx", 0, 1.0, 0, 3.0, &c->h_over_dx));
+    TRY(get_num(r, n, "numerics", "cfl", 0, 0.0, 1, 1.0, &c->cfl));
+    TRY(get_num(r, n, "numerics", "cfl_visc", 0, 0.0, 1, 1.0, &c->cfl_visc));
+    TRY(get_num(r, n, "numerics", "t_end", 1, 0.0, 1, 1e6, &c->t_end));
+    TRY(get_num(r, n, "numerics", "wall_layers", 0, 1.0, 0, 8.0, &layers));
+    c->wall_layers = (int)layers;
+    if ((double)c->wall_layers != layers) return FAIL(r, "%s: numerics.wall_layers: expected an integer", r->origin);
+    if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
+        return FAIL(r, "%s: numerics.wall_layers: %d layers do not cover the kernel support 2h = %.2f dx (expected >= %d)",
+                    r->origin, c->wall_layers, 2.0 * c->h_over_dx, (int)ceil(2.0 * c->h_over_dx));
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_media(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"type", "rho", "K", "c", "mu", "alpha_m", NULL};
+    const cJSON *m;
+    TRY(get_obj(r, root, "", "media", 1, &m));
+    for (const cJSON *it = m->child; it; it = it->next) {
+        char path[128];
+        snprintf(path, sizeof path, "media.%s", it->string);
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
+        if (c->n_media == CASE_MAX_MEDIA) return FAIL(r, "%s: media: at most %d media", r->origin, CASE_MAX_MEDIA);
+        struct medium *md = &c->media[c->n_media];
+        TRY(copy_name(r, path, it->string, md->name));
+        TRY(check_keys(r, it, path, keys));
+        const char *type = NULL;
+        TRY(get_str(r, it, path, "type", 1, &type));
+        if (strcmp(type, "fluid") == 0) {
+            md->kind = MEDIUM_FLUID;
+        } else {
+            return FAIL(r, "%s: %s.type: '%s' is not a known medium type (expected \"fluid\")", r->origin, path, type);
+        }
+        TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho0));
+        const int has_k = cJSON_HasObjectItem(it, "K"), has_c = cJSON_HasObjectItem(it, "c");
+        if (has_k == has_c) return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
+        if (has_k) {
+            double k = 0;
+            TRY(get_num(r, it, path, "K", 1, 0.0, 1, 1e12, &k));
+            md->c = sqrt(k / md->rho0);
+        } else {
+            TRY(get_num(r, it, path, "c", 1, 0.0, 1, 1e5, &md->c));
+        }
+        md->mu = 0.0;
+        md->alpha_m = 0.0;
+        TRY(get_num(r, it, path, "mu", 0, 0.0, 0, 1e9, &md->mu));
+        TRY(get_num(r, it, path, "alpha_m", 0, 0.0, 0, 10.0, &md->alpha_m));
+        c->n_media++;
+    }
+    if (c->n_media == 0) return FAIL(r, "%s: media: expected at least one medium", r->origin);
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_bodies(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"medium", "polygon", "z_min", "z_max", NULL};
+    const cJSON *b;
+    TRY(get_obj(r, root, "", "bodies", 1, &b));
+    for (const cJSON *it = b->child; it; it = it->next) {
+        char path[128];
+        snprintf(path, sizeof path, "bodies.%s", it->string);
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
+        if (c->n_bodies == CASE_MAX_BODIES) return FAIL(r, "%s: bodies: at most %d bodies", r->origin, CASE_MAX_BODIES);
+        struct body *bd = &c->bodies[c->n_bodies++];
+        TRY(copy_name(r, path, it->string, bd->name));
+        TRY(check_keys(r, it, path, keys));
+        const char *medium = NULL;
+        TRY(get_str(r, it, path, "medium", 1, &medium));
+        bd->medium = find_medium(c, medium);
+        if (bd->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
+        TRY(get_points(r, it, path, "polygon", 3, &bd->polygon));
+        bd->z_min = -INFINITY;
+        bd->z_max = INFINITY;
+        TRY(get_num(r, it, path, "z_min", 0, -1e9, 0, 1e9, &bd->z_min));
+        TRY(get_num(r, it, path, "z_max", 0, -1e9, 0, 1e9, &bd->z_max));
+    }
+    if (c->n_bodies == 0) return FAIL(r, "%s: bodies: expected at least one body", r->origin);
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_motions(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"t", "vx", "vz", "speed_scale", "time_scale", NULL};
+    const cJSON *m;
+    TRY(get_obj(r, root, "", "motions", 0, &m));
+    if (!m) return MIXSPH_OK;
+    for (const cJSON *it = m->child; it; it = it->next) {
+        char path[128];
+        snprintf(path, sizeof path, "motions.%s", it->string);
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
+        if (c->n_motions == CASE_MAX_MOTIONS) return FAIL(r, "%s: motions: at most %d", r->origin, CASE_MAX_MOTIONS);
+        struct motion *mo = &c->motions[c->n_motions++];
+        TRY(copy_name(r, path, it->string, mo->name));
+        TRY(check_keys(r, it, path, keys));
+        size_t nt = 0, nx = 0, nz = 0;
+        TRY(get_numbers(r, it, path, "t", 1, &mo->t, &nt));
+        TRY(get_numbers(r, it, path, "vx", 1, &mo->vx, &nx));
+        TRY(get_numbers(r, it, path, "vz", 1, &mo->vz, &nz));
+        if (nx != nt || nz != nt) return FAIL(r, "%s: %s: t, vx and vz must have the same length (%zu, %zu, %zu)", r->origin, path, nt, nx, nz);
+        for (size_t k = 1; k < nt; k++)
+            if (!(mo->t[k] > mo->t[k - 1])) return FAIL(r, "%s: %s.t[%zu]: times must increase", r->origin, path, k);
+        mo->n = nt;
+        mo->speed_scale = 1.0;
+        mo->time_scale = 1.0;
+        TRY(get_num(r, it, path, "speed_scale", 0, 0.0, 0, 1e3, &mo->speed_scale));
+        TRY(get_num(r, it, path, "time_scale", 0, 0.0, 1, 1e3, &mo->time_scale));
+    }
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_walls(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"polyline", "fluid_side", "motion", "slip", NULL};
+    const cJSON *w;
+    TRY(get_obj(r, root, "", "walls", 1, &w));
+    for (const cJSON *it = w->child; it; it = it->next) {
+        char path[128];
+        snprintf(path, sizeof path, "walls.%s", it->string);
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
+        if (c->n_walls == CASE_MAX_WALLS) return FAIL(r, "%s: walls: at most %d walls", r->origin, CASE_MAX_WALLS);
+        struct wall *wl = &c->walls[c->n_walls++];
+        TRY(copy_name(r, path, it->string, wl->name));
+        TRY(check_keys(r, it, path, keys));
+        TRY(get_points(r, it, path, "polyline", 2, &wl->line));
+        const char *side = NULL, *slip = "no-slip", *motion = NULL;
+        TRY(get_str(r, it, path, "fluid_side", 1, &side));
+        if (strcmp(side, "left") == 0) wl->side = 1;
+        else if (strcmp(side, "right") == 0) wl->side = -1;
+        else return FAIL(r, "%s: %s.fluid_side: '%s' (expected \"left\" or \"right\" of the polyline's direction)", r->origin, path, side);
+        TRY(get_str(r, it, path, "slip", 0, &slip));
+        if (strcmp(slip, "no-slip") == 0) wl->slip = WALL_NO_SLIP;
+        else if (strcmp(slip, "free-slip") == 0) wl->slip = WALL_FREE_SLIP;
+        else return FAIL(r, "%s: %s.slip: '%s' (expected \"no-slip\" or \"free-slip\")", r->origin, path, slip);
+        wl->motion = -1;
+        TRY(get_str(r, it, path, "motion", 0, &motion));
+        if (motion) {
+            wl->motion = find_motion(c, motion);
+            if (wl->motion < 0) return FAIL(r, "%s: %s.motion: '%s' is not one of the motions", r->origin, path, motion);
+        }
+    }
+    if (c->n_walls == 0) return FAIL(r, "%s: walls: expected at least one wall", r->origin);
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"type", "medium", "direction", "x_min", "x_max", "min_neighbours", NULL};
+    const cJSON *m;
+    TRY(get_obj(r, root, "", "monitors", 0, &m));
+    if (!m) return MIXSPH_OK;
+    for (const cJSON *it = m->child; it; it = it->next) {
+        char path[128];
+        snprintf(path, sizeof path, "monitors.%s", it->string);
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
+        if (c->n_monitors == CASE_MAX_MONITORS) return FAIL(r, "%s: monitors: at most %d", r->origin, CASE_MAX_MONITORS);
+        struct monitor_def *md = &c->monitors[c->n_monitors++];
+        TRY(copy_name(r, path, it->string, md->name));
+        TRY(check_keys(r, it, path, keys));
+        const char *type = NULL, *medium = NULL, *dir = "+x";
+        TRY(get_str(r, it, path, "type", 1, &type));
+        TRY(get_str(r, it, path, "medium", 1, &medium));
+        md->medium = find_medium(c, medium);
+        if (md->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
+        double mn = 3;
+        TRY(get_num(r, it, path, "min_neighbours", 0, 0.0, 0, 100.0, &mn));
+        md->min_neighbours = (int)mn;
+        md->x_min = -INFINITY;
+        md->x_max = INFINITY;
+        if (strcmp(type, "front") == 0) {
+            md->kind = MONITOR_FRONT;
+            TRY(get_str(r, it, path, "direction", 0, &dir));
+            if (strcmp(dir, "+x") == 0) md->direction = 1;
+            else if (strcmp(dir, "-x") == 0) md->direction = -1;
+            else return FAIL(r, "%s: %s.direction: '%s' (expected \"+x\" or \"-x\")", r->origin, path, dir);
+        } else if (strcmp(type, "max_elevation") == 0) {
+            md->kind = MONITOR_MAX_ELEVATION;
+            TRY(get_num(r, it, path, "x_min", 0, -1e9, 0, 1e9, &md->x_min));
+            TRY(get_num(r, it, path, "x_max", 0, -1e9, 0, 1e9, &md->x_max));
+            if (!(md->x_max > md->x_min)) return FAIL(r, "%s: %s: expected x_min < x_max", r->origin, path);
+        } else {
+            return FAIL(r, "%s: %s.type: '%s' (expected \"front\" or \"max_elevation\")", r->origin, path, type);
+        }
+    }
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_root(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"name", "description", "gravity", "numerics", "domain", "media", "bodies",
+                                       "walls", "motions", "monitors", "output", NULL};
+    static const char *const dkeys[] = {"x_min", "x_max", "z_min", "z_max", NULL};
+    static const char *const okeys[] = {"monitor_interval", "snapshot_interval", NULL};
+    if (!cJSON_IsObject(root)) return FAIL(r, "%s: the case must be a JSON object", r->origin);
+    TRY(check_keys(r, root, "", keys));
+    const char *name = NULL, *desc = NULL;
+    TRY(get_str(r, root, "case", "name", 1, &name));
+    TRY(copy_name(r, "name", name, c->name));
+    TRY(get_str(r, root, "case", "description", 0, &desc));
+    c->g = 9.81;
+    TRY(get_num(r, root, "case", "gravity", 0, 0.0, 0, 100.0, &c->g));
+    TRY(read_numerics(r, root, c));
+    const cJSON *d;
+    TRY(get_obj(r, root, "", "domain", 0, &d));
+    if (d) {
+        TRY(check_keys(r, d, "domain", dkeys));
+        for (int k = 0; k < 4; k++) TRY(get_num(r, d, "domain", dkeys[k], 1, -1e9, 0, 1e9, &c->domain[k]));
+        if (!(c->domain[1] > c->domain[0]) || !(c->domain[3] > c->domain[2]))
+            return FAIL(r, "%s: domain: expected x_min < x_max and z_min < z_max", r->origin);
+        c->has_domain = 1;
+    }
+    TRY(read_media(r, root, c));
+    TRY(read_bodies(r, root, c));
+    TRY(read_motions(r, root, c));
+    TRY(read_walls(r, root, c));
+    TRY(read_monitors(r, root, c));
+    const cJSON *o;
+    TRY(get_obj(r, root, "", "output", 0, &o));
+    c->monitor_interval = c->t_end / 200.0;
+    c->snapshot_interval = 0.0;
+    if (o) {
+        TRY(check_keys(r, o, "output", okeys));
+        TRY(get_num(r, o, "output", "monitor_interval", 0, 0.0, 1, 1e6, &c->monitor_interval));
+        TRY(get_num(r, o, "output", "snapshot_interval", 0, 0.0, 0, 1e6, &c->snapshot_interval));
+    }
+    return MIXSPH_OK;
+}
+
+mixsph_status case_parse(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,
+                         struct case_def *c, char *err, size_t err_len)
+{
+    struct reader r = {origin ? origin : "(case)", err, err_len};
+    memset(c, 0, sizeof *c);
+    snprintf(c->origin, sizeof c->origin, "%s", r.origin);
+    if (!json_text) return FAIL(&r, "%s: no case text", r.origin);
+    const char *where = NULL;
+    cJSON *root = cJSON_ParseWithOpts(json_text, &where, 1);
+    if (!root) {
+        size_t line = 1;
+        for (const char *p = json_text; where && p < where; p++) line += *p == '\n';
+        return FAIL(&r, "%s: line %zu: not valid JSON", r.origin, line);
+    }
+    mixsph_status st = MIXSPH_OK;
+    for (size_t k = 0; k < n_ov && st == MIXSPH_OK; k++) st = apply_override(&r, root, &ov[k]);
+    if (st == MIXSPH_OK) st = read_root(&r, root, c);
+    cJSON_Delete(root);
+    if (st != MIXSPH_OK) case_free(c);
+    return st;
+}
+
+void case_free(struct case_def *c)
+{
+    for (size_t i = 0; i < CASE_MAX_BODIES; i++) geom_free(&c->bodies[i].polygon);
+    for (size_t i = 0; i < CASE_MAX_WALLS; i++) geom_free(&c->walls[i].line);
+    for (size_t i = 0; i < CASE_MAX_MOTIONS; i++) {
+        free(c->motions[i].t);
+        free(c->motions[i].vx);
+        free(c->motions[i].vz);
+        c->motions[i].t = c->motions[i].vx = c->motions[i].vz = NULL;
+    }
+}
+
+/* ---- motion laws ------------------------------------------------------------------------- */
+
+/* Interval k and fraction f of law time tl: t[k] <= tl < t[k+1]; k = -1 before, n-1 after. */
+static void motion_locate(const struct motion *m, double tl, size_t *k, double *f, int *outside)
+{
+    *outside = 0;
+    if (m->n == 1 || tl <= m->t[0]) {
+        *k = 0;
+        *f = 0.0;
+        *outside = 1;
+        return;
+    }
+    if (tl >= m->t[m->n - 1]) {
+        *k = m->n - 1;
+        *f = 0.0;
+        *outside = 1;
+        return;
+    }
+    size_t lo = 0, hi = m->n - 1;
+    while (hi - lo > 1) {
+        size_t mid = (lo + hi) / 2;
+        if (m->t[mid] <= tl) lo = mid;
+        else hi = mid;
+    }
+    *k = lo;
+    *f = (tl - m->t[lo]) / (m->t[lo + 1] - m->t[lo]);
+}
+
+void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz)
+{
+    size_t k;
+    double f;
+    int outside;
+    motion_locate(m, t / m->time_scale, &k, &f, &outside);
+    if (outside) {
+        *vx = m->speed_scale * m->vx[k];
+        *vz = m->speed_scale * m->vz[k];
+        return;
+    }
+    *vx = m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k]));
+    *vz = m->speed_scale * (m->vz[k] + f * (m->vz[k + 1] - m->vz[k]));
+}
+
+void case_motion_acceleration(const struct motion *m, double t, double *ax, double *az)
+{
+    size_t k;
+    double f;
+    int outside;
+    motion_locate(m, t / m->time_scale, &k, &f, &outside);
+    if (outside) {
+        *ax = *az = 0.0;
+        return;
+    }
+    const double dt = (m->t[k + 1] - m->t[k]) * m->time_scale;
+    *ax = m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt;
+    *az = m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt;
+}

@@ -1,0 +1,99 @@
+/* case.h - the case definition: media, bodies, walls, motion laws, numerics, monitors, output;
+ * read from a JSON case file (cJSON) with numeric key=value overrides, and validated.
+ * Every error names the file, the key and what was expected. */
+#ifndef MIXSPH_CASE_H
+#define MIXSPH_CASE_H
+#include <stddef.h>
+#include "geometry.h"
+#include "mixsph.h"
+
+#define CASE_NAME_LEN 48
+#define CASE_MAX_MEDIA 8
+#define CASE_MAX_BODIES 16
+#define CASE_MAX_WALLS 16
+#define CASE_MAX_MOTIONS 8
+#define CASE_MAX_MONITORS 16
+
+enum medium_kind { MEDIUM_FLUID = 0, MEDIUM_GRANULAR = 1 };
+
+struct medium {
+    char name[CASE_NAME_LEN];
+    int kind;          /* MEDIUM_FLUID / MEDIUM_GRANULAR */
+    double rho0;       /* reference density [kg/m3] */
+    double c;          /* sound speed [m/s] */
+    double mu;         /* dynamic viscosity [Pa s] */
+    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] */
+};
+
+struct body {
+    char name[CASE_NAME_LEN];
+    int medium;               /* index into media */
+    struct polyline polygon;  /* closed implicitly [m] */
+    double z_min, z_max;      /* the body is clipped to z_min <= z <= z_max [m] */
+};
+
+struct motion {
+    char name[CASE_NAME_LEN];
+    size_t n;
+    double *t, *vx, *vz;      /* velocity law, linear between rows [s], [m/s] */
+    double speed_scale;       /* velocities are multiplied by this [-] */
+    double time_scale;        /* the law is stretched in time by this [-] */
+};
+
+enum wall_slip { WALL_NO_SLIP = 0, WALL_FREE_SLIP = 1 };
+
+struct wall {
+    char name[CASE_NAME_LEN];
+    struct polyline line;     /* open polyline [m] */
+    int side;                 /* +1: fluid on the left of the direction of travel, -1: right */
+    int motion;               /* index into motions, -1 for a fixed wall */
+    int slip;                 /* enum wall_slip */
+};
+
+enum monitor_kind { MONITOR_FRONT = 0, MONITOR_MAX_ELEVATION = 1 };
+
+struct monitor_def {
+    char name[CASE_NAME_LEN];
+    int kind;                 /* enum monitor_kind */
+    int medium;               /* index into media */
+    int direction;            /* front: +1 largest x, -1 smallest x */
+    double x_min, x_max;      /* max_elevation: x-range [m] */
+    int min_neighbours;       /* particles with fewer same-medium neighbours are spray, ignored */
+};
+
+struct case_def {
+    char origin[256];         /* file name, for messages */
+    char name[CASE_NAME_LEN];
+    double g;                 /* gravity magnitude [m/s2], acting along -z */
+    double dx;                /* particle spacing [m] */
+    double h_over_dx;         /* h = h_over_dx dx */
+    double cfl, cfl_visc;     /* time-step coefficients of (4) */
+    double t_end;             /* [s] */
+    int wall_layers;          /* layers of wall particles behind each wall */
+    int has_domain;
+    double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */
+    double monitor_interval;  /* [s] */
+    double snapshot_interval; /* [s], 0 = none */
+    size_t n_media, n_bodies, n_walls, n_motions, n_monitors;
+    struct medium media[CASE_MAX_MEDIA];
+    struct body bodies[CASE_MAX_BODIES];
+    struct wall walls[CASE_MAX_WALLS];
+    struct motion motions[CASE_MAX_MOTIONS];
+    struct monitor_def monitors[CASE_MAX_MONITORS];
+};
+
+/** Read and validate a case from JSON text; `origin` names it in messages. */
+mixsph_status case_parse(const char *json_text, const char *origin, const mixsph_override *ov,
+                         size_t n_ov, struct case_def *c, char *err, size_t err_len);
+
+/** Read a whole file into a NUL-terminated buffer (caller frees). */
+mixsph_status case_read_file(const char *path, char **text, char *err, size_t err_len);
+
+void case_free(struct case_def *c);
+
+/** Velocity of a motion law at time t (linear between rows, held at the ends). */
+void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz);
+/** Acceleration of a motion law at time t (slope of the current interval). */
+void case_motion_acceleration(const struct motion *m, double t, double *ax, double *az);
+
+#endif

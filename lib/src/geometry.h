@@ -1,0 +1,28 @@
+/* geometry.h - polygons and polylines in the x-z plane: point in polygon, signed distance to
+ * a wall polyline, and the segment crossing test used to keep particles out of walls. */
+#ifndef MIXSPH_GEOMETRY_H
+#define MIXSPH_GEOMETRY_H
+#include <stddef.h>
+
+struct polyline {
+    size_t n;     /* vertices */
+    double *x;    /* [m] */
+    double *z;    /* [m] */
+};
+
+/** Even-odd point-in-polygon test (the polygon is closed implicitly). */
+int geom_inside_polygon(const struct polyline *poly, double x, double z);
+
+/** Distance from (x,z) to an open polyline, signed: positive on the side `side` (+1: left of
+ *  the direction of travel, -1: right). *at_end is set when the nearest point is one of the two
+ *  open ends (the point lies beyond the polyline, not beside it). */
+double geom_signed_distance(const struct polyline *line, int side, double x, double z, int *at_end);
+
+/** Does the path a->b cross segment c->d? On a crossing returns 1 and the fraction s in [0,1]
+ *  of the path at which it happens. */
+int geom_path_crosses(double ax, double az, double bx, double bz, double cx, double cz, double dx,
+                      double dz, double *s);
+
+void geom_free(struct polyline *p);
+
+#endif

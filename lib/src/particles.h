@@ -1,0 +1,37 @@
+/* particles.h - struct-of-arrays particle storage (fluid, granular and wall particles in one
+ * set, told apart by `state`), growth and permutation (the cell sort reorders every step). */
+#ifndef MIXSPH_PARTICLES_H
+#define MIXSPH_PARTICLES_H
+#include <stddef.h>
+#include <stdint.h>
+
+struct particles {
+    size_t n, cap;
+    double *x, *z;        /* position [m] */
+    double *vx, *vz;      /* velocity [m/s]; walls: the wall's prescribed velocity */
+    double *uvx, *uvz;    /* velocity seen by viscous terms [m/s]: walls: no-slip mirror velocity */
+    double *rho;          /* density [kg/m3] */
+    double *p;            /* pressure [Pa]; walls: extrapolated (Adami et al. 2012) */
+    double *m;            /* mass [kg] */
+    double *vol;          /* volume m/rho [m3 per m] */
+    double *mu;           /* dynamic viscosity [Pa s] */
+    double *ax, *az;      /* acceleration [m/s2] */
+    double *drho;         /* density rate [kg/m3/s] */
+    uint8_t *medium;      /* index into the case's media (walls: the wall index) */
+    uint8_t *state;       /* MIXSPH_STATE_* */
+    uint16_t *nneigh;     /* neighbours of the same medium within 2h (last force pass) */
+    uint32_t *id;         /* stable id */
+};
+
+/** Allocate room for cap particles (n = 0). Returns 0 on success. */
+int particles_alloc(struct particles *P, size_t cap);
+void particles_free(struct particles *P);
+/** Append one particle with zero velocity and rates; returns its index or (size_t)-1. */
+size_t particles_push(struct particles *P, double x, double z, double rho, double m, uint8_t medium,
+                      uint8_t state);
+/** Reorder: new particle k is old particle perm[k]. `scratch` holds n doubles. */
+void particles_permute(struct particles *P, const size_t *perm, void *scratch);
+/** Deep copy (dst must be zeroed or freed). Returns 0 on success. */
+int particles_copy(struct particles *dst, const struct particles *src);
+
+#endif

@@ -1,0 +1,353 @@
+/* sim.c - the simulation object: creation from a case (particles on the lattice, hydrostatic
+ * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
+#include "sim.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "eos.h"
+#include "status.h"
+
+/* A lattice site of a body, for the hydrostatic initialisation. */
+struct site {
+    long i, k;       /* lattice indices: x = (i + 1/2) dx, z = (k + 1/2) dx */
+    int medium;
+};
+
+static int site_cmp(const void *a, const void *b)
+{
+    const struct site *p = a, *q = b;
+    if (p->i != q->i) return p->i < q->i ? -1 : 1;
+    if (p->k != q->k) return p->k > q->k ? -1 : 1; /* top first */
+    return 0;
+}
+
+/* Is (x, z) too close to a wall, or behind one, to hold a particle? */
+static int site_blocked(const mixsph_sim *s, double x, double z)
+{
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        int at_end = 0;
+        double d;
+        walls_signed_distance(s, w, x, z, &d, &at_end);
+        if (!at_end && d < 0.5 * s->dx * (1.0 - 1e-9)) return 1;
+    }
+    return 0;
+}
+
+/* Fill every body on the global lattice (a site belongs to the first body listing it), then
+ * give each particle the hydrostatic pressure of the lattice column above it:
+ * p = sum over the sites above of rho0 g dx, plus half its own; rho from the EOS; m = rho dx^2. */
+static mixsph_status fill_bodies(mixsph_sim *s)
+{
+    const double dx = s->dx;
+    size_t n = 0, cap = 1024;
+    struct site *sites = malloc(cap * sizeof *sites);
+    if (!sites) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    double bx0 = INFINITY, bx1 = -INFINITY, bz0 = INFINITY, bz1 = -INFINITY;
+    for (size_t b = 0; b < s->cfg.n_bodies; b++) {
+        const struct polyline *pg = &s->cfg.bodies[b].polygon;
+        for (size_t k = 0; k < pg->n; k++) {
+            bx0 = fmin(bx0, pg->x[k]);
+            bx1 = fmax(bx1, pg->x[k]);
+            bz0 = fmin(bz0, pg->z[k]);
+            bz1 = fmax(bz1, pg->z[k]);
+        }
+    }
+    const long i0 = (long)floor(bx0 / dx) - 1, i1 = (long)ceil(bx1 / dx) + 1;
+    const long k0 = (long)floor(bz0 / dx) - 1, k1 = (long)ceil(bz1 / dx) + 1;
+    for (long k = k0; k <= k1; k++) {
+        for (long i = i0; i <= i1; i++) {
+            const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
+            int medium = -1;
+            for (size_t b = 0; b < s->cfg.n_bodies && medium < 0; b++) {
+                const struct body *bd = &s->cfg.bodies[b];
+                if (z >= bd->z_min && z <= bd->z_max && geom_inside_polygon(&bd->polygon, x, z)) medium = bd->medium;
+            }
+            if (medium < 0 || site_blocked(s, x, z)) continue;
+            if (n == cap) {
+                struct site *q = realloc(sites, 2 * cap * sizeof *sites);
+                if (!q) {
+                    free(sites);
+                    return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+                }
+                sites = q;
+                cap *= 2;
+            }
+            sites[n++] = (struct site){i, k, medium};
+        }
+    }
+    if (n == 0) {
+        free(sites);
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: bodies: no particle fits in the bodies at dx = %g", s->cfg.origin, dx);
+    }
+    if (n > 50000000) {
+        free(sites);
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: numerics.dx: %g gives %zu particles (limit 5e7)", s->cfg.origin, dx, n);
+    }
+    qsort(sites, n, sizeof *sites, site_cmp);
+    if (particles_alloc(&s->P, n + n / 2 + 1024) != 0) {
+        free(sites);
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
+    }
+    double above = 0.0; /* pressure of the column above the current site [Pa] */
+    for (size_t q = 0; q < n; q++) {
+        if (q == 0 || sites[q].i != sites[q - 1].i) above = 0.0;
+        const struct medium *m = &s->cfg.media[sites[q].medium];
+        const double p = above + 0.5 * m->rho0 * s->cfg.g * dx;
+        above += m->rho0 * s->cfg.g * dx;
+        const double rho = eos_density(p, m->rho0, m->c);
+        particles_push(&s->P, (sites[q].i + 0.5) * dx, (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
+                       (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
+        s->P.mu[s->P.n - 1] = m->mu;
+    }
+    s->n_fluid = n;
+    free(sites);
+    return MIXSPH_OK;
+}
+
+/* The domain: given in the case, or the bounding box of all geometry (moving walls swept over
+ * the run) with room for the wall layers, and half the height again above for splashes. */
+static void set_domain(mixsph_sim *s)
+{
+    if (s->cfg.has_domain) {
+        memcpy(s->domain, s->cfg.domain, sizeof s->domain);
+        return;
+    }
+    double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
+    for (size_t i = 0; i < s->P.n; i++) {
+        x0 = fmin(x0, s->P.x[i]);
+        x1 = fmax(x1, s->P.x[i]);
+        z0 = fmin(z0, s->P.z[i]);
+        z1 = fmax(z1, s->P.z[i]);
+    }
+    /* sweep of moving walls */
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        const int mo = s->cfg.walls[w].motion;
+        if (mo < 0) continue;
+        double ox = 0, oz = 0, oxmin = 0, oxmax = 0, ozmin = 0, ozmax = 0;
+        const int nsub = 2000;
+        const double dt = s->cfg.t_end / nsub;
+        for (int k = 0; k < nsub; k++) {
+            double vx, vz;
+            case_motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
+            ox += vx * dt;
+            oz += vz * dt;
+            oxmin = fmin(oxmin, ox);
+            oxmax = fmax(oxmax, ox);
+            ozmin = fmin(ozmin, oz);
+            ozmax = fmax(ozmax, oz);
+        }
+        x0 += fmin(0.0, oxmin);
+        x1 += fmax(0.0, oxmax);
+        z0 += fmin(0.0, ozmin);
+        z1 += fmax(0.0, ozmax);
+    }
+    const double pad = 2.0 * s->dx;
+    s->domain[0] = x0 - pad;
+    s->domain[1] = x1 + pad;
+    s->domain[2] = z0 - pad;
+    s->domain[3] = z1 + 0.5 * (z1 - z0) + pad;
+}
+
+static mixsph_status sim_init(mixsph_sim *s)
+{
+    mixsph_status st;
+    s->dx = s->cfg.dx;
+    s->h = s->cfg.h_over_dx * s->dx;
+    s->K = kernel_make(s->h);
+    s->c_max = 0.0;
+    for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        const int mo = s->cfg.walls[w].motion;
+        if (mo < 0) continue;
+        case_motion_velocity(&s->cfg.motions[mo], 0.0, &s->walls[w].vx, &s->walls[w].vz);
+        case_motion_acceleration(&s->cfg.motions[mo], 0.0, &s->walls[w].ax, &s->walls[w].az);
+    }
+    if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
+    if ((st = walls_generate(s)) != MIXSPH_OK) return st;
+    for (size_t i = s->n_fluid; i < s->P.n; i++) {
+        const struct wall_state *ws = &s->walls[s->P.medium[i]];
+        s->P.vx[i] = s->P.uvx[i] = ws->vx;
+        s->P.vz[i] = s->P.uvz[i] = ws->vz;
+    }
+    set_domain(s);
+    if (cells_init(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
+                        s->cfg.origin, s->domain[0], s->domain[1], s->domain[2], s->domain[3]);
+    if (cells_build(&s->C, &s->P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
+    s->n_lost = 0;
+    for (size_t i = 0; i < s->P.n; i++)
+        if (s->P.state[i] == MIXSPH_STATE_LOST)
+            return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
+                            s->P.x[i], s->P.z[i]);
+    integrate_eos(s);
+    walls_pressure(s);
+    if (forces_compute(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
+    s->dt = integrate_time_step(s);
+    monitors_init(s);
+    s->next_sample = 0.0;
+    s->next_snapshot = 0.0;
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov,
+                                          size_t n_ov, mixsph_sim **out, char *err, size_t err_len)
+{
+    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: out is NULL");
+    *out = NULL;
+    if (n_ov > 0 && !ov) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: overrides are NULL");
+    mixsph_sim *s = calloc(1, sizeof *s);
+    if (!s) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    mixsph_status st = case_parse(json_text, origin, ov, n_ov, &s->cfg, s->err, sizeof s->err);
+    if (st == MIXSPH_OK) st = sim_init(s);
+    if (st != MIXSPH_OK) {
+        status_set(err, err_len, st, "%s", s->err);
+        mixsph_sim_destroy(s);
+        return st;
+    }
+    *out = s;
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_create(const char *case_path, const mixsph_override *ov, size_t n_ov, mixsph_sim **out,
+                                char *err, size_t err_len)
+{
+    if (out) *out = NULL;
+    if (!case_path) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: no case file given");
+    char *text = NULL;
+    mixsph_status st = case_read_file(case_path, &text, err, err_len);
+    if (st != MIXSPH_OK) return st;
+    st = mixsph_sim_create_from_text(text, case_path, ov, n_ov, out, err, err_len);
+    free(text);
+    return st;
+}
+
+void mixsph_sim_destroy(mixsph_sim *s)
+{
+    if (!s) return;
+    if (s->monitor_csv) fclose(s->monitor_csv);
+    particles_free(&s->P);
+    cells_free(&s->C);
+    case_free(&s->cfg);
+    free(s);
+}
+
+mixsph_status mixsph_sim_set_threads(mixsph_sim *s, int n_threads)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    if (n_threads < 0 || n_threads > 1024) return SIM_FAIL(s, MIXSPH_ERR_ARG, "threads: %d is not in 0..1024", n_threads);
+    s->n_threads = n_threads;
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir)
+{
+    if (!s || !dir || !*dir) return s ? SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: empty name") : MIXSPH_ERR_ARG;
+    if (strlen(dir) >= sizeof s->out_dir) return SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: name too long");
+    /* create each missing component */
+    char path[sizeof s->out_dir];
+    strcpy(path, dir);
+    for (char *p = path + 1; *p; p++) {
+        if (*p != '/') continue;
+        *p = '\0';
+        if (mkdir(path, 0777) != 0 && errno != EEXIST)
+            return SIM_FAIL(s, MIXSPH_ERR_IO, "output folder %s: cannot create %s: %s", dir, path, strerror(errno));
+        *p = '/';
+    }
+    if (mkdir(path, 0777) != 0 && errno != EEXIST)
+        return SIM_FAIL(s, MIXSPH_ERR_IO, "output folder %s: cannot create: %s", dir, strerror(errno));
+    if (s->monitor_csv) {
+        fclose(s->monitor_csv);
+        s->monitor_csv = NULL;
+    }
+    strcpy(s->out_dir, dir);
+    return monitors_open(s);
+}
+
+/* Take the samples and snapshots that are due at the current time. */
+static mixsph_status sim_outputs_due(mixsph_sim *s)
+{
+    mixsph_status st = MIXSPH_OK;
+    if (s->t >= s->next_sample - 1e-12) {
+        st = monitors_sample(s);
+        while (s->next_sample <= s->t + 1e-12) s->next_sample += s->cfg.monitor_interval;
+    }
+    if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out_dir[0] && s->t >= s->next_snapshot - 1e-12) {
+        st = monitors_snapshot(s);
+        while (s->next_snapshot <= s->t + 1e-12) s->next_snapshot += s->cfg.snapshot_interval;
+    }
+    return st;
+}
+
+mixsph_status mixsph_sim_step(mixsph_sim *s)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    mixsph_status st = MIXSPH_OK;
+    if (s->step == 0 && s->n_samples == 0) st = sim_outputs_due(s);
+    if (st == MIXSPH_OK) st = integrate_step(s);
+    if (st == MIXSPH_OK) st = sim_outputs_due(s);
+    return st;
+}
+
+mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    if (!isfinite(t)) return SIM_FAIL(s, MIXSPH_ERR_ARG, "advance_to: time %g is not finite", t);
+    while (s->t < t) {
+        mixsph_status st = mixsph_sim_step(s);
+        if (st != MIXSPH_OK) return st;
+    }
+    return MIXSPH_OK;
+}
+
+const char *mixsph_sim_last_error(const mixsph_sim *s) { return s ? s->err : "no simulation"; }
+double mixsph_sim_time(const mixsph_sim *s) { return s->t; }
+double mixsph_sim_end_time(const mixsph_sim *s) { return s->cfg.t_end; }
+double mixsph_sim_dt(const mixsph_sim *s) { return s->dt; }
+uint64_t mixsph_sim_steps(const mixsph_sim *s) { return s->step; }
+size_t mixsph_sim_particles(const mixsph_sim *s) { return s->n_fluid; }
+size_t mixsph_sim_wall_particles(const mixsph_sim *s) { return s->n_wall; }
+const char *mixsph_sim_name(const mixsph_sim *s) { return s->cfg.name; }
+size_t mixsph_sim_output_count(const mixsph_sim *s) { return s->n_out; }
+
+const char *mixsph_sim_output_name(const mixsph_sim *s, size_t k) { return k < s->n_out ? s->out_name[k] : NULL; }
+
+double mixsph_sim_output_value(const mixsph_sim *s, size_t k) { return k < s->n_out ? monitors_value(s, k) : NAN; }
+
+void mixsph_sim_output_extremes(const mixsph_sim *s, size_t k, double *max, double *t_max, double *min, double *t_min)
+{
+    const int ok = k < s->n_out;
+    if (max) *max = ok ? s->out_max[k] : NAN;
+    if (t_max) *t_max = ok ? s->out_tmax[k] : NAN;
+    if (min) *min = ok ? s->out_min[k] : NAN;
+    if (t_min) *t_min = ok ? s->out_tmin[k] : NAN;
+}
+
+long mixsph_sim_output_find(const mixsph_sim *s, const char *name)
+{
+    for (size_t k = 0; k < s->n_out; k++)
+        if (name && strcmp(s->out_name[k], name) == 0) return (long)k;
+    return -1;
+}
+
+mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v)
+{
+    if (!s || !v) return MIXSPH_ERR_ARG;
+    const struct particles *P = &s->P;
+    v->n = P->n;
+    v->n_fluid = s->n_fluid;
+    v->x = P->x;
+    v->z = P->z;
+    v->vx = P->vx;
+    v->vz = P->vz;
+    v->rho = P->rho;
+    v->p = P->p;
+    v->mu = P->mu;
+    v->medium = P->medium;
+    v->state = P->state;
+    v->id = P->id;
+    return MIXSPH_OK;
+}

@@ -1,0 +1,87 @@
+/* sim.h - the simulation object (internal definition of the opaque mixsph_sim). It owns all
+ * state: the case, the particles, the cell list, the walls' motion, the outputs and files. */
+#ifndef MIXSPH_SIM_H
+#define MIXSPH_SIM_H
+#include <stdint.h>
+#include <stdio.h>
+
+#include "case.h"
+#include "cells.h"
+#include "kernel.h"
+#include "mixsph.h"
+#include "particles.h"
+
+#ifdef _OPENMP
+#include <omp.h>
+#define SIM_THREADS(s) ((s)->n_threads > 0 ? (s)->n_threads : omp_get_max_threads())
+#else
+#define SIM_THREADS(s) 1
+#endif
+
+#define SIM_MAX_OUTPUTS (8 + CASE_MAX_MONITORS)
+
+struct wall_state {
+    double ox, oz;   /* displacement of the wall since t = 0 [m] */
+    double vx, vz;   /* current velocity [m/s] */
+    double ax, az;   /* current acceleration [m/s2] */
+};
+
+struct mixsph_sim {
+    struct case_def cfg;
+    struct kernel K;
+    double dx, h;
+    double c_max;                 /* highest sound speed [m/s] */
+    double domain[4];             /* x_min, x_max, z_min, z_max [m] */
+    struct particles P;
+    struct cells C;
+    size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
+    struct wall_state walls[CASE_MAX_WALLS];
+
+    double t, dt;                 /* time, next time step [s] */
+    uint64_t step;
+    int n_threads;
+    long n_lost;                  /* particles that left the domain */
+    long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
+
+    /* outputs: diagnostics then the case's monitors */
+    size_t n_out;
+    char out_name[SIM_MAX_OUTPUTS][CASE_NAME_LEN];
+    double out_max[SIM_MAX_OUTPUTS], out_tmax[SIM_MAX_OUTPUTS];
+    double out_min[SIM_MAX_OUTPUTS], out_tmin[SIM_MAX_OUTPUTS];
+    long n_samples;
+    double next_sample, next_snapshot;
+    int snap_index;
+    char out_dir[512];
+    FILE *monitor_csv;
+
+    char err[1024];
+};
+
+/* walls.c */
+mixsph_status walls_generate(mixsph_sim *s);
+void walls_signed_distance(const mixsph_sim *s, size_t w, double x, double z, double *d, int *at_end);
+void walls_move(mixsph_sim *s, double t_from, double dt);
+void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old, double x0, double z0,
+                double *x1, double *z1, double *vx, double *vz, long *clips);
+void walls_pressure(mixsph_sim *s);
+
+/* forces.c */
+int forces_compute(mixsph_sim *s);
+int forces_continuity(mixsph_sim *s);
+void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
+
+/* integrate.c */
+double integrate_time_step(const mixsph_sim *s);
+mixsph_status integrate_step(mixsph_sim *s);
+void integrate_eos(mixsph_sim *s);
+
+/* monitors.c */
+void monitors_init(mixsph_sim *s);
+double monitors_value(const mixsph_sim *s, size_t k);
+mixsph_status monitors_sample(mixsph_sim *s);
+mixsph_status monitors_open(mixsph_sim *s);
+mixsph_status monitors_snapshot(mixsph_sim *s);
+
+#define SIM_FAIL(s, st, ...) status_set((s)->err, sizeof (s)->err, (st), __VA_ARGS__)
+
+#endif

@@ -1,0 +1,190 @@
+/* walls.c - walls from polylines (MODEL.md section 8).
+ *
+ * Treatment: layers of dummy wall particles behind each polyline, on the global lattice
+ * (i + 1/2) dx, as deep as the kernel support; their pressure is extrapolated from the fluid
+ * (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
+ *     p_w = [ sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf ] / sum_f W_wf
+ * clamped at 0 (no suction at walls), and their velocity in viscous terms is the no-slip mirror
+ * 2 v_wall - v~ (v~ the kernel average of the fluid velocity) or v~ for free slip.
+ * Moving walls (the Vajont plate) translate with a prescribed piecewise-linear velocity law.
+ * On top of the pressure barrier, a geometric guarantee: a particle whose step would cross a
+ * wall segment (in the wall's frame) is put back on the fluid side at 0.1 dx and loses its
+ * velocity component into the wall; such corrections are counted (sim->n_clipped). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "eos.h"
+#include "geometry.h"
+#include "sim.h"
+#include "status.h"
+
+#define WALLS_CLIP_GAP 0.1 /* distance [dx] at which a crossing particle is put back */
+
+void walls_signed_distance(const mixsph_sim *s, size_t w, double x, double z, double *d, int *at_end)
+{
+    const struct wall *wl = &s->cfg.walls[w];
+    *d = geom_signed_distance(&wl->line, wl->side, x - s->walls[w].ox, z - s->walls[w].oz, at_end);
+}
+
+mixsph_status walls_generate(mixsph_sim *s)
+{
+    const double dx = s->dx;
+    const double depth = s->cfg.wall_layers * dx;
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        const struct wall *wl = &s->cfg.walls[w];
+        double xmin = INFINITY, xmax = -INFINITY, zmin = INFINITY, zmax = -INFINITY;
+        for (size_t k = 0; k < wl->line.n; k++) {
+            xmin = fmin(xmin, wl->line.x[k]);
+            xmax = fmax(xmax, wl->line.x[k]);
+            zmin = fmin(zmin, wl->line.z[k]);
+            zmax = fmax(zmax, wl->line.z[k]);
+        }
+        const long i0 = (long)floor((xmin - depth) / dx) - 1, i1 = (long)ceil((xmax + depth) / dx) + 1;
+        const long k0 = (long)floor((zmin - depth) / dx) - 1, k1 = (long)ceil((zmax + depth) / dx) + 1;
+        for (long k = k0; k <= k1; k++) {
+            for (long i = i0; i <= i1; i++) {
+                const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
+                int at_end = 0;
+                const double d = geom_signed_distance(&wl->line, wl->side, x, z, &at_end);
+                if (at_end || d >= 0.0 || d < -depth) continue;
+                /* one particle per lattice site among fixed walls (a site behind two walls) */
+                int dup = 0;
+                for (size_t v = 0; v < w && !dup && wl->motion < 0; v++) {
+                    if (s->cfg.walls[v].motion >= 0) continue;
+                    int e2 = 0;
+                    const double d2 = geom_signed_distance(&s->cfg.walls[v].line, s->cfg.walls[v].side, x, z, &e2);
+                    dup = !e2 && d2 < 0.0 && d2 >= -depth;
+                }
+                if (dup) continue;
+                const size_t j = particles_push(&s->P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
+                if (j == (size_t)-1) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
+                s->P.vol[j] = dx * dx;
+                s->P.m[j] = 0.0;
+                s->n_wall++;
+            }
+        }
+    }
+    return MIXSPH_OK;
+}
+
+/* Move the walls from t_from by dt: each moving wall translates by its velocity at mid-step
+ * (exact for a law linear over the step), then takes the velocity and acceleration at t+dt. */
+void walls_move(mixsph_sim *s, double t_from, double dt)
+{
+    int moving = 0;
+    double dxw[CASE_MAX_WALLS] = {0}, dzw[CASE_MAX_WALLS] = {0};
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        const int mo = s->cfg.walls[w].motion;
+        if (mo < 0) continue;
+        const struct motion *m = &s->cfg.motions[mo];
+        struct wall_state *ws = &s->walls[w];
+        double vx, vz;
+        case_motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
+        dxw[w] = vx * dt;
+        dzw[w] = vz * dt;
+        ws->ox += dxw[w];
+        ws->oz += dzw[w];
+        case_motion_velocity(m, t_from + dt, &ws->vx, &ws->vz);
+        case_motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
+        moving = 1;
+    }
+    if (!moving) return;
+    struct particles *P = &s->P;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        const size_t w = P->medium[i];
+        if (s->cfg.walls[w].motion < 0) continue;
+        P->x[i] += dxw[w];
+        P->z[i] += dzw[w];
+        P->vx[i] = s->walls[w].vx;
+        P->vz[i] = s->walls[w].vz;
+    }
+}
+
+/* Keep a particle moving (x0,z0) -> (*x1,*z1) on the fluid side of every wall. ox_old/oz_old:
+ * the walls' displacements at the start of the step (the walls are already moved). */
+void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old, double x0, double z0, double *x1,
+                double *z1, double *vx, double *vz, long *clips)
+{
+    const double gap = WALLS_CLIP_GAP * s->dx;
+    for (int pass = 0; pass < 4; pass++) {
+        int hit = 0;
+        for (size_t w = 0; w < s->cfg.n_walls && !hit; w++) {
+            const struct wall *wl = &s->cfg.walls[w];
+            const struct wall_state *ws = &s->walls[w];
+            /* the path in the frame of the wall */
+            const double ax = x0 - ox_old[w], az = z0 - oz_old[w];
+            const double bx = *x1 - ws->ox, bz = *z1 - ws->oz;
+            for (size_t k = 0; k + 1 < wl->line.n; k++) {
+                const double cx = wl->line.x[k], cz = wl->line.z[k];
+                const double ex = wl->line.x[k + 1] - cx, ez = wl->line.z[k + 1] - cz;
+                double sc;
+                if (!geom_path_crosses(ax, az, bx, bz, cx, cz, cx + ex, cz + ez, &sc)) continue;
+                /* fluid-side unit normal of this segment */
+                const double len = hypot(ex, ez);
+                const double nx = -ez / len * wl->side, nz = ex / len * wl->side;
+                /* only a crossing from the fluid side into the wall counts */
+                if ((bx - ax) * nx + (bz - az) * nz >= 0.0) continue;
+                const double px = ax + sc * (bx - ax), pz = az + sc * (bz - az);
+                *x1 = px + gap * nx + ws->ox;
+                *z1 = pz + gap * nz + ws->oz;
+                const double vn = (*vx - ws->vx) * nx + (*vz - ws->vz) * nz;
+                if (vn < 0.0) {
+                    *vx -= vn * nx;
+                    *vz -= vn * nz;
+                }
+                (*clips)++;
+                hit = 1;
+                break;
+            }
+        }
+        if (!hit) return;
+    }
+}
+
+/* Pressure and viscous velocity of wall particles from the surrounding fluid (Adami 2012). */
+void walls_pressure(mixsph_sim *s)
+{
+    struct particles *P = &s->P;
+    const struct cells *C = &s->C;
+    const struct kernel *K = &s->K;
+    const double g = s->cfg.g;
+    const size_t n = C->start[C->ncell];
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        const struct wall_state *ws = &s->walls[P->medium[i]];
+        /* g - a_w, with g = (0, -g) */
+        const double gx = -ws->ax, gz = -g - ws->az;
+        const double xi = P->x[i], zi = P->z[i];
+        double sw = 0.0, sp = 0.0, svx = 0.0, svz = 0.0;
+        int ix, iz;
+        cells_coords(C, xi, zi, &ix, &iz);
+        for (int row = -1; row <= 1; row++) {
+            const struct range rg = cells_row(C, ix, iz, row);
+            for (size_t j = rg.begin; j < rg.end; j++) {
+                if (P->state[j] == MIXSPH_STATE_WALL) continue;
+                const double rx = xi - P->x[j], rz = zi - P->z[j];
+                const double r2 = rx * rx + rz * rz;
+                if (r2 >= K->r2max) continue;
+                const double wgt = kernel_w(K, sqrt(r2));
+                sw += wgt;
+                sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
+                svx += P->vx[j] * wgt;
+                svz += P->vz[j] * wgt;
+            }
+        }
+        const int noslip = s->cfg.walls[P->medium[i]].slip == WALL_NO_SLIP;
+        if (sw > 0.0) {
+            const double pw = sp / sw;
+            P->p[i] = pw > 0.0 ? pw : 0.0;
+            P->uvx[i] = noslip ? 2.0 * ws->vx - svx / sw : svx / sw;
+            P->uvz[i] = noslip ? 2.0 * ws->vz - svz / sw : svz / sw;
+        } else {
+            P->p[i] = 0.0;
+            P->uvx[i] = ws->vx;
+            P->uvz[i] = ws->vz;
+        }
+    }
+}
