@@ -12,6 +12,8 @@
 
 #include "status.h"
 
+#define KERNEL_PI_ 3.14159265358979323846
+
 struct reader {
     const char *origin;
     char *err;
@@ -268,6 +270,81 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     return MIXSPH_OK;
 }
 
+static mixsph_status get_bool(struct reader *r, const cJSON *obj, const char *path, const char *key, int *out)
+{
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return MIXSPH_OK;
+    if (!cJSON_IsBool(it)) return FAIL(r, "%s: %s.%s: expected true or false", r->origin, path, key);
+    *out = cJSON_IsTrue(it);
+    return MIXSPH_OK;
+}
+
+/* Sound speed from exactly one of K (bulk modulus, with density rho_pure) or c. */
+static mixsph_status read_sound_speed(struct reader *r, const cJSON *it, const char *path, double rho_pure, double *c)
+{
+    const int has_k = cJSON_HasObjectItem(it, "K"), has_c = cJSON_HasObjectItem(it, "c");
+    if (has_k == has_c) return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
+    if (has_k) {
+        double k = 0;
+        TRY(get_num(r, it, path, "K", 1, 0.0, 1, 1e12, &k));
+        *c = sqrt(k / rho_pure);
+        return MIXSPH_OK;
+    }
+    return get_num(r, it, path, "c", 1, 0.0, 1, 1e5, c);
+}
+
+static mixsph_status read_granular(struct reader *r, const cJSON *it, const char *path, struct case_def *c, struct medium *md)
+{
+    static const char *const keys[] = {"type", "rho", "K", "c", "porosity", "phi", "d50", "saturated", "pore_fluid",
+                                       "mu_thr", "mu0", "mu1", NULL};
+    TRY(check_keys(r, it, path, keys));
+    md->kind = MEDIUM_GRANULAR;
+    TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho_grain));
+    TRY(read_sound_speed(r, it, path, md->rho_grain, &md->c));
+    TRY(get_num(r, it, path, "porosity", 1, 0.0, 1, 0.95, &md->porosity));
+    TRY(get_num(r, it, path, "phi", 1, 0.0, 1, 89.0, &md->phi_deg));
+    md->sin_phi = sin(md->phi_deg * KERNEL_PI_ / 180.0);
+    md->d50 = 0.0;
+    TRY(get_num(r, it, path, "d50", 0, 0.0, 0, 10.0, &md->d50));
+    md->saturated = 0;
+    TRY(get_bool(r, it, path, "saturated", &md->saturated));
+    md->pore_fluid = -1;
+    const char *fluid = NULL;
+    TRY(get_str(r, it, path, "pore_fluid", 0, &fluid));
+    if (fluid) {
+        md->pore_fluid = find_medium(c, fluid);
+        if (md->pore_fluid < 0 || c->media[md->pore_fluid].kind != MEDIUM_FLUID)
+            return FAIL(r, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", r->origin, path, fluid);
+    }
+    if (md->saturated && md->pore_fluid < 0)
+        return FAIL(r, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", r->origin, path);
+    const double n = md->porosity;
+    if (md->saturated) {
+        const struct medium *f = &c->media[md->pore_fluid];
+        md->rho_f = f->rho0;
+        md->eps_f_mu_f = n * f->mu;
+        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
+    } else {
+        md->rho_f = 0.0;
+        md->eps_f_mu_f = 0.0;
+        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
+    }
+    const int has_mu1 = cJSON_HasObjectItem(it, "mu1");
+    md->mu0 = INFINITY;
+    if (has_mu1) {
+        if (cJSON_HasObjectItem(it, "mu_thr") || cJSON_HasObjectItem(it, "mu0"))
+            return FAIL(r, "%s: %s.mu1: the mu1 rheology (Run 7) replaces mu_thr and mu0: give mu1 alone", r->origin, path);
+        TRY(get_num(r, it, path, "mu1", 1, 0.0, 1, 1e12, &md->mu_thr));
+        md->mu1_mode = 1;
+    } else {
+        TRY(get_num(r, it, path, "mu_thr", 1, 0.0, 1, 1e12, &md->mu_thr));
+        TRY(get_num(r, it, path, "mu0", 0, 0.0, 1, 1e12, &md->mu0));
+    }
+    md->mu = 0.0;
+    md->alpha_m = 0.0;
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_media(struct reader *r, const cJSON *root, struct case_def *c)
 {
     static const char *const keys[] = {"type", "rho", "K", "c", "mu", "alpha_m", NULL};
@@ -280,24 +357,19 @@ static mixsph_status read_media(struct reader *r, const cJSON *root, struct case
         if (c->n_media == CASE_MAX_MEDIA) return FAIL(r, "%s: media: at most %d media", r->origin, CASE_MAX_MEDIA);
         struct medium *md = &c->media[c->n_media];
         TRY(copy_name(r, path, it->string, md->name));
-        TRY(check_keys(r, it, path, keys));
         const char *type = NULL;
         TRY(get_str(r, it, path, "type", 1, &type));
-        if (strcmp(type, "fluid") == 0) {
-            md->kind = MEDIUM_FLUID;
-        } else {
-            return FAIL(r, "%s: %s.type: '%s' is not a known medium type (expected \"fluid\")", r->origin, path, type);
+        if (strcmp(type, "granular") == 0) {
+            TRY(read_granular(r, it, path, c, md));
+            c->n_media++;
+            continue;
         }
+        if (strcmp(type, "fluid") != 0)
+            return FAIL(r, "%s: %s.type: '%s' is not a known medium type (expected \"fluid\" or \"granular\")", r->origin, path, type);
+        TRY(check_keys(r, it, path, keys));
+        md->kind = MEDIUM_FLUID;
         TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho0));
-        const int has_k = cJSON_HasObjectItem(it, "K"), has_c = cJSON_HasObjectItem(it, "c");
-        if (has_k == has_c) return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
-        if (has_k) {
-            double k = 0;
-            TRY(get_num(r, it, path, "K", 1, 0.0, 1, 1e12, &k));
-            md->c = sqrt(k / md->rho0);
-        } else {
-            TRY(get_num(r, it, path, "c", 1, 0.0, 1, 1e5, &md->c));
-        }
+        TRY(read_sound_speed(r, it, path, md->rho0, &md->c));
         md->mu = 0.0;
         md->alpha_m = 0.0;
         TRY(get_num(r, it, path, "mu", 0, 0.0, 0, 1e9, &md->mu));

@@ -19,10 +19,23 @@ enum medium_kind { MEDIUM_FLUID = 0, MEDIUM_GRANULAR = 1 };
 struct medium {
     char name[CASE_NAME_LEN];
     int kind;          /* MEDIUM_FLUID / MEDIUM_GRANULAR */
-    double rho0;       /* reference density [kg/m3] */
-    double c;          /* sound speed [m/s] */
-    double mu;         /* dynamic viscosity [Pa s] */
-    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] */
+    double rho0;       /* reference density [kg/m3]; granular: the mixture density (5) */
+    double c;          /* sound speed [m/s]; granular: sqrt(K_s / rho_s) */
+    double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
+    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (fluids only) */
+    /* granular media (MODEL.md sections 5-6) */
+    double rho_grain;  /* density of the grains rho_s [kg/m3] */
+    double porosity;   /* n = eps_f at the packing limit [-] */
+    double phi_deg;    /* angle of internal friction [deg] */
+    double sin_phi;
+    double d50;        /* median grain size [m] (recorded; the packing-limit law does not use it) */
+    int saturated;     /* pores filled with the pore fluid (else dry) */
+    int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
+    double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */
+    double eps_f_mu_f; /* eps_f mu_f [Pa s] (0 if dry) */
+    double mu_thr;     /* threshold viscosity [Pa s] */
+    double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
+    int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
 };
 
 struct body {

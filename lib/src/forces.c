@@ -3,147 +3,378 @@
  *   d rho_i/dt = rho_i sum_j V_j (u_i - u_j) . grad_i W_ij
  *   d u_i/dt   = -1/rho_i sum_j V_j (p_i + p_j) grad_i W_ij          (= -sum m_j (p_i+p_j)/(rho_i rho_j) gradW)
  *                - sum_j m_j Pi_ij grad_i W_ij                         (Monaghan, same fluid medium only)
- *                + 1/rho_i sum_j V_j (mu_i + mu_j) F r^2/(r^2 + eta^2) (u_i - u_j)   (Morris et al. 1997)
+ *                + 1/rho_i sum_j V_j 2 mu_ij F r^2/(r^2 + eta^2) (u_i - u_j)   (Morris et al. 1997)
  *                + g
- * with V_j = m_j / rho_j (wall particles: V = dx^2, their extrapolated pressure, the fluid's own
- * density and viscosity, and their no-slip velocity in the viscous term). Every pairwise term
- * is antisymmetric (m_i a_ij = -m_j a_ji), so momentum is conserved between particles.
+ * with V_j = m_j / rho_j, grad_i W_ij = F(r) (x_i - x_j) (kernel.h), eta^2 = 0.01 h^2,
+ * mu_ij = 2 mu_i mu_j / (mu_i + mu_j) the harmonic mean (it is bounded by 2 min(mu_i, mu_j), so
+ * the explicit viscous step of a mobile grain next to a fixed one at mu_thr stays governed by
+ * the grain's own viscosity, and water slides past grains with the water's viscosity), and
+ * Pi_ij = -alpha c h min(u_ij . x_ij, 0) / (r^2 + eta^2) (1/rho_i + 1/rho_j)/2 (the mean of the
+ * inverse densities: symmetric, like the usual inverse of the mean, and free of divisions).
+ * Wall particles enter with V = dx^2, their extrapolated pressure (walls.c), the kernel mean
+ * density of the fluid near them, the fluid's own viscosity (mu_wall = 0 plus the fluid's) and
+ * their no-slip mirror velocity in the viscous term.
+ *
+ * Symmetric evaluation: every pair is computed once, as a force f_ij = m_i a_ij = -m_j a_ji,
+ * added to i and subtracted from j, so momentum is conserved to round-off by construction.
+ * Particles are sorted by cell (cells.c); particle i of cell (ix, iz) meets the particles after
+ * it in its own cell and cell ix+1 (one contiguous range), and cells ix-1..ix+1 of row iz+1
+ * (another), so each pair is met once and the inner loops run over contiguous memory; they are
+ * branch-free (the kernel factor is 0 beyond 2h; wall and artificial-viscosity terms are
+ * selected arithmetically) and vectorised with `omp simd`. The loops are compiled for AVX-512,
+ * AVX2 and baseline x86-64 and the widest is picked at run time (target_clones).
+ *
+ * Threads: the grid is cut into bands of two cell rows; a band writes its own rows and the row
+ * above, so even bands never touch each other, nor odd bands: even bands run in parallel, then
+ * odd bands. The bands do not depend on the thread count and each band is walked in memory
+ * order, so every particle receives its contributions in the same order whatever the number of
+ * threads: results are bit-identical for any thread count.
+ *
  * Two passes per step: continuity (with the newest velocities) before the EOS, momentum after;
- * see integrate.c for why. Gather form: each thread writes only particle i, so results do not
- * depend on the thread count. */
+ * see integrate.c for why. */
 #include <math.h>
+#include <string.h>
 
 #include "sim.h"
 
-/* Per-step constants of the pair loop. */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(MIXSPH_NO_CLONES) && \
+    !defined(__SANITIZE_ADDRESS__)
+#define FORCES_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"), noinline))
+#else
+#define FORCES_CLONES
+#endif
+#define FORCES_INLINE static inline __attribute__((always_inline))
+
+#define FORCES_BAND_ROWS 2
+/* The inner loops run over chunks of FORCES_CHUNK candidates with the lanes past the range
+ * masked off (a whole AVX-512 vector of doubles, no scalar remainder): the ranges are short
+ * (10-20 candidates), so scalar remainders would cost more than the vector part. Reads may go up
+ * to FORCES_CHUNK - 1 elements past a range (particles.c keeps that padding initialised). */
+#define FORCES_CHUNK 8
+
+/* Per-step constants of the pair loops. */
 struct pair_ctx {
-    struct kernel K;
-    double eta2;                      /* 0.01 h^2 */
-    double c[CASE_MAX_MEDIA];         /* sound speed per medium */
-    double alpha[CASE_MAX_MEDIA];     /* artificial viscosity per medium (fluids only) */
+    double inv_h, f_fac, eta2, r2max;
 };
 
 static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
 {
-    X->K = s->K;
+    X->inv_h = 1.0 / s->K.h;
+    X->f_fac = s->K.f_fac;
     X->eta2 = 0.01 * s->h * s->h;
-    for (size_t k = 0; k < s->cfg.n_media; k++) {
-        X->c[k] = s->cfg.media[k].c;
-        X->alpha[k] = s->cfg.media[k].kind == MEDIUM_FLUID ? s->cfg.media[k].alpha_m : 0.0;
-    }
+    X->r2max = s->K.r2max;
 }
 
-/* Momentum contribution of particle j to particle i (i not a wall): adds to (ax, az). */
-static inline void pair_accumulate(const struct pair_ctx *X, const struct particles *P, size_t i, size_t j,
-                                   double *ax, double *az)
+/* F(r) of kernel.h without branches: 0 beyond 2h. */
+FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2)
 {
-    const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
-    const double r2 = rx * rx + rz * rz;
-    if (r2 >= X->K.r2max || j == i) return;
-    const double F = kernel_f(&X->K, sqrt(r2));
-    const double rhoi = P->rho[i];
-    const int mi = P->medium[i];
-    const int wall = P->state[j] == MIXSPH_STATE_WALL;
-    const double vj = P->vol[j];
-    const double dvx = P->vx[i] - P->vx[j], dvz = P->vz[i] - P->vz[j];
-    const double vdotr = dvx * rx + dvz * rz;
-    /* pressure */
-    double fac = -vj * (P->p[i] + P->p[j]) * F / rhoi;
-    /* artificial viscosity: fluid pairs of one medium, and fluid-wall pairs */
-    const double alpha = X->alpha[mi];
-    if (alpha > 0.0 && vdotr < 0.0 && (wall || P->medium[j] == mi)) {
-        const double rhoj = wall ? rhoi : P->rho[j];
-        const double mj = wall ? rhoi * vj : P->m[j];
-        const double muij = X->K.h * vdotr / (r2 + X->eta2);
-        const double pi_ij = -alpha * X->c[mi] * muij / (0.5 * (rhoi + rhoj));
-        fac -= mj * pi_ij * F;
-    }
-    *ax += fac * rx;
-    *az += fac * rz;
-    /* laminar viscosity (Morris): walls use the fluid's viscosity and their mirror velocity */
-    const double mui = P->mu[i], muj = wall ? mui : P->mu[j];
-    if (mui + muj > 0.0) {
-        const double uxj = wall ? P->uvx[j] : P->vx[j], uzj = wall ? P->uvz[j] : P->vz[j];
-        const double vf = vj * (mui + muj) * F * r2 / ((r2 + X->eta2) * rhoi);
-        *ax += vf * (P->vx[i] - uxj);
-        *az += vf * (P->vz[i] - uzj);
-    }
+    double sq = 1.0 - 0.5 * sqrt(r2) * X->inv_h;
+    sq = sq > 0.0 ? sq : 0.0;
+    return X->f_fac * sq * sq * sq;
 }
 
-/* Continuity contribution of j to i (without the rho_i factor) and same-medium neighbours. */
-static inline void pair_continuity(const struct kernel *K, const struct particles *P, size_t i, size_t j, double *drho,
-                                   int *nn)
+/* Continuity between i and candidates [b, e): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
+ * and same-medium neighbour counts. */
+FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b,
+                                    size_t e, double *di, double *ni)
 {
-    const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
-    const double r2 = rx * rx + rz * rz;
-    if (r2 >= K->r2max || j == i) return;
-    const double F = kernel_f(K, sqrt(r2));
-    const double vdotr = (P->vx[i] - P->vx[j]) * rx + (P->vz[i] - P->vz[j]) * rz;
-    *drho += P->vol[j] * vdotr * F;
-    *nn += P->state[j] != MIXSPH_STATE_WALL && P->medium[j] == P->medium[i];
+    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
+    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
+    const double *restrict vol = P->vol, *restrict tag = P->tag;
+    double *restrict d = P->drho, *restrict nn = P->ax; /* ax holds neighbour counts in this pass */
+    const struct pair_ctx Xl = *X;
+    double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
+    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+#pragma omp simd
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
+            const int in = j < e;
+            const double rx = xi - x[j], rz = zi - z[j];
+            const double r2 = rx * rx + rz * rz;
+            const double uf = in ? ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * pair_f(&Xl, r2) : 0.0;
+            const double c = (in && r2 < Xl.r2max && tag[j] == ti && ti >= 0.0) ? 1.0 : 0.0;
+            acc[k] += vol[j] * uf;
+            cnt[k] += c;
+            if (in) {
+                d[j] += voli * uf;
+                nn[j] += c;
+            }
+        }
+    }
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        *di += acc[k];
+        *ni += cnt[k];
+    }
 }
 
-/* Density rate and neighbour counts of every mobile particle, from the current positions and
- * velocities. Returns 1 if a non-finite value appeared. */
+/* As continuity_range, plus the uncorrected velocity gradient G = sum_j V_j (u_j - u_i) (x) grad_i W
+ * and the correction matrix L = sum_j V_j (x_j - x_i) (x) grad_i W of the granular strain rate
+ * (MODEL.md section 5); both are shared by i and j with the other's volume. Walls enter with
+ * their no-slip velocity, so grains feel the shear of a wall. */
+FORCES_INLINE void kinematics_range(const struct pair_ctx *X, struct particles *restrict P, struct kinematics *restrict K,
+                                    size_t i, size_t b, size_t e, double *acc_i)
+{
+    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
+    const double uxi = P->uvx[i], uzi = P->uvz[i];
+    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
+    const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict vol = P->vol, *restrict tag = P->tag;
+    double *restrict d = P->drho, *restrict nn = P->ax;
+    double *restrict gux = K->gux, *restrict guz = K->guz, *restrict gwx = K->gwx, *restrict gwz = K->gwz;
+    double *restrict lxx = K->lxx, *restrict lxz = K->lxz, *restrict lzz = K->lzz;
+    const struct pair_ctx Xl = *X;
+    double a[9][FORCES_CHUNK] = {{0}};
+    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+#pragma omp simd
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        const size_t j = jb + k;
+        const int in = j < e;
+        const double rx = xi - x[j], rz = zi - z[j];
+        const double r2 = rx * rx + rz * rz;
+        const double F = in ? pair_f(&Xl, r2) : 0.0;
+        const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * F;
+        const double c = (in && r2 < Xl.r2max && tag[j] == ti && ti >= 0.0) ? 1.0 : 0.0;
+        const double dux = (uvx[j] - uxi) * F, duz = (uvz[j] - uzi) * F;
+        const double g0 = dux * rx, g1 = dux * rz, g2 = duz * rx, g3 = duz * rz;
+        const double l0 = -F * rx * rx, l1 = -F * rx * rz, l2 = -F * rz * rz;
+        const double vj = vol[j];
+        a[0][k] += vj * uf;
+        a[1][k] += c;
+        a[2][k] += vj * g0;
+        a[3][k] += vj * g1;
+        a[4][k] += vj * g2;
+        a[5][k] += vj * g3;
+        a[6][k] += vj * l0;
+        a[7][k] += vj * l1;
+        a[8][k] += vj * l2;
+        if (in) {
+            d[j] += voli * uf;
+            nn[j] += c;
+            gux[j] += voli * g0;
+            guz[j] += voli * g1;
+            gwx[j] += voli * g2;
+            gwz[j] += voli * g3;
+            lxx[j] += voli * l0;
+            lxz[j] += voli * l1;
+            lzz[j] += voli * l2;
+        }
+    }
+    }
+    for (int q = 0; q < 9; q++)
+        for (size_t k = 0; k < FORCES_CHUNK; k++) acc_i[q] += a[q][k];
+}
+
+/* Momentum between i and candidates [b, e): the pair force f_ij (per unit depth) is added to
+ * a_i as f/m_i and subtracted from a_j as f/m_j. */
+FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b, size_t e,
+                                  double *axi, double *azi)
+{
+    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
+    const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
+    const double ti = P->tag[i], avci = P->avc[i];
+    const double walli = ti < 0.0 ? 1.0 : 0.0;
+    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
+    const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
+    const double *restrict m = P->m, *restrict irho = P->inv_rho, *restrict mu = P->mu, *restrict tag = P->tag;
+    const double *restrict avc = P->avc, *restrict im = P->inv_m;
+    double *restrict ax = P->ax, *restrict az = P->az;
+    const struct pair_ctx Xl = *X;
+    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
+    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+#pragma omp simd
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        const size_t j = jb + k;
+        const int in = j < e;
+        const double rx = xi - x[j], rz = zi - z[j];
+        const double r2 = rx * rx + rz * rz;
+        const double F = in ? pair_f(&Xl, r2) : 0.0;
+        const double inv_r2e = 1.0 / (r2 + Xl.eta2);
+        const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
+        const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
+        /* pressure */
+        double fr = -vv * (pi + p[j]);
+        /* artificial viscosity: approaching pairs of one fluid medium, or fluid and wall */
+        double vdotr = (vxi - vx[j]) * rx + (vzi - vz[j]) * rz;
+        vdotr = vdotr < 0.0 ? vdotr : 0.0;
+        const double same = (tag[j] == ti || walli + wallj > 0.0) ? 1.0 : 0.0;
+        const double avc_ij = avci > avc[j] ? avci : avc[j];
+        fr += same * (1.0 - walli * wallj) * avc_ij * mi * m[j] * vdotr * inv_r2e * 0.5 * (irhoi + irho[j]);
+        /* laminar viscosity, pairwise harmonic mean (a wall takes the viscosity of the particle
+         * it meets): mu_i + mu_j of Morris is replaced by 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j) */
+        const double muj = mu[j] + wallj * mui, mu_i = mui + walli * mu[j];
+        const double musum = 4.0 * mu_i * muj / (mu_i + muj + 1e-300);
+        const double fv = vv * musum * r2 * inv_r2e;
+        const double fx = F * (fr * rx + fv * (uvxi - uvx[j]));
+        const double fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+        sx[k] += fx;
+        sz[k] += fz;
+        if (in) {
+            ax[j] -= fx * im[j];
+            az[j] -= fz * im[j];
+        }
+    }
+    }
+    double tx = 0.0, tz = 0.0;
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        tx += sx[k];
+        tz += sz[k];
+    }
+    *axi += tx;
+    *azi += tz;
+}
+
+/* The two candidate ranges of particle i in cell (ix, iz): after i in its cell and cell ix+1;
+ * cells ix-1..ix+1 of row iz+1. */
+FORCES_INLINE void half_ranges(const struct cells *C, size_t i, struct range *a, struct range *b)
+{
+    const size_t c = C->cell[i];
+    const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
+    a->begin = i + 1;
+    a->end = C->start[c + (ix + 1 < C->nx ? 2 : 1)];
+    *b = cells_row(C, ix, iz, 1);
+}
+
+FORCES_CLONES
+static void continuity_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                            struct kinematics *restrict K, size_t b0, size_t b1)
+{
+    for (size_t i = b0; i < b1; i++) {
+        struct range ra, rb;
+        half_ranges(C, i, &ra, &rb);
+        double di = 0.0, ni = 0.0;
+        continuity_range(X, P, i, ra.begin, ra.end, &di, &ni);
+        continuity_range(X, P, i, rb.begin, rb.end, &di, &ni);
+        (void)K;
+        P->drho[i] += di;
+        P->ax[i] += ni;
+    }
+}
+
+FORCES_CLONES
+static void kinematics_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                            struct kinematics *restrict K, size_t b0, size_t b1)
+{
+    for (size_t i = b0; i < b1; i++) {
+        struct range ra, rb;
+        half_ranges(C, i, &ra, &rb);
+        double acc[9] = {0};
+        kinematics_range(X, P, K, i, ra.begin, ra.end, acc);
+        kinematics_range(X, P, K, i, rb.begin, rb.end, acc);
+        P->drho[i] += acc[0];
+        P->ax[i] += acc[1];
+        K->gux[i] += acc[2];
+        K->guz[i] += acc[3];
+        K->gwx[i] += acc[4];
+        K->gwz[i] += acc[5];
+        K->lxx[i] += acc[6];
+        K->lxz[i] += acc[7];
+        K->lzz[i] += acc[8];
+    }
+}
+
+FORCES_CLONES
+static void momentum_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                          struct kinematics *restrict K, size_t b0, size_t b1)
+{
+    (void)K;
+    for (size_t i = b0; i < b1; i++) {
+        struct range ra, rb;
+        half_ranges(C, i, &ra, &rb);
+        double sx = 0.0, sz = 0.0;
+        momentum_range(X, P, i, ra.begin, ra.end, &sx, &sz);
+        momentum_range(X, P, i, rb.begin, rb.end, &sx, &sz);
+        P->ax[i] += sx * P->inv_m[i];
+        P->az[i] += sz * P->inv_m[i];
+    }
+}
+
+typedef void (*band_fn)(const struct pair_ctx *, const struct cells *, struct particles *restrict,
+                        struct kinematics *restrict, size_t, size_t);
+
+/* Run `fn` over all bands of FORCES_BAND_ROWS cell rows: even bands in parallel, then odd. */
+static void for_bands(mixsph_sim *s, band_fn fn, const struct pair_ctx *X)
+{
+    const struct cells *C = &s->C;
+    const long nb = (C->nz + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
+    struct particles *P = &s->P;
+#pragma omp parallel num_threads(SIM_THREADS(s))
+    for (int phase = 0; phase < 2; phase++) {
+#pragma omp for schedule(dynamic, 1)
+        for (long b = phase; b < nb; b += 2) {
+            const long r0 = b * FORCES_BAND_ROWS;
+            const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;
+            fn(X, C, P, &s->kin, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
+        }
+    }
+}
+
+/* Density rate and neighbour counts of every particle, from the current positions and
+ * velocities, and (with granular media) the velocity gradient and its correction matrix.
+ * Returns 1 if a non-finite value appeared at a mobile particle. */
 int forces_continuity(mixsph_sim *s)
 {
     struct particles *P = &s->P;
-    const struct cells *C = &s->C;
-    const struct kernel K = s->K;
-    const size_t n = C->start[C->ncell];
+    struct pair_ctx X;
+    pair_ctx_init(s, &X);
+    const size_t n = s->C.start[s->C.ncell];
+    memset(P->drho, 0, n * sizeof(double));
+    memset(P->ax, 0, n * sizeof(double));
+    if (s->has_granular) {
+        struct kinematics *K = &s->kin;
+        double *f[7] = {K->gux, K->guz, K->gwx, K->gwz, K->lxx, K->lxz, K->lzz};
+        for (int k = 0; k < 7; k++) memset(f[k], 0, n * sizeof(double));
+        for_bands(s, kinematics_band, &X);
+    } else {
+        for_bands(s, continuity_band, &X);
+    }
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        double drho = 0.0;
-        int nn = 0;
-        int ix, iz;
-        cells_coords(C, P->x[i], P->z[i], &ix, &iz);
-        for (int row = -1; row <= 1; row++) {
-            const struct range rg = cells_row(C, ix, iz, row);
-            for (size_t j = rg.begin; j < rg.end; j++) pair_continuity(&K, P, i, j, &drho, &nn);
-        }
-        P->drho[i] = P->rho[i] * drho;
-        P->nneigh[i] = (uint16_t)(nn < 65535 ? nn : 65535);
-        bad |= !isfinite(drho);
+        P->drho[i] *= P->rho[i];
+        P->nneigh[i] = (uint16_t)(P->ax[i] < 65535.0 ? P->ax[i] : 65535.0);
+        P->ax[i] = 0.0;
+        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
     }
     return bad;
 }
 
-/* Acceleration of every mobile particle. Returns 1 if a non-finite value appeared. */
+/* Acceleration of every particle (gravity included). Returns 1 if a non-finite value appeared
+ * at a mobile particle. */
 int forces_compute(mixsph_sim *s)
 {
     struct particles *P = &s->P;
-    const struct cells *C = &s->C;
     struct pair_ctx X;
     pair_ctx_init(s, &X);
+    const size_t n = s->C.start[s->C.ncell];
+    memset(P->ax, 0, n * sizeof(double));
+    memset(P->az, 0, n * sizeof(double));
+    for_bands(s, momentum_band, &X);
     const double g = s->cfg.g;
-    const size_t n = C->start[C->ncell];
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        double ax = 0.0, az = 0.0;
-        int ix, iz;
-        cells_coords(C, P->x[i], P->z[i], &ix, &iz);
-        for (int row = -1; row <= 1; row++) {
-            const struct range rg = cells_row(C, ix, iz, row);
-            for (size_t j = rg.begin; j < rg.end; j++) pair_accumulate(&X, P, i, j, &ax, &az);
-        }
-        P->ax[i] = ax;
-        P->az[i] = az - g;
-        bad |= !isfinite(ax + az);
+        P->az[i] -= g;
+        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
     }
     return bad;
 }
 
-/* Test hook: the acceleration particle j gives particle i (no gravity). */
+/* Test hook: the acceleration (without gravity) and the density rate particle j gives i,
+ * evaluated by the same pair code (on a scratch copy of the rate arrays). */
 void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho)
 {
     struct pair_ctx X;
     pair_ctx_init(s, &X);
-    int nn = 0;
-    *ax = *az = *drho = 0.0;
-    pair_accumulate(&X, &s->P, i, j, ax, az);
-    pair_continuity(&X.K, &s->P, i, j, drho, &nn);
+    struct particles *P = (struct particles *)&s->P;
+    const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
+    double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
+    momentum_range(&X, P, i, j, j + 1, &sx, &sz);
+    *ax = sx * P->inv_m[i];
+    *az = sz * P->inv_m[i];
+    P->ax[j] = save[0];
+    P->az[j] = save[1];
+    continuity_range(&X, P, i, j, j + 1, &di, &ni);
+    *drho = P->rho[i] * di;
+    P->ax[j] = save[0];
+    P->drho[j] = save[2];
+    P->ax[i] = save[3];
 }

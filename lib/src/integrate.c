@@ -6,6 +6,9 @@
  *   a^{n+1}   = A(x^{n+1}, rho^{n+1}, v^{n+1/2})     (EOS, wall pressure, momentum pass)
  *   v^{n+1}   = v^{n+1/2} + dt/2 a^{n+1}
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
+ * Granular particles: after the continuity pass (which also gives their strain rate from
+ * v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still gets
+ * forces and the kicks, is not drifted and does not limit dt (MODEL.md section 6).
  * Evaluating both rates in one pass from the same old state would be explicit Euler for the
  * acoustic modes, which grow without bound (found the hard way: the hydrostatic tank blew up). */
 #include <math.h>
@@ -14,7 +17,9 @@
 #include "sim.h"
 #include "status.h"
 
-/* (4): dt = min over mobile particles of CFL_vis 2 h^2 / nu_i and CFL 2 h / (c_max + |u_i|). */
+/* (4): dt = min over mobile particles of CFL_vis 2 h^2 / nu_i and CFL 2 h / (c_max + |u_i|).
+ * Fixed grains are left out of the viscous bound (that is the point of mu_thr) but not of the
+ * acoustic one, which stays the bound when every grain is fixed. */
 double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;
@@ -22,10 +27,10 @@ double integrate_time_step(const mixsph_sim *s)
     double dt = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : dt) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
         double d = cfl * 2.0 * h / (cmax + u);
-        if (P->mu[i] > 0.0) {
+        if (P->mu[i] > 0.0 && P->state[i] == MIXSPH_STATE_MOBILE) {
             const double dv = cflv * 2.0 * h * h * P->rho[i] / P->mu[i];
             if (dv < d) d = dv;
         }
@@ -43,7 +48,9 @@ void integrate_eos(mixsph_sim *s)
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
         const struct medium *m = &M[P->medium[i]];
         P->p[i] = eos_pressure(P->rho[i], m->rho0, m->c);
-        P->vol[i] = P->m[i] / P->rho[i];
+        P->inv_rho[i] = 1.0 / P->rho[i];
+        P->vol[i] = P->m[i] * P->inv_rho[i];
+        P->avc[i] = m->kind == MEDIUM_FLUID ? m->alpha_m * m->c * s->h : 0.0;
     }
 }
 
@@ -63,16 +70,19 @@ mixsph_status integrate_step(mixsph_sim *s)
     long clips = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clips) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+        const int st = P->state[i];
+        if (st == MIXSPH_STATE_WALL || st == MIXSPH_STATE_LOST) continue;
         double vx = P->vx[i] + 0.5 * dt * P->ax[i];
         double vz = P->vz[i] + 0.5 * dt * P->az[i];
-        const double x0 = P->x[i], z0 = P->z[i];
-        double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
-        walls_clip(s, ox_old, oz_old, x0, z0, &x1, &z1, &vx, &vz, &clips);
-        P->x[i] = x1;
-        P->z[i] = z1;
-        P->vx[i] = vx;
-        P->vz[i] = vz;
+        if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
+            const double x0 = P->x[i], z0 = P->z[i];
+            double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
+            walls_clip(s, ox_old, oz_old, x0, z0, &x1, &z1, &vx, &vz, &clips);
+            P->x[i] = x1;
+            P->z[i] = z1;
+        }
+        P->vx[i] = P->uvx[i] = vx;
+        P->vz[i] = P->uvz[i] = vz;
     }
     s->n_clipped += clips;
     s->t += dt;
@@ -83,19 +93,20 @@ mixsph_status integrate_step(mixsph_sim *s)
     const int bad_rho = forces_continuity(s);
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++)
-        if (P->state[i] == MIXSPH_STATE_MOBILE) P->rho[i] += dt * P->drho[i];
+        if (P->state[i] <= MIXSPH_STATE_FIXED) P->rho[i] += dt * P->drho[i];
     integrate_eos(s);
+    if (s->has_granular) mixture_update(s);
     walls_pressure(s);
     if (forces_compute(s) || bad_rho) {
         for (size_t i = 0; i < P->n; i++)
-            if (P->state[i] == MIXSPH_STATE_MOBILE && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
+            if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                                 "non-finite acceleration or density rate at particle %u (x = %g, z = %g) at t = %.6g s",
                                 P->id[i], P->x[i], P->z[i], s->t);
     }
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         P->vx[i] += 0.5 * dt * P->ax[i];
         P->vz[i] += 0.5 * dt * P->az[i];
     }

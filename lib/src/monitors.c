@@ -1,5 +1,5 @@
 /* monitors.c - scalar outputs sampled during the run: diagnostics (kinetic energy, mass, time
- * step, lost particles, wall corrections, speed) and the case's monitors:
+ * step, lost particles, wall corrections, speed, grains held fixed) and the case's monitors:
  *   front          - the largest (+x) or smallest (-x) x of a medium's particles;
  *   max_elevation  - the highest z of a medium's particles inside [x_min, x_max] (the run-up
  *                    when the range covers the opposite slope).
@@ -16,9 +16,9 @@
 #include "sim.h"
 #include "status.h"
 
-enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_N_DIAG };
+enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_N_DIAG };
 static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt", "lost_particles", "wall_corrections",
-                                                   "max_speed"};
+                                                   "max_speed", "fixed_particles"};
 
 void monitors_init(mixsph_sim *s)
 {
@@ -59,6 +59,7 @@ double monitors_value(const mixsph_sim *s, size_t k)
     if (k == OUT_DT) return s->dt;
     if (k == OUT_LOST) return (double)s->n_lost;
     if (k == OUT_CLIPS) return (double)s->n_clipped;
+    if (k == OUT_FIXED) return (double)s->n_fixed;
     double ke = 0.0, mass = 0.0, vmax = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;

@@ -6,8 +6,10 @@
 
 #include "mixsph.h"
 
+#define PARTICLES_PAD 8
+
 #define PARTICLES_DOUBLE_FIELDS(X) \
-    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho)
+    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc)
 
 static int grow(void **ptr, size_t cap, size_t elem)
 {
@@ -21,7 +23,11 @@ int particles_alloc(struct particles *P, size_t cap)
 {
     if (cap < 16) cap = 16;
     int bad = 0;
-#define X(f) bad |= grow((void **)&P->f, cap, sizeof(double));
+    /* PARTICLES_PAD zeroed elements past cap: the vectorised pair loops may read (never write)
+     * up to 7 elements past a range */
+#define X(f)                                                                  \
+    bad |= grow((void **)&P->f, cap + PARTICLES_PAD, sizeof(double));         \
+    if (!bad) memset(P->f + P->cap, 0, (cap + PARTICLES_PAD - P->cap) * sizeof(double));
     PARTICLES_DOUBLE_FIELDS(X)
 #undef X
     bad |= grow((void **)&P->medium, cap, 1);
@@ -59,6 +65,9 @@ size_t particles_push(struct particles *P, double x, double z, double rho, doubl
     P->vol[i] = m / rho;
     P->medium[i] = medium;
     P->state[i] = state;
+    P->tag[i] = state == MIXSPH_STATE_WALL ? -1.0 : (double)medium;
+    P->inv_rho[i] = 1.0 / rho;
+    P->inv_m[i] = m > 0.0 && state != MIXSPH_STATE_WALL ? 1.0 / m : 0.0;
     P->nneigh[i] = 0;
     P->id[i] = (uint32_t)i;
     return i;

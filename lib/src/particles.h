@@ -17,6 +17,10 @@ struct particles {
     double *mu;           /* dynamic viscosity [Pa s] */
     double *ax, *az;      /* acceleration [m/s2] */
     double *drho;         /* density rate [kg/m3/s] */
+    double *tag;          /* medium index as a number, -1 for walls (branch-free pair loops) */
+    double *inv_rho;      /* 1 / rho [m3/kg] */
+    double *inv_m;        /* 1 / m [1/kg]; 0 for walls (they take no acceleration) */
+    double *avc;          /* alpha_M c h of the particle's medium [m2/s]; 0 if no artificial viscosity */
     uint8_t *medium;      /* index into the case's media (walls: the wall index) */
     uint8_t *state;       /* MIXSPH_STATE_* */
     uint16_t *nneigh;     /* neighbours of the same medium within 2h (last force pass) */

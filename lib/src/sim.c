@@ -174,6 +174,8 @@ static mixsph_status sim_init(mixsph_sim *s)
         s->P.vz[i] = s->P.uvz[i] = ws->vz;
     }
     set_domain(s);
+    for (size_t k = 0; k < s->cfg.n_media; k++) s->has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
+    if (s->has_granular && (st = mixture_alloc(s)) != MIXSPH_OK) return st;
     if (cells_init(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->domain[0], s->domain[1], s->domain[2], s->domain[3]);
@@ -183,7 +185,9 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (s->P.state[i] == MIXSPH_STATE_LOST)
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
                             s->P.x[i], s->P.z[i]);
+    if (forces_continuity(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     integrate_eos(s);
+    if (s->has_granular) mixture_update(s);
     walls_pressure(s);
     if (forces_compute(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
     s->dt = integrate_time_step(s);
@@ -229,6 +233,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
 {
     if (!s) return;
     if (s->monitor_csv) fclose(s->monitor_csv);
+    if (s->has_granular) mixture_free(s);
     particles_free(&s->P);
     cells_free(&s->C);
     case_free(&s->cfg);

@@ -26,6 +26,15 @@ struct wall_state {
     double ax, az;   /* current acceleration [m/s2] */
 };
 
+/* Per-step scratch of the granular strain rate (not permuted: filled and used within a step). */
+struct kinematics {
+    size_t cap;
+    double *gux, *guz, *gwx, *gwz; /* uncorrected velocity gradient du/dx, du/dz, dw/dx, dw/dz [1/s] */
+    double *lxx, *lxz, *lzz;       /* correction matrix L (symmetric) [-] */
+    double *ztop;                  /* per x-bin of width dx: top of the saturated granular column [m] */
+    size_t nbins;
+};
+
 struct mixsph_sim {
     struct case_def cfg;
     struct kernel K;
@@ -36,6 +45,9 @@ struct mixsph_sim {
     struct cells C;
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
+    int has_granular;             /* any granular medium: strain rates and regimes every step */
+    struct kinematics kin;
+    long n_fixed;                 /* granular particles held fixed after the last step */
 
     double t, dt;                 /* time, next time step [s] */
     uint64_t step;
@@ -69,6 +81,11 @@ void walls_pressure(mixsph_sim *s);
 int forces_compute(mixsph_sim *s);
 int forces_continuity(mixsph_sim *s);
 void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
+
+/* mixture.c */
+mixsph_status mixture_alloc(mixsph_sim *s);
+void mixture_free(mixsph_sim *s);
+void mixture_update(mixsph_sim *s);
 
 /* integrate.c */
 double integrate_time_step(const mixsph_sim *s);

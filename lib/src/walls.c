@@ -5,7 +5,8 @@
  * (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
  *     p_w = [ sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf ] / sum_f W_wf
  * clamped at 0 (no suction at walls), and their velocity in viscous terms is the no-slip mirror
- * 2 v_wall - v~ (v~ the kernel average of the fluid velocity) or v~ for free slip.
+ * 2 v_wall - v~ (v~ the kernel average of the fluid velocity) or v~ for free slip; their density
+ * (used by the artificial viscosity only) is the kernel average of the fluid's.
  * Moving walls (the Vajont plate) translate with a prescribed piecewise-linear velocity law.
  * On top of the pressure barrier, a geometric guarantee: a particle whose step would cross a
  * wall segment (in the wall's frame) is put back on the fluid side at 0.1 dx and loses its
@@ -149,7 +150,7 @@ void walls_pressure(mixsph_sim *s)
     struct particles *P = &s->P;
     const struct cells *C = &s->C;
     const struct kernel *K = &s->K;
-    const double g = s->cfg.g;
+    const double g = s->cfg.g, vol = s->dx * s->dx, rho_default = s->cfg.media[0].rho0;
     const size_t n = C->start[C->ncell];
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
@@ -158,7 +159,7 @@ void walls_pressure(mixsph_sim *s)
         /* g - a_w, with g = (0, -g) */
         const double gx = -ws->ax, gz = -g - ws->az;
         const double xi = P->x[i], zi = P->z[i];
-        double sw = 0.0, sp = 0.0, svx = 0.0, svz = 0.0;
+        double sw = 0.0, sp = 0.0, svx = 0.0, svz = 0.0, srho = 0.0;
         int ix, iz;
         cells_coords(C, xi, zi, &ix, &iz);
         for (int row = -1; row <= 1; row++) {
@@ -172,6 +173,7 @@ void walls_pressure(mixsph_sim *s)
                 sw += wgt;
                 sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
                 svx += P->vx[j] * wgt;
+                srho += P->rho[j] * wgt;
                 svz += P->vz[j] * wgt;
             }
         }
@@ -181,10 +183,14 @@ void walls_pressure(mixsph_sim *s)
             P->p[i] = pw > 0.0 ? pw : 0.0;
             P->uvx[i] = noslip ? 2.0 * ws->vx - svx / sw : svx / sw;
             P->uvz[i] = noslip ? 2.0 * ws->vz - svz / sw : svz / sw;
+            P->rho[i] = srho / sw;
         } else {
             P->p[i] = 0.0;
+            P->rho[i] = rho_default;
             P->uvx[i] = ws->vx;
             P->uvz[i] = ws->vz;
         }
+        P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
+        P->inv_rho[i] = 1.0 / P->rho[i];
     }
 }

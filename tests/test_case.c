@@ -1,0 +1,382 @@
+/* test_case.c - case files (case.c): every class of bad input is refused with a message naming
+ * the file, the key path and what was expected (STYLE.md, "Errors"); numeric overrides
+ * (mixsph_override_parse and their application); reading from a file; a good case with an
+ * override of numerics.dx gives the expected particle count. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "case.h"
+#include "mixsph.h"
+
+#define ORIGIN "tiny.json"
+
+/* A valid case; one key per line where the tests below alter it. */
+static const char *const BASE =
+    "{\n"                                                                                     /* 1 */
+    "  \"name\": \"tiny\",\n"                                                                 /* 2 */
+    "  \"gravity\": 9.81,\n"                                                                  /* 3 */
+    "  \"numerics\": { \"dx\": 0.02, \"h_over_dx\": 1.3, \"cfl\": 0.1, \"cfl_visc\": 0.05,\n" /* 4 */
+    "                \"t_end\": 0.1, \"wall_layers\": 3 },\n"                                 /* 5 */
+    "  \"media\": {\n"                                                                        /* 6 */
+    "    \"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 20.0, \"mu\": 1.0e-3, \"alpha_m\": 0.1 }\n"
+    "  },\n"
+    "  \"bodies\": {\n"
+    "    \"pool\": { \"medium\": \"water\", \"polygon\": [[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]] }\n"
+    "  },\n"
+    "  \"motions\": {\n"
+    "    \"plate\": { \"t\": [0.0, 0.5, 1.0], \"vx\": [0.0, 0.1, 0.0], \"vz\": [0.0, 0.0, 0.0] }\n"
+    "  },\n"
+    "  \"walls\": {\n"
+    "    \"tank\": { \"polyline\": [[0.0, 0.3], [0.0, 0.0], [0.2, 0.0], [0.2, 0.3]], \"fluid_side\": \"left\" },\n"
+    "    \"paddle\": { \"polyline\": [[0.5, 0.3], [0.5, 0.0]], \"fluid_side\": \"right\", \"motion\": \"plate\",\n"
+    "                \"slip\": \"free-slip\" }\n"
+    "  },\n"
+    "  \"monitors\": {\n"
+    "    \"front\": { \"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\" }\n"
+    "  },\n"
+    "  \"output\": { \"monitor_interval\": 0.01 }\n"
+    "}\n";
+
+/* BASE with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
+static char *edit(const char *old, const char *new_text)
+{
+    const char *at = strstr(BASE, old);
+    assert_non_null(at);
+    assert_null(strstr(at + 1, old));
+    const size_t lb = strlen(BASE), lo = strlen(old), ln = strlen(new_text);
+    char *out = malloc(lb - lo + ln + 1);
+    assert_non_null(out);
+    const size_t head = (size_t)(at - BASE);
+    memcpy(out, BASE, head);
+    memcpy(out + head, new_text, ln);
+    memcpy(out + head + ln, at + lo, lb - head - lo + 1);
+    return out;
+}
+
+/* Parse `json` (with overrides) and expect status `expect` with a message containing every
+ * string of the NULL-terminated list. */
+static void expect_error_ov(const char *json, const mixsph_override *ov, size_t n_ov, mixsph_status expect, ...)
+{
+    struct case_def c;
+    char err[512] = "";
+    const mixsph_status st = case_parse(json, ORIGIN, ov, n_ov, &c, err, sizeof err);
+    print_message("  -> %s\n", err);
+    assert_int_equal(st, expect);
+    va_list ap;
+    va_start(ap, expect);
+    for (const char *needle = va_arg(ap, const char *); needle; needle = va_arg(ap, const char *)) {
+        if (!strstr(err, needle)) print_error("message lacks \"%s\"\n", needle);
+        assert_non_null(strstr(err, needle));
+    }
+    va_end(ap);
+}
+
+#define EXPECT_ERROR(json, ...) expect_error_ov((json), NULL, 0, MIXSPH_ERR_CASE, __VA_ARGS__, (const char *)NULL)
+
+/* BASE edited once, expected to fail with the given message parts. */
+#define EXPECT_EDIT_ERROR(old, new_text, ...)          \
+    do {                                               \
+        char *j_ = edit((old), (new_text));            \
+        EXPECT_ERROR(j_, __VA_ARGS__);                 \
+        free(j_);                                      \
+    } while (0)
+
+/* The base case is valid and read as written (the control for every test below). */
+static void test_good_case(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    assert_int_equal(case_parse(BASE, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_string_equal(c.name, "tiny");
+    assert_string_equal(c.origin, ORIGIN);
+    assert_true(c.g == 9.81 && c.dx == 0.02 && c.h_over_dx == 1.3 && c.t_end == 0.1 && c.wall_layers == 3);
+    assert_int_equal(c.n_media, 1);
+    assert_true(c.media[0].rho0 == 1000.0 && c.media[0].c == 20.0 && c.media[0].alpha_m == 0.1);
+    assert_int_equal(c.n_bodies, 1);
+    assert_int_equal(c.bodies[0].medium, 0);
+    assert_int_equal(c.bodies[0].polygon.n, 4);
+    assert_int_equal(c.n_walls, 2);
+    assert_int_equal(c.walls[0].side, 1);
+    assert_int_equal(c.walls[0].motion, -1);
+    assert_int_equal(c.walls[0].slip, WALL_NO_SLIP); /* the default */
+    assert_int_equal(c.walls[1].side, -1);
+    assert_int_equal(c.walls[1].motion, 0);
+    assert_int_equal(c.walls[1].slip, WALL_FREE_SLIP);
+    assert_int_equal(c.n_motions, 1);
+    assert_int_equal(c.motions[0].n, 3);
+    assert_true(c.motions[0].vx[1] == 0.1);
+    assert_int_equal(c.n_monitors, 1);
+    assert_int_equal(c.monitors[0].direction, 1);
+    assert_true(c.monitor_interval == 0.01);
+    case_free(&c);
+    /* K instead of c: c = sqrt(K / rho) */
+    char *j = edit("\"c\": 20.0", "\"K\": 4.0e5");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.media[0].c == 20.0);
+    case_free(&c);
+    free(j);
+}
+
+static void test_invalid_json(void **state)
+{
+    (void)state;
+    /* an extra comma on line 3 */
+    EXPECT_EDIT_ERROR("\"gravity\": 9.81,", "\"gravity\": 9.81,,", ORIGIN ": line 3: ", "not valid JSON");
+    /* an unterminated string on line 2 */
+    EXPECT_EDIT_ERROR("\"name\": \"tiny\",", "\"name\": \"tiny,", ORIGIN ": line ", "not valid JSON");
+    /* not an object */
+    EXPECT_ERROR("[1, 2]", ORIGIN ": ", "must be a JSON object");
+    EXPECT_ERROR("", ORIGIN ": line 1: not valid JSON");
+}
+
+static void test_missing_key(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"dx\": 0.02, ", "", ORIGIN ": numerics.dx: missing (expected a number)");
+    EXPECT_EDIT_ERROR("\"t_end\": 0.1, ", "", ORIGIN ": numerics.t_end: missing (expected a number)");
+    EXPECT_EDIT_ERROR("\"type\": \"fluid\", ", "", ORIGIN ": media.water.type: missing (expected a string)");
+    EXPECT_EDIT_ERROR(", \"fluid_side\": \"left\"", "", ORIGIN ": walls.tank.fluid_side: missing (expected a string)");
+    EXPECT_EDIT_ERROR(", \"vz\": [0.0, 0.0, 0.0]", "", ORIGIN ": motions.plate.vz: missing (expected an array of numbers)");
+    EXPECT_EDIT_ERROR("\"c\": 20.0, ", "", ORIGIN ": media.water: ", "exactly one of K", "or c");
+}
+
+static void test_wrong_type(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"dx\": 0.02", "\"dx\": \"0.02\"", ORIGIN ": numerics.dx: expected a number");
+    EXPECT_EDIT_ERROR("\"rho\": 1000.0", "\"rho\": [1000.0]", ORIGIN ": media.water.rho: expected a number");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\"", "\"fluid_side\": 1", ORIGIN ": walls.tank.fluid_side: expected a string");
+    EXPECT_EDIT_ERROR("[0.2, 0.0], [0.2, 0.1]", "[0.2], [0.2, 0.1]",
+                      ORIGIN ": bodies.pool.polygon[1]: expected a point [x, z] of two numbers");
+    EXPECT_EDIT_ERROR("\"vx\": [0.0, 0.1, 0.0]", "\"vx\": [0.0, \"fast\", 0.0]",
+                      ORIGIN ": motions.plate.vx[1]: expected a number");
+    EXPECT_EDIT_ERROR("\"output\": { \"monitor_interval\": 0.01 }", "\"output\": 0.01",
+                      ORIGIN ": output: expected an object");
+}
+
+static void test_out_of_range(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"dx\": 0.02", "\"dx\": 0", ORIGIN ": numerics.dx: 0 is out of range (expected 0 < x <= 10)");
+    EXPECT_EDIT_ERROR("\"dx\": 0.02", "\"dx\": -0.01", ORIGIN ": numerics.dx: -0.01 is out of range");
+    EXPECT_EDIT_ERROR("\"h_over_dx\": 1.3", "\"h_over_dx\": 5",
+                      ORIGIN ": numerics.h_over_dx: 5 is out of range (expected 1 <= x <= 3)");
+    EXPECT_EDIT_ERROR("\"rho\": 1000.0", "\"rho\": -1000.0", ORIGIN ": media.water.rho: -1000 is out of range");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 2", ORIGIN ": numerics.wall_layers: ",
+                      "do not cover the kernel support", "expected >= 3");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3.5", ORIGIN ": numerics.wall_layers: expected an integer");
+    EXPECT_EDIT_ERROR("[0.2, 0.0], [0.2, 0.1]", "[0.2, 0.0], [0.2, 0.0]", ORIGIN ": bodies.pool.polygon[2]: repeats");
+}
+
+/* Keys at the top level: the key path is the key itself, as in the file and in an override
+ * ("gravity", not "case.gravity"). */
+static void test_top_level_key_paths(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"name\": \"tiny\",", "", ORIGIN ": name: missing (expected a string)");
+    EXPECT_EDIT_ERROR("\"gravity\": 9.81", "\"gravity\": true", ORIGIN ": gravity: expected a number");
+    EXPECT_EDIT_ERROR("\"gravity\": 9.81", "\"gravity\": -9.81", ORIGIN ": gravity: -9.81 is out of range");
+}
+
+static void test_unknown_key(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"dx\": 0.02", "\"dxx\": 0.02", ORIGIN ": numerics.dxx: unknown key");
+    EXPECT_EDIT_ERROR("\"alpha_m\": 0.1", "\"alpha\": 0.1", ORIGIN ": media.water.alpha: unknown key");
+    EXPECT_EDIT_ERROR("\"gravity\": 9.81", "\"gravty\": 9.81", ORIGIN ": gravty: unknown key");
+    EXPECT_EDIT_ERROR("\"monitor_interval\"", "\"monitor_intervall\"", ORIGIN ": output.monitor_intervall: unknown key");
+}
+
+static void test_bad_reference_or_choice(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"medium\": \"water\", \"polygon\"", "\"medium\": \"sand\", \"polygon\"",
+                      ORIGIN ": bodies.pool.medium: 'sand' is not one of the media");
+    EXPECT_EDIT_ERROR("\"motion\": \"plate\"", "\"motion\": \"plat\"",
+                      ORIGIN ": walls.paddle.motion: 'plat' is not one of the motions");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\"", "\"fluid_side\": \"up\"",
+                      ORIGIN ": walls.tank.fluid_side: 'up'", "expected \"left\" or \"right\"");
+    EXPECT_EDIT_ERROR("\"slip\": \"free-slip\"", "\"slip\": \"sticky\"", ORIGIN ": walls.paddle.slip: 'sticky'",
+                      "expected \"no-slip\" or \"free-slip\"");
+    EXPECT_EDIT_ERROR("\"type\": \"fluid\"", "\"type\": \"honey\"", ORIGIN ": media.water.type: 'honey'",
+                      "expected \"fluid\"");
+    EXPECT_EDIT_ERROR("\"direction\": \"+x\"", "\"direction\": \"up\"", ORIGIN ": monitors.front.direction: 'up'",
+                      "expected \"+x\" or \"-x\"");
+    EXPECT_EDIT_ERROR("\"type\": \"front\"", "\"type\": \"back\"", ORIGIN ": monitors.front.type: 'back'");
+}
+
+static void test_motion_arrays(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"vx\": [0.0, 0.1, 0.0]", "\"vx\": [0.0, 0.1]", ORIGIN ": motions.plate: ",
+                      "t, vx and vz must have the same length (3, 2, 3)");
+    EXPECT_EDIT_ERROR("\"t\": [0.0, 0.5, 1.0]", "\"t\": [0.0, 0.5, 0.5]", ORIGIN ": motions.plate.t[2]: ",
+                      "times must increase");
+    EXPECT_EDIT_ERROR("\"t\": [0.0, 0.5, 1.0]", "\"t\": [0.0, -0.5, 1.0]", ORIGIN ": motions.plate.t[1]: ",
+                      "times must increase");
+    EXPECT_EDIT_ERROR("\"t\": [0.0, 0.5, 1.0], \"vx\": [0.0, 0.1, 0.0], \"vz\": [0.0, 0.0, 0.0]",
+                      "\"t\": [], \"vx\": [], \"vz\": []", ORIGIN ": motions.plate.t: expected at least 1 numbers");
+}
+
+/* Overrides applied to the JSON before validation. */
+static void test_overrides(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    /* good: a number, an array element, an optional key absent from the file (added) */
+    const mixsph_override good[] = {
+        {"numerics.dx", 0.01}, {"motions.plate.vx.1", 0.3}, {"output.snapshot_interval", 0.05}, {"gravity", 1.5}};
+    assert_int_equal(case_parse(BASE, ORIGIN, good, 4, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.dx == 0.01);
+    assert_true(c.motions[0].vx[1] == 0.3);
+    assert_true(c.snapshot_interval == 0.05);
+    assert_true(c.g == 1.5);
+    case_free(&c);
+
+    const mixsph_override missing[] = {{"numerix.dx", 0.01}};
+    expect_error_ov(BASE, missing, 1, MIXSPH_ERR_CASE, ORIGIN ": override numerix.dx: no such key", "'numerix'", NULL);
+    const mixsph_override index[] = {{"motions.plate.vx.7", 0.01}};
+    expect_error_ov(BASE, index, 1, MIXSPH_ERR_CASE, ORIGIN ": override motions.plate.vx.7: no such key", "'7'", NULL);
+    /* a misspelt leaf is added, then refused by the validation as an unknown key */
+    const mixsph_override typo[] = {{"numerics.dxx", 0.01}};
+    expect_error_ov(BASE, typo, 1, MIXSPH_ERR_CASE, ORIGIN ": numerics.dxx: unknown key", NULL);
+    const mixsph_override string[] = {{"walls.tank.fluid_side", 1.0}};
+    expect_error_ov(BASE, string, 1, MIXSPH_ERR_CASE, ORIGIN ": override walls.tank.fluid_side: ",
+                    "not a number or a Boolean", NULL);
+    const mixsph_override object[] = {{"numerics", 1.0}};
+    expect_error_ov(BASE, object, 1, MIXSPH_ERR_CASE, ORIGIN ": override numerics: ", "not a number or a Boolean", NULL);
+    /* an override is validated like the file: out of range */
+    const mixsph_override range[] = {{"numerics.dx", -1.0}};
+    expect_error_ov(BASE, range, 1, MIXSPH_ERR_CASE, ORIGIN ": numerics.dx: -1 is out of range", NULL);
+    const mixsph_override nan_ov[] = {{"numerics.dx", NAN}};
+    expect_error_ov(BASE, nan_ov, 1, MIXSPH_ERR_CASE, ORIGIN ": override numerics.dx: ", "not finite", NULL);
+}
+
+/* "key=value" syntax. */
+static void test_override_parse(void **state)
+{
+    (void)state;
+    char err[256];
+    mixsph_override ov;
+    char ok[] = "numerics.dx=0.01";
+    assert_int_equal(mixsph_override_parse(ok, &ov, err, sizeof err), MIXSPH_OK);
+    assert_string_equal(ov.key, "numerics.dx");
+    assert_true(ov.value == 0.01);
+    char neg[] = "motions.plate.vx.3=-2.5e-1";
+    assert_int_equal(mixsph_override_parse(neg, &ov, err, sizeof err), MIXSPH_OK);
+    assert_string_equal(ov.key, "motions.plate.vx.3");
+    assert_true(ov.value == -0.25);
+
+    static const char *const no_eq[] = {"dx", "=3", "", NULL};
+    for (const char *const *t = no_eq; *t; t++) {
+        char buf[64];
+        snprintf(buf, sizeof buf, "%s", *t);
+        err[0] = '\0';
+        assert_int_equal(mixsph_override_parse(buf, &ov, err, sizeof err), MIXSPH_ERR_ARG);
+        print_message("  '%s' -> %s\n", *t, err);
+        assert_non_null(strstr(err, "expected key=value"));
+        assert_string_equal(buf, *t); /* the text is left as it was */
+    }
+    static const char *const bad_value[][2] = {
+        {"dx=abc", "'abc'"}, {"dx=", "''"}, {"dx=1e999", "'1e999'"}, {"dx=nan", "'nan'"},
+        {"dx=inf", "'inf'"}, {"dx=3x", "'3x'"},   {"a=b=1", "'b=1'"}, {NULL, NULL}};
+    for (size_t k = 0; bad_value[k][0]; k++) {
+        char buf[64];
+        snprintf(buf, sizeof buf, "%s", bad_value[k][0]);
+        err[0] = '\0';
+        assert_int_equal(mixsph_override_parse(buf, &ov, err, sizeof err), MIXSPH_ERR_ARG);
+        print_message("  '%s' -> %s\n", bad_value[k][0], err);
+        assert_non_null(strstr(err, bad_value[k][1]));
+        assert_non_null(strstr(err, "is not a finite number"));
+        assert_string_equal(buf, bad_value[k][0]); /* the '=' is put back */
+    }
+}
+
+/* Through the public API: a missing file, errors passed on by create, and the particle count
+ * following an override of numerics.dx. */
+static void test_create(void **state)
+{
+    (void)state;
+    mixsph_sim *s = (mixsph_sim *)&s; /* not NULL: create must reset it */
+    char err[512] = "";
+    const char *missing = MIXSPH_SOURCE_DIR "/cases/no_such_case.json";
+    assert_int_equal(mixsph_sim_create(missing, NULL, 0, &s, err, sizeof err), MIXSPH_ERR_IO);
+    print_message("  -> %s\n", err);
+    assert_null(s);
+    assert_non_null(strstr(err, missing));
+    assert_non_null(strstr(err, "cannot open"));
+
+    /* a parse error comes back through create with the origin given */
+    char *bad = edit("\"dx\": 0.02", "\"dx\": 0");
+    assert_int_equal(mixsph_sim_create_from_text(bad, ORIGIN, NULL, 0, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    assert_null(s);
+    assert_non_null(strstr(err, ORIGIN ": numerics.dx: 0 is out of range"));
+    free(bad);
+    /* errors found while building: no lattice site inside the body */
+    bad = edit("[[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]]", "[[0.052, 0.052], [0.053, 0.052], [0.053, 0.053]]");
+    assert_int_equal(mixsph_sim_create_from_text(bad, ORIGIN, NULL, 0, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    print_message("  -> %s\n", err);
+    assert_non_null(strstr(err, ORIGIN ": bodies: no particle fits"));
+    free(bad);
+    /* a domain that does not hold the particles */
+    bad = edit("  \"output\"", "  \"domain\": { \"x_min\": 0.0, \"x_max\": 0.1, \"z_min\": -0.1, \"z_max\": 0.5 },\n  \"output\"");
+    assert_int_equal(mixsph_sim_create_from_text(bad, ORIGIN, NULL, 0, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    print_message("  -> %s\n", err);
+    assert_non_null(strstr(err, ORIGIN ": domain: a particle at"));
+    free(bad);
+
+    /* particle counts: the pool 0.2 x 0.1 holds (0.2/dx)(0.1/dx) lattice sites */
+    assert_int_equal(mixsph_sim_create_from_text(BASE, ORIGIN, NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 50);
+    mixsph_sim_destroy(s);
+    const mixsph_override fine = {"numerics.dx", 0.01};
+    assert_int_equal(mixsph_sim_create_from_text(BASE, ORIGIN, &fine, 1, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 200);
+    mixsph_sim_destroy(s);
+
+    /* from a file: the hydrostatic tank, 0.4 x 0.3 m of water */
+    const char *tank = MIXSPH_SOURCE_DIR "/cases/hydrostatic_tank.json";
+    assert_int_equal(mixsph_sim_create(tank, NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 1200); /* dx = 0.01 */
+    assert_string_equal(mixsph_sim_name(s), "hydrostatic_tank");
+    mixsph_sim_destroy(s);
+    const mixsph_override coarse = {"numerics.dx", 0.02};
+    assert_int_equal(mixsph_sim_create(tank, &coarse, 1, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 300);
+    mixsph_sim_destroy(s);
+    /* and its error messages name the file */
+    const mixsph_override typo = {"numerix.dx", 0.02};
+    assert_int_equal(mixsph_sim_create(tank, &typo, 1, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    assert_non_null(strstr(err, tank));
+    assert_null(s);
+    mixsph_sim_destroy(NULL); /* NULL-safe */
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_good_case),
+        cmocka_unit_test(test_invalid_json),
+        cmocka_unit_test(test_missing_key),
+        cmocka_unit_test(test_wrong_type),
+        cmocka_unit_test(test_out_of_range),
+        cmocka_unit_test(test_top_level_key_paths),
+        cmocka_unit_test(test_unknown_key),
+        cmocka_unit_test(test_bad_reference_or_choice),
+        cmocka_unit_test(test_motion_arrays),
+        cmocka_unit_test(test_overrides),
+        cmocka_unit_test(test_override_parse),
+        cmocka_unit_test(test_create),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
