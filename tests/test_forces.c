@@ -118,7 +118,7 @@ static void test_setup_is_wall_free(void **state)
 }
 
 /* Pair symmetry: m_i a_ij = -m_j a_ji for every fluid pair within the support, including pairs
- * across the two media; the continuity terms obey drho_ij / V_j = drho_ji / V_i. */
+ * across the two media; the continuity terms obey drho_ij / (rho_i V_j) = drho_ji / (rho_j V_i). */
 static void test_pair_symmetry(void **state)
 {
     const mixsph_sim *s = *state;

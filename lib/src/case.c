@@ -248,7 +248,7 @@ static int find_motion(const struct case_def *c, const char *name)
 
 static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", NULL};
+    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", NULL};
     const cJSON *n;
     TRY(get_obj(r, root, "", "numerics", 1, &n));
     TRY(check_keys(r, n, "numerics", keys));
@@ -262,6 +262,8 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     TRY(get_num(r, n, "numerics", "cfl_visc", 0, 0.0, 1, 1.0, &c->cfl_visc));
     TRY(get_num(r, n, "numerics", "t_end", 1, 0.0, 1, 1e6, &c->t_end));
     TRY(get_num(r, n, "numerics", "wall_layers", 0, 1.0, 0, 8.0, &layers));
+    c->p_background = 0.0;
+    TRY(get_num(r, n, "numerics", "background_pressure", 0, 0.0, 0, 1e9, &c->p_background));
     c->wall_layers = (int)layers;
     if ((double)c->wall_layers != layers) return FAIL(r, "%s: numerics.wall_layers: expected an integer", r->origin);
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
@@ -471,9 +473,17 @@ static mixsph_status read_walls(struct reader *r, const cJSON *root, struct case
     return MIXSPH_OK;
 }
 
+static int find_wall(const struct case_def *c, const char *name)
+{
+    for (size_t i = 0; i < c->n_walls; i++)
+        if (strcmp(c->walls[i].name, name) == 0) return (int)i;
+    return -1;
+}
+
 static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"type", "medium", "direction", "x_min", "x_max", "min_neighbours", NULL};
+    static const char *const keys[] = {"type", "medium", "wall", "direction", "x_min", "x_max", "z_min", "z_max",
+                                       "min_neighbours", "bin", "times", NULL};
     const cJSON *m;
     TRY(get_obj(r, root, "", "monitors", 0, &m));
     if (!m) return MIXSPH_OK;
@@ -485,16 +495,30 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
         struct monitor_def *md = &c->monitors[c->n_monitors++];
         TRY(copy_name(r, path, it->string, md->name));
         TRY(check_keys(r, it, path, keys));
-        const char *type = NULL, *medium = NULL, *dir = "+x";
+        const char *type = NULL, *medium = NULL, *dir = "+x", *wall = NULL;
         TRY(get_str(r, it, path, "type", 1, &type));
-        TRY(get_str(r, it, path, "medium", 1, &medium));
-        md->medium = find_medium(c, medium);
-        if (md->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
+        md->medium = md->wall = -1;
+        md->x_min = md->z_min = -INFINITY;
+        md->x_max = md->z_max = INFINITY;
         double mn = 3;
         TRY(get_num(r, it, path, "min_neighbours", 0, 0.0, 0, 100.0, &mn));
         md->min_neighbours = (int)mn;
-        md->x_min = -INFINITY;
-        md->x_max = INFINITY;
+        TRY(get_num(r, it, path, "x_min", 0, -1e9, 0, 1e9, &md->x_min));
+        TRY(get_num(r, it, path, "x_max", 0, -1e9, 0, 1e9, &md->x_max));
+        TRY(get_num(r, it, path, "z_min", 0, -1e9, 0, 1e9, &md->z_min));
+        TRY(get_num(r, it, path, "z_max", 0, -1e9, 0, 1e9, &md->z_max));
+        if (!(md->x_max > md->x_min) || !(md->z_max > md->z_min))
+            return FAIL(r, "%s: %s: expected x_min < x_max and z_min < z_max", r->origin, path);
+        if (strcmp(type, "wall_pressure") == 0) {
+            md->kind = MONITOR_WALL_PRESSURE;
+            TRY(get_str(r, it, path, "wall", 1, &wall));
+            md->wall = find_wall(c, wall);
+            if (md->wall < 0) return FAIL(r, "%s: %s.wall: '%s' is not one of the walls", r->origin, path, wall);
+            continue;
+        }
+        TRY(get_str(r, it, path, "medium", 1, &medium));
+        md->medium = find_medium(c, medium);
+        if (md->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
         if (strcmp(type, "front") == 0) {
             md->kind = MONITOR_FRONT;
             TRY(get_str(r, it, path, "direction", 0, &dir));
@@ -503,11 +527,27 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
             else return FAIL(r, "%s: %s.direction: '%s' (expected \"+x\" or \"-x\")", r->origin, path, dir);
         } else if (strcmp(type, "max_elevation") == 0) {
             md->kind = MONITOR_MAX_ELEVATION;
-            TRY(get_num(r, it, path, "x_min", 0, -1e9, 0, 1e9, &md->x_min));
-            TRY(get_num(r, it, path, "x_max", 0, -1e9, 0, 1e9, &md->x_max));
-            if (!(md->x_max > md->x_min)) return FAIL(r, "%s: %s: expected x_min < x_max", r->origin, path);
+        } else if (strcmp(type, "profile") == 0) {
+            md->kind = MONITOR_PROFILE;
+            if (!isfinite(md->x_min) || !isfinite(md->x_max))
+                return FAIL(r, "%s: %s: a profile needs x_min and x_max", r->origin, path);
+            md->bin = c->dx;
+            TRY(get_num(r, it, path, "bin", 0, 0.0, 1, 1e3, &md->bin));
+            double *t = NULL;
+            size_t nt = 0;
+            TRY(get_numbers(r, it, path, "times", 1, &t, &nt));
+            if (nt > CASE_MAX_PROFILE_TIMES) {
+                free(t);
+                return FAIL(r, "%s: %s.times: at most %d times", r->origin, path, CASE_MAX_PROFILE_TIMES);
+            }
+            for (size_t k = 0; k < nt; k++) md->times[k] = t[k];
+            md->n_times = nt;
+            free(t);
+            for (size_t k = 1; k < nt; k++)
+                if (!(md->times[k] > md->times[k - 1])) return FAIL(r, "%s: %s.times[%zu]: times must increase", r->origin, path, k);
         } else {
-            return FAIL(r, "%s: %s.type: '%s' (expected \"front\" or \"max_elevation\")", r->origin, path, type);
+            return FAIL(r, "%s: %s.type: '%s' (expected \"front\", \"max_elevation\", \"profile\" or \"wall_pressure\")",
+                        r->origin, path, type);
         }
     }
     return MIXSPH_OK;

@@ -63,15 +63,22 @@ struct wall {
     int slip;                 /* enum wall_slip */
 };
 
-enum monitor_kind { MONITOR_FRONT = 0, MONITOR_MAX_ELEVATION = 1 };
+#define CASE_MAX_PROFILE_TIMES 16
+
+enum monitor_kind { MONITOR_FRONT = 0, MONITOR_MAX_ELEVATION = 1, MONITOR_PROFILE = 2, MONITOR_WALL_PRESSURE = 3 };
 
 struct monitor_def {
     char name[CASE_NAME_LEN];
     int kind;                 /* enum monitor_kind */
-    int medium;               /* index into media */
+    int medium;               /* index into media (-1 for wall_pressure) */
+    int wall;                 /* wall_pressure: index into walls */
     int direction;            /* front: +1 largest x, -1 smallest x */
-    double x_min, x_max;      /* max_elevation: x-range [m] */
+    double x_min, x_max;      /* region [m] (infinite when not given) */
+    double z_min, z_max;
     int min_neighbours;       /* particles with fewer same-medium neighbours are spray, ignored */
+    double bin;               /* profile: bin width [m] */
+    size_t n_times;           /* profile: times at which it is written [s] */
+    double times[CASE_MAX_PROFILE_TIMES];
 };
 
 struct case_def {
@@ -83,6 +90,7 @@ struct case_def {
     double cfl, cfl_visc;     /* time-step coefficients of (4) */
     double t_end;             /* [s] */
     int wall_layers;          /* layers of wall particles behind each wall */
+    double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */
     double monitor_interval;  /* [s] */

@@ -17,9 +17,12 @@
 #include "sim.h"
 #include "status.h"
 
-/* (4): dt = min over mobile particles of CFL_vis 2 h^2 / nu_i and CFL 2 h / (c_max + |u_i|).
- * Fixed grains are left out of the viscous bound (that is the point of mu_thr) but not of the
- * acoustic one, which stays the bound when every grain is fixed. */
+/* (4): dt = min over particles of CFL_vis 2 h^2 / nu_i and CFL 2 h / (c_max + |u_i|).
+ * A fixed grain enters the viscous bound with min(mu0, mu_thr), the largest viscosity it can
+ * have once mobile, not with its mu_thr: that is the paper's saving (dt ~ 1/mu0, Table 2), and
+ * a grain mobilised at the next step is then integrated stably from its first mobile step. It
+ * also keeps the velocity a fixed grain picks up in one step (dt a) small, so grains whose forces
+ * nearly balance stay fixed (MODEL.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
 double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;
@@ -30,8 +33,13 @@ double integrate_time_step(const mixsph_sim *s)
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
         double d = cfl * 2.0 * h / (cmax + u);
-        if (P->mu[i] > 0.0 && P->state[i] == MIXSPH_STATE_MOBILE) {
-            const double dv = cflv * 2.0 * h * h * P->rho[i] / P->mu[i];
+        double mu = P->mu[i];
+        if (P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
+            const struct medium *m = &s->cfg.media[P->medium[i]];
+            mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
+        }
+        if (mu > 0.0) {
+            const double dv = cflv * 2.0 * h * h * P->rho[i] / mu;
             if (dv < d) d = dv;
         }
         if (d < dt) dt = d;
@@ -43,11 +51,12 @@ void integrate_eos(mixsph_sim *s)
 {
     struct particles *P = &s->P;
     const struct medium *M = s->cfg.media;
+    const double pb = s->cfg.p_background;
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
         const struct medium *m = &M[P->medium[i]];
-        P->p[i] = eos_pressure(P->rho[i], m->rho0, m->c);
+        P->p[i] = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
         P->inv_rho[i] = 1.0 / P->rho[i];
         P->vol[i] = P->m[i] * P->inv_rho[i];
         P->avc[i] = m->kind == MEDIUM_FLUID ? m->alpha_m * m->c * s->h : 0.0;

@@ -120,7 +120,7 @@ void mixture_update(mixsph_sim *s)
         }
         const double sii = rheology_sqrt_ii(dudx, dudz, dwdx, dwdz);
         const double pw = m->saturated ? pore_pressure(s, m, P->x[i], P->z[i]) : 0.0;
-        const double sigma = rheology_effective_stress(P->p[i], pw);
+        const double sigma = rheology_effective_stress(P->p[i] - s->cfg.p_background, pw);
         const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
         double mu;
         if (rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED) {

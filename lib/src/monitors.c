@@ -1,16 +1,21 @@
-/* monitors.c - scalar outputs sampled during the run: diagnostics (kinetic energy, mass, time
- * step, lost particles, wall corrections, speed, grains held fixed) and the case's monitors:
- *   front          - the largest (+x) or smallest (-x) x of a medium's particles;
- *   max_elevation  - the highest z of a medium's particles inside [x_min, x_max] (the run-up
- *                    when the range covers the opposite slope).
- * Both ignore spray: a particle counts only if it has at least min_neighbours particles of its
- * own medium within the kernel support 2h (counted in the last force pass).
+/* monitors.c - outputs sampled during the run: diagnostics (kinetic energy, mass, time step,
+ * lost particles, wall corrections, speed, grains held fixed) and the case's monitors:
+ *   front          - the largest (+x) or smallest (-x) x of a medium's particles in the region;
+ *   max_elevation  - the highest z of a medium's particles in the region (the run-up when the
+ *                    region covers the opposite slope);
+ *   wall_pressure  - the highest pressure of the first layer of a wall's particles in the region;
+ *   profile        - at given times, the top of a medium (highest particle centre + dx/2) in bins
+ *                    of x, written to profile_<name>_<k>.csv (free surface, landslide surface,
+ *                    mixture-water interface).
+ * Particle monitors ignore spray: a particle counts only if it has at least min_neighbours
+ * particles of its own medium within the kernel support 2h (counted in the last pass).
  * Samples are taken every output.monitor_interval of simulated time; the extremes over the
  * samples and their times are kept, and each sample is a row of monitors.csv when an output
  * folder is set. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sim.h"
@@ -23,8 +28,16 @@ static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt
 void monitors_init(mixsph_sim *s)
 {
     s->n_out = 0;
-    for (size_t k = 0; k < OUT_N_DIAG; k++) snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", diag_names[k]);
-    for (size_t k = 0; k < s->cfg.n_monitors; k++) snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
+    for (size_t k = 0; k < OUT_N_DIAG; k++) {
+        s->out_monitor[s->n_out] = -1;
+        snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", diag_names[k]);
+    }
+    for (size_t k = 0; k < s->cfg.n_monitors; k++) {
+        s->profile_next[k] = 0;
+        if (s->cfg.monitors[k].kind == MONITOR_PROFILE) continue;
+        s->out_monitor[s->n_out] = (int)k;
+        snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
+    }
     for (size_t k = 0; k < s->n_out; k++) {
         s->out_max[k] = s->out_min[k] = NAN;
         s->out_tmax[k] = s->out_tmin[k] = NAN;
@@ -32,20 +45,30 @@ void monitors_init(mixsph_sim *s)
     s->n_samples = 0;
 }
 
+static int in_region(const struct monitor_def *md, double x, double z)
+{
+    return x >= md->x_min && x <= md->x_max && z >= md->z_min && z <= md->z_max;
+}
+
 static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 {
     const struct particles *P = &s->P;
     double best = NAN;
+    if (md->kind == MONITOR_WALL_PRESSURE) {
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P->x[i], P->z[i])) continue;
+            double d;
+            int at_end;
+            walls_signed_distance(s, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
+            if (d < -s->dx) continue; /* first layer only */
+            if (isnan(best) || P->p[i] > best) best = P->p[i];
+        }
+        return best;
+    }
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-        if (P->nneigh[i] < md->min_neighbours) continue;
-        double v;
-        if (md->kind == MONITOR_FRONT) {
-            v = md->direction * P->x[i];
-        } else {
-            if (P->x[i] < md->x_min || P->x[i] > md->x_max) continue;
-            v = P->z[i];
-        }
+        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
+        const double v = md->kind == MONITOR_FRONT ? md->direction * P->x[i] : P->z[i];
         if (isnan(best) || v > best) best = v;
     }
     if (md->kind == MONITOR_FRONT && !isnan(best)) best *= md->direction;
@@ -55,7 +78,7 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 double monitors_value(const mixsph_sim *s, size_t k)
 {
     const struct particles *P = &s->P;
-    if (k >= OUT_N_DIAG) return monitor_eval(s, &s->cfg.monitors[k - OUT_N_DIAG]);
+    if (k >= OUT_N_DIAG) return monitor_eval(s, &s->cfg.monitors[s->out_monitor[k]]);
     if (k == OUT_DT) return s->dt;
     if (k == OUT_LOST) return (double)s->n_lost;
     if (k == OUT_CLIPS) return (double)s->n_clipped;
@@ -84,8 +107,55 @@ mixsph_status monitors_open(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
+/* Write the profiles that are due (needs an output folder). */
+mixsph_status monitors_profiles(mixsph_sim *s)
+{
+    const struct particles *P = &s->P;
+    for (size_t k = 0; k < s->cfg.n_monitors; k++) {
+        const struct monitor_def *md = &s->cfg.monitors[k];
+        if (md->kind != MONITOR_PROFILE || s->profile_next[k] >= md->n_times || s->t < md->times[s->profile_next[k]])
+            continue;
+        const size_t nb = (size_t)ceil((md->x_max - md->x_min) / md->bin);
+        double *top = malloc((nb ? nb : 1) * sizeof *top);
+        if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
+        for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
+            if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
+            size_t b = (size_t)((P->x[i] - md->x_min) / md->bin);
+            if (b >= nb) b = nb - 1;
+            if (P->z[i] + 0.5 * s->dx > top[b]) top[b] = P->z[i] + 0.5 * s->dx;
+        }
+        if (s->out_dir[0]) {
+            char path[700];
+            snprintf(path, sizeof path, "%s/profile_%s_%zu.csv", s->out_dir, md->name, s->profile_next[k]);
+            FILE *f = fopen(path, "w");
+            if (!f) {
+                free(top);
+                return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+            }
+            fprintf(f, "# profile %s of %s at t = %.9g s (requested %.9g s): top of the medium per x bin\nx,z_top\n",
+                    md->name, s->cfg.media[md->medium].name, s->t, md->times[s->profile_next[k]]);
+            for (size_t b = 0; b < nb; b++) {
+                fprintf(f, "%.7g,", md->x_min + (b + 0.5) * md->bin);
+                if (isfinite(top[b])) fprintf(f, "%.7g\n", top[b]);
+                else fprintf(f, "nan\n");
+            }
+            const int bad = ferror(f);
+            if (fclose(f) != 0 || bad) {
+                free(top);
+                return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: write failed", path);
+            }
+        }
+        free(top);
+        s->profile_next[k]++;
+    }
+    return MIXSPH_OK;
+}
+
 mixsph_status monitors_sample(mixsph_sim *s)
 {
+
     double v[SIM_MAX_OUTPUTS];
     for (size_t k = 0; k < s->n_out; k++) {
         v[k] = monitors_value(s, k);

@@ -275,8 +275,8 @@ mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir)
 /* Take the samples and snapshots that are due at the current time. */
 static mixsph_status sim_outputs_due(mixsph_sim *s)
 {
-    mixsph_status st = MIXSPH_OK;
-    if (s->t >= s->next_sample - 1e-12) {
+    mixsph_status st = monitors_profiles(s);
+    if (st == MIXSPH_OK && s->t >= s->next_sample - 1e-12) {
         st = monitors_sample(s);
         while (s->next_sample <= s->t + 1e-12) s->next_sample += s->cfg.monitor_interval;
     }

@@ -58,6 +58,8 @@ struct mixsph_sim {
     /* outputs: diagnostics then the case's monitors */
     size_t n_out;
     char out_name[SIM_MAX_OUTPUTS][CASE_NAME_LEN];
+    int out_monitor[SIM_MAX_OUTPUTS];             /* case monitor behind output k, -1 for diagnostics */
+    size_t profile_next[CASE_MAX_MONITORS];       /* profile monitors: next time to write */
     double out_max[SIM_MAX_OUTPUTS], out_tmax[SIM_MAX_OUTPUTS];
     double out_min[SIM_MAX_OUTPUTS], out_tmin[SIM_MAX_OUTPUTS];
     long n_samples;
@@ -96,6 +98,7 @@ void integrate_eos(mixsph_sim *s);
 void monitors_init(mixsph_sim *s);
 double monitors_value(const mixsph_sim *s, size_t k);
 mixsph_status monitors_sample(mixsph_sim *s);
+mixsph_status monitors_profiles(mixsph_sim *s);
 mixsph_status monitors_open(mixsph_sim *s);
 mixsph_status monitors_snapshot(mixsph_sim *s);
 
