@@ -235,7 +235,7 @@ static void test_motion_arrays(void **state)
     EXPECT_EDIT_ERROR("\"t\": [0.0, 0.5, 1.0]", "\"t\": [0.0, -0.5, 1.0]", ORIGIN ": motions.plate.t[1]: ",
                       "times must increase");
     EXPECT_EDIT_ERROR("\"t\": [0.0, 0.5, 1.0], \"vx\": [0.0, 0.1, 0.0], \"vz\": [0.0, 0.0, 0.0]",
-                      "\"t\": [], \"vx\": [], \"vz\": []", ORIGIN ": motions.plate.t: expected at least 1 numbers");
+                      "\"t\": [], \"vx\": [], \"vz\": []", ORIGIN ": motions.plate.t: expected at least 1 number(s)");
 }
 
 /* Overrides applied to the JSON before validation. */

@@ -123,31 +123,46 @@ static void test_support(void **state)
 }
 
 /* F(r) = W'(r) / r against a central finite difference of W, over the whole support;
- * F continuous at 2h (goes to 0), finite at r = 0 (W'(0) = 0). */
-static void test_derivative(void **state)
+ * F continuous at 2h (goes to 0), finite at r = 0 (W'(0) = 0); W(0) and F(0) from the formulas
+ * in kernel.h. */
+static void check_derivative(int type, double w0_coef, double f0_coef, double end_order)
 {
-    (void)state;
-    const struct kernel K = kernel_make(0.013);
+    const struct kernel K = kernel_make_type(0.013, type);
     const double h = K.h;
     for (int k = 1; k < 40; k++) {
         const double r = k * 2.0 * h / 40.0, e = 1e-6 * h;
+        if (type == KERNEL_CUBIC_SPLINE && fabs(r - h) < 2.0 * e) continue; /* W'' jumps at q = 1 */
         const double dw = (kernel_w(&K, r + e) - kernel_w(&K, r - e)) / (2.0 * e);
         const double F = kernel_f(&K, r);
         /* reference: analytic W'(r)/r; tolerance 1e-6 relative to max |F| = |F(0)|, the
          * truncation (e^2 W''') plus round-off (eps W / e) of the central difference */
         assert_true(fabs(F - dw / r) < 1e-6 * fabs(kernel_f(&K, 0.0)));
     }
-    /* W(0) = a_d = 7 / (4 pi h^2) (the formula's value at q = 0) */
-    assert_true(fabs(kernel_w(&K, 0.0) - 7.0 / (4.0 * KERNEL_PI * h * h)) < 1e-12 * kernel_w(&K, 0.0));
-    /* F(0) finite: -5 a_d / h^2, so W'(r) = F r -> 0 at r = 0 */
+    /* W(0) = a_d w0_coef with a_d the normalisation of kernel.h */
+    assert_true(fabs(kernel_w(&K, 0.0) - w0_coef / (KERNEL_PI * h * h)) < 1e-12 * kernel_w(&K, 0.0));
+    /* F(0) finite, so W'(r) = F r -> 0 at r = 0 */
     const double f0 = kernel_f(&K, 0.0);
     assert_true(isfinite(f0));
-    assert_true(fabs(f0 + 5.0 * 7.0 / (4.0 * KERNEL_PI * h * h) / (h * h)) < 1e-12 * fabs(f0));
+    assert_true(fabs(f0 - f0_coef / (KERNEL_PI * h * h) / (h * h)) < 1e-12 * fabs(f0));
     assert_true(fabs(kernel_f(&K, 1e-9 * h) - f0) < 1e-8 * fabs(f0));
-    /* continuity at 2h: F(2h - e) -> 0 like e^3 (F ~ (1 - q/2)^3) */
+    /* continuity at 2h: F(2h - e) -> 0 like e^end_order */
     const double fe = kernel_f(&K, 2.0 * h * (1.0 - 1e-4));
-    assert_true(fabs(fe) < 1e-11 * fabs(f0));
-    assert_true(fabs(kernel_w(&K, 2.0 * h * (1.0 - 1e-4))) < 1e-14 * kernel_w(&K, 0.0));
+    assert_true(fabs(fe) < 10.0 * pow(1e-4, end_order) * fabs(f0));
+    assert_true(fabs(kernel_w(&K, 2.0 * h * (1.0 - 1e-4))) < 1e-11 * kernel_w(&K, 0.0));
+}
+
+static void test_derivative_cubic_spline(void **state)
+{
+    (void)state;
+    /* W(0) = 10/(7 pi h^2); F(0) = -3 * 10/(7 pi h^2) / h^2; F ~ (2 - q)^2 at the edge */
+    check_derivative(KERNEL_CUBIC_SPLINE, 10.0 / 7.0, -30.0 / 7.0, 2.0);
+}
+
+static void test_derivative_wendland(void **state)
+{
+    (void)state;
+    /* W(0) = 7/(4 pi h^2); F(0) = -5 * 7/(4 pi h^2) / h^2; F ~ (1 - q/2)^3 at the edge */
+    check_derivative(KERNEL_WENDLAND_C2, 7.0 / 4.0, -35.0 / 4.0, 3.0);
 }
 
 int main(void)
@@ -157,7 +172,8 @@ int main(void)
         cmocka_unit_test(test_lattice_sum_is_one),
         cmocka_unit_test(test_gradient_of_linear_field),
         cmocka_unit_test(test_support),
-        cmocka_unit_test(test_derivative),
+        cmocka_unit_test(test_derivative_cubic_spline),
+        cmocka_unit_test(test_derivative_wendland),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

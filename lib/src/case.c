@@ -132,13 +132,13 @@ static mixsph_status get_num(struct reader *r, const cJSON *obj, const char *pat
                              double lo, int lo_open, double hi, double *out)
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!it) return required ? FAIL(r, "%s: %s.%s: missing (expected a number)", r->origin, path, key) : MIXSPH_OK;
+    if (!it) return required ? FAIL(r, "%s: %s%s%s: missing (expected a number)", r->origin, path, *path ? "." : "", key) : MIXSPH_OK;
     if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
-        return FAIL(r, "%s: %s.%s: expected a number", r->origin, path, key);
+        return FAIL(r, "%s: %s%s%s: expected a number", r->origin, path, *path ? "." : "", key);
     const double v = it->valuedouble;
     if ((lo_open ? v <= lo : v < lo) || v > hi) {
-        if (isinf(hi)) return FAIL(r, "%s: %s.%s: %g is out of range (expected %s %g)", r->origin, path, key, v, lo_open ? ">" : ">=", lo);
-        return FAIL(r, "%s: %s.%s: %g is out of range (expected %g %s x <= %g)", r->origin, path, key, v, lo, lo_open ? "<" : "<=", hi);
+        if (isinf(hi)) return FAIL(r, "%s: %s%s%s: %g is out of range (expected %s %g)", r->origin, path, *path ? "." : "", key, v, lo_open ? ">" : ">=", lo);
+        return FAIL(r, "%s: %s%s%s: %g is out of range (expected %g %s x <= %g)", r->origin, path, *path ? "." : "", key, v, lo, lo_open ? "<" : "<=", hi);
     }
     *out = v;
     return MIXSPH_OK;
@@ -148,8 +148,8 @@ static mixsph_status get_str(struct reader *r, const cJSON *obj, const char *pat
                              const char **out)
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!it) return required ? FAIL(r, "%s: %s.%s: missing (expected a string)", r->origin, path, key) : MIXSPH_OK;
-    if (!cJSON_IsString(it)) return FAIL(r, "%s: %s.%s: expected a string", r->origin, path, key);
+    if (!it) return required ? FAIL(r, "%s: %s%s%s: missing (expected a string)", r->origin, path, *path ? "." : "", key) : MIXSPH_OK;
+    if (!cJSON_IsString(it)) return FAIL(r, "%s: %s%s%s: expected a string", r->origin, path, *path ? "." : "", key);
     *out = it->valuestring;
     return MIXSPH_OK;
 }
@@ -170,17 +170,17 @@ static mixsph_status get_numbers(struct reader *r, const cJSON *obj, const char 
                                  double **out, size_t *n)
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!it) return FAIL(r, "%s: %s.%s: missing (expected an array of numbers)", r->origin, path, key);
-    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s.%s: expected an array of numbers", r->origin, path, key);
+    if (!it) return FAIL(r, "%s: %s%s%s: missing (expected an array of numbers)", r->origin, path, *path ? "." : "", key);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s%s%s: expected an array of numbers", r->origin, path, *path ? "." : "", key);
     size_t len = (size_t)cJSON_GetArraySize(it);
-    if (len < min_n) return FAIL(r, "%s: %s.%s: expected at least %zu numbers", r->origin, path, key, min_n);
+    if (len < min_n) return FAIL(r, "%s: %s%s%s: expected at least %zu number(s)", r->origin, path, *path ? "." : "", key, min_n);
     double *v = calloc(len, sizeof *v);
     if (!v) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
     size_t k = 0;
     for (const cJSON *e = it->child; e; e = e->next, k++) {
         if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
             free(v);
-            return FAIL(r, "%s: %s.%s[%zu]: expected a number", r->origin, path, key, k);
+            return FAIL(r, "%s: %s%s%s[%zu]: expected a number", r->origin, path, *path ? "." : "", key, k);
         }
         v[k] = e->valuedouble;
     }
@@ -194,10 +194,10 @@ static mixsph_status get_points(struct reader *r, const cJSON *obj, const char *
                                 struct polyline *pl)
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
-    if (!it) return FAIL(r, "%s: %s.%s: missing (expected an array of [x, z] points)", r->origin, path, key);
-    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s.%s: expected an array of [x, z] points", r->origin, path, key);
+    if (!it) return FAIL(r, "%s: %s%s%s: missing (expected an array of [x, z] points)", r->origin, path, *path ? "." : "", key);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s%s%s: expected an array of [x, z] points", r->origin, path, *path ? "." : "", key);
     size_t len = (size_t)cJSON_GetArraySize(it);
-    if (len < min_n) return FAIL(r, "%s: %s.%s: expected at least %zu [x, z] points", r->origin, path, key, min_n);
+    if (len < min_n) return FAIL(r, "%s: %s%s%s: expected at least %zu [x, z] point(s)", r->origin, path, *path ? "." : "", key, min_n);
     pl->x = calloc(len, sizeof(double));
     pl->z = calloc(len, sizeof(double));
     pl->n = len;
@@ -207,11 +207,11 @@ static mixsph_status get_points(struct reader *r, const cJSON *obj, const char *
         const cJSON *a = cJSON_IsArray(e) && cJSON_GetArraySize(e) == 2 ? e->child : NULL;
         if (!a || !cJSON_IsNumber(a) || !cJSON_IsNumber(a->next) || !isfinite(a->valuedouble) ||
             !isfinite(a->next->valuedouble))
-            return FAIL(r, "%s: %s.%s[%zu]: expected a point [x, z] of two numbers", r->origin, path, key, k);
+            return FAIL(r, "%s: %s%s%s[%zu]: expected a point [x, z] of two numbers", r->origin, path, *path ? "." : "", key, k);
         pl->x[k] = a->valuedouble;
         pl->z[k] = a->next->valuedouble;
         if (k > 0 && pl->x[k] == pl->x[k - 1] && pl->z[k] == pl->z[k - 1])
-            return FAIL(r, "%s: %s.%s[%zu]: repeats the previous point", r->origin, path, key, k);
+            return FAIL(r, "%s: %s%s%s[%zu]: repeats the previous point", r->origin, path, *path ? "." : "", key, k);
     }
     return MIXSPH_OK;
 }
@@ -248,7 +248,7 @@ static int find_motion(const struct case_def *c, const char *name)
 
 static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", NULL};
+    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", NULL};
     const cJSON *n;
     TRY(get_obj(r, root, "", "numerics", 1, &n));
     TRY(check_keys(r, n, "numerics", keys));
@@ -262,6 +262,11 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     TRY(get_num(r, n, "numerics", "cfl_visc", 0, 0.0, 1, 1.0, &c->cfl_visc));
     TRY(get_num(r, n, "numerics", "t_end", 1, 0.0, 1, 1e6, &c->t_end));
     TRY(get_num(r, n, "numerics", "wall_layers", 0, 1.0, 0, 8.0, &layers));
+    const char *kernel = "cubic_spline";
+    TRY(get_str(r, n, "numerics", "kernel", 0, &kernel));
+    if (strcmp(kernel, "cubic_spline") == 0) c->kernel = 0;
+    else if (strcmp(kernel, "wendland_c2") == 0) c->kernel = 1;
+    else return FAIL(r, "%s: numerics.kernel: '%s' (expected \"cubic_spline\" or \"wendland_c2\")", r->origin, kernel);
     c->p_background = 0.0;
     TRY(get_num(r, n, "numerics", "background_pressure", 0, 0.0, 0, 1e9, &c->p_background));
     c->wall_layers = (int)layers;
@@ -276,7 +281,7 @@ static mixsph_status get_bool(struct reader *r, const cJSON *obj, const char *pa
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!it) return MIXSPH_OK;
-    if (!cJSON_IsBool(it)) return FAIL(r, "%s: %s.%s: expected true or false", r->origin, path, key);
+    if (!cJSON_IsBool(it)) return FAIL(r, "%s: %s%s%s: expected true or false", r->origin, path, *path ? "." : "", key);
     *out = cJSON_IsTrue(it);
     return MIXSPH_OK;
 }
@@ -562,11 +567,11 @@ static mixsph_status read_root(struct reader *r, const cJSON *root, struct case_
     if (!cJSON_IsObject(root)) return FAIL(r, "%s: the case must be a JSON object", r->origin);
     TRY(check_keys(r, root, "", keys));
     const char *name = NULL, *desc = NULL;
-    TRY(get_str(r, root, "case", "name", 1, &name));
+    TRY(get_str(r, root, "", "name", 1, &name));
     TRY(copy_name(r, "name", name, c->name));
-    TRY(get_str(r, root, "case", "description", 0, &desc));
+    TRY(get_str(r, root, "", "description", 0, &desc));
     c->g = 9.81;
-    TRY(get_num(r, root, "case", "gravity", 0, 0.0, 0, 100.0, &c->g));
+    TRY(get_num(r, root, "", "gravity", 0, 0.0, 0, 100.0, &c->g));
     TRY(read_numerics(r, root, c));
     const cJSON *d;
     TRY(get_obj(r, root, "", "domain", 0, &d));

@@ -90,6 +90,7 @@ struct case_def {
     double cfl, cfl_visc;     /* time-step coefficients of (4) */
     double t_end;             /* [s] */
     int wall_layers;          /* layers of wall particles behind each wall */
+    int kernel;               /* enum kernel_type */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */

@@ -99,10 +99,13 @@ mixsph_status integrate_step(mixsph_sim *s)
     const long lost = cells_build(&s->C, P);
     if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
     s->n_lost += lost;
-    const int bad_rho = forces_continuity(s);
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++)
-        if (P->state[i] <= MIXSPH_STATE_FIXED) P->rho[i] += dt * P->drho[i];
+    int bad_rho = forces_continuity(s);
+#pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        P->rho[i] += dt * P->drho[i];
+        bad_rho |= !(P->rho[i] > 0.0);
+    }
     integrate_eos(s);
     if (s->has_granular) mixture_update(s);
     walls_pressure(s);
@@ -110,8 +113,8 @@ mixsph_status integrate_step(mixsph_sim *s)
         for (size_t i = 0; i < P->n; i++)
             if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
-                                "non-finite acceleration or density rate at particle %u (x = %g, z = %g) at t = %.6g s",
-                                P->id[i], P->x[i], P->z[i], s->t);
+                                "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
+                                P->rho[i], P->id[i], P->x[i], P->z[i], s->t);
     }
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {

@@ -76,6 +76,7 @@ size_t particles_push(struct particles *P, double x, double z, double rho, doubl
 void particles_permute(struct particles *P, const size_t *perm, void *scratch)
 {
     const size_t n = P->n;
+    if (n == 0) return;
     double *d = scratch;
 #define X(f)                                          \
     for (size_t k = 0; k < n; k++) d[k] = P->f[perm[k]]; \

@@ -157,7 +157,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     mixsph_status st;
     s->dx = s->cfg.dx;
     s->h = s->cfg.h_over_dx * s->dx;
-    s->K = kernel_make(s->h);
+    s->K = kernel_make_type(s->h, s->cfg.kernel);
     s->c_max = 0.0;
     for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
