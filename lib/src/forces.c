@@ -67,11 +67,12 @@ static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
     X->wendland = s->K.type == KERNEL_WENDLAND_C2;
 }
 
-/* F(r) of kernel.h without branches (both laws are evaluated and one is selected): 0 beyond 2h. */
-FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2)
+/* F(r) of kernel.h without branches: 0 beyond 2h. `wendland` is a compile-time constant in each
+ * inlined copy (the band functions dispatch on the kernel once, outside the loops). */
+FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendland)
 {
     const double q = sqrt(r2) * X->inv_h;
-    if (X->wendland) { /* uniform across the loop: hoisted by the compiler */
+    if (wendland) {
         double sq = 1.0 - 0.5 * q;
         sq = sq > 0.0 ? sq : 0.0;
         return X->f_fac * sq * sq * sq;
@@ -83,33 +84,50 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2)
     return X->f_fac * (q < 1.0 ? inner : outer);
 }
 
+/* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
+#define FORCES_LANE_IN(k, m) ((k) < (m) ? 1.0 : 0.0)
+
+/* Add the chunk's lane values v[] to a[jb..jb+m): a vector add for a full chunk, scalar adds
+ * for the last partial one (never a write past the range: another thread may own it). */
+FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const double *restrict v)
+{
+    if (m == FORCES_CHUNK) {
+#pragma omp simd
+        for (size_t k = 0; k < FORCES_CHUNK; k++) a[jb + k] += v[k];
+    } else {
+        for (size_t k = 0; k < m; k++) a[jb + k] += v[k];
+    }
+}
+
 /* Continuity between i and candidates [b, e): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
  * and same-medium neighbour counts. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b,
-                                    size_t e, double *di, double *ni)
+                                    size_t e, double *di, double *ni, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
     const double *restrict vol = P->vol, *restrict tag = P->tag;
-    double *restrict d = P->drho, *restrict nn = P->ax; /* ax holds neighbour counts in this pass */
     const struct pair_ctx Xl = *X;
+    const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
     for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        double dj[FORCES_CHUNK], cj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
-            const int in = j < e;
+            const double in = FORCES_LANE_IN(k, m);
             const double rx = xi - x[j], rz = zi - z[j];
             const double r2 = rx * rx + rz * rz;
-            const double uf = in ? ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * pair_f(&Xl, r2) : 0.0;
-            const double c = (in && r2 < Xl.r2max && tag[j] == ti && ti >= 0.0) ? 1.0 : 0.0;
+            const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * pair_f(&Xl, r2, wendland) * in;
+            const double c = (r2 < Xl.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
             acc[k] += vol[j] * uf;
             cnt[k] += c;
-            if (in) {
-                d[j] += voli * uf;
-                nn[j] += c;
-            }
+            dj[k] = voli * uf;
+            cj[k] = c;
         }
+        chunk_add(P->drho, jb, m, dj);
+        chunk_add(P->ax, jb, m, cj); /* ax holds neighbour counts in this pass */
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *di += acc[k];
@@ -117,66 +135,45 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     }
 }
 
-/* As continuity_range, plus the uncorrected velocity gradient G = sum_j V_j (u_j - u_i) (x) grad_i W
- * and the correction matrix L = sum_j V_j (x_j - x_i) (x) grad_i W of the granular strain rate
- * (MODEL.md section 5); both are shared by i and j with the other's volume. Walls enter with
- * their no-slip velocity, so grains feel the shear of a wall. */
-FORCES_INLINE void kinematics_range(const struct pair_ctx *X, struct particles *restrict P, struct kinematics *restrict K,
-                                    size_t i, size_t b, size_t e, double *acc_i)
+/* Velocity gradient of granular particle i, gathered over candidates [b, e): the uncorrected
+ * G = sum_j V_j (u_j - u_i) (x) grad_i W and the correction matrix
+ * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (MODEL.md section 5). Walls enter
+ * with their no-slip velocity, so grains feel the shear of a wall. Only granular particles need
+ * it, so it is a gather over them alone rather than part of the symmetric pass. */
+FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i, size_t b,
+                                  size_t e, double *acc_i, const int wendland)
 {
-    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
-    const double uxi = P->uvx[i], uzi = P->uvz[i];
-    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
-    const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict vol = P->vol, *restrict tag = P->tag;
-    double *restrict d = P->drho, *restrict nn = P->ax;
-    double *restrict gux = K->gux, *restrict guz = K->guz, *restrict gwx = K->gwx, *restrict gwz = K->gwz;
-    double *restrict lxx = K->lxx, *restrict lxz = K->lxz, *restrict lzz = K->lzz;
+    const double xi = P->x[i], zi = P->z[i], uxi = P->uvx[i], uzi = P->uvz[i];
+    const double *restrict x = P->x, *restrict z = P->z, *restrict uvx = P->uvx, *restrict uvz = P->uvz;
+    const double *restrict vol = P->vol;
     const struct pair_ctx Xl = *X;
-    double a[9][FORCES_CHUNK] = {{0}};
+    double a[7][FORCES_CHUNK] = {{0}};
     for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
 #pragma omp simd
-    for (size_t k = 0; k < FORCES_CHUNK; k++) {
-        const size_t j = jb + k;
-        const int in = j < e;
-        const double rx = xi - x[j], rz = zi - z[j];
-        const double r2 = rx * rx + rz * rz;
-        const double F = in ? pair_f(&Xl, r2) : 0.0;
-        const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * F;
-        const double c = (in && r2 < Xl.r2max && tag[j] == ti && ti >= 0.0) ? 1.0 : 0.0;
-        const double dux = (uvx[j] - uxi) * F, duz = (uvz[j] - uzi) * F;
-        const double g0 = dux * rx, g1 = dux * rz, g2 = duz * rx, g3 = duz * rz;
-        const double l0 = -F * rx * rx, l1 = -F * rx * rz, l2 = -F * rz * rz;
-        const double vj = vol[j];
-        a[0][k] += vj * uf;
-        a[1][k] += c;
-        a[2][k] += vj * g0;
-        a[3][k] += vj * g1;
-        a[4][k] += vj * g2;
-        a[5][k] += vj * g3;
-        a[6][k] += vj * l0;
-        a[7][k] += vj * l1;
-        a[8][k] += vj * l2;
-        if (in) {
-            d[j] += voli * uf;
-            nn[j] += c;
-            gux[j] += voli * g0;
-            guz[j] += voli * g1;
-            gwx[j] += voli * g2;
-            gwz[j] += voli * g3;
-            lxx[j] += voli * l0;
-            lxz[j] += voli * l1;
-            lzz[j] += voli * l2;
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
+            const double rx = xi - x[j], rz = zi - z[j];
+            const double r2 = rx * rx + rz * rz;
+            const double vf = vol[j] * pair_f(&Xl, r2, wendland) * FORCES_LANE_IN(k, m);
+            const double dux = (uvx[j] - uxi) * vf, duz = (uvz[j] - uzi) * vf;
+            a[0][k] += dux * rx;
+            a[1][k] += dux * rz;
+            a[2][k] += duz * rx;
+            a[3][k] += duz * rz;
+            a[4][k] -= vf * rx * rx;
+            a[5][k] -= vf * rx * rz;
+            a[6][k] -= vf * rz * rz;
         }
     }
-    }
-    for (int q = 0; q < 9; q++)
+    for (int q = 0; q < 7; q++)
         for (size_t k = 0; k < FORCES_CHUNK; k++) acc_i[q] += a[q][k];
 }
 
 /* Momentum between i and candidates [b, e): the pair force f_ij (per unit depth) is added to
  * a_i as f/m_i and subtracted from a_j as f/m_j. */
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b, size_t e,
-                                  double *axi, double *azi)
+                                  double *axi, double *azi, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
@@ -186,42 +183,43 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
     const double *restrict m = P->m, *restrict irho = P->inv_rho, *restrict mu = P->mu, *restrict tag = P->tag;
     const double *restrict avc = P->avc, *restrict im = P->inv_m;
-    double *restrict ax = P->ax, *restrict az = P->az;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
     for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+        const size_t n = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
 #pragma omp simd
-    for (size_t k = 0; k < FORCES_CHUNK; k++) {
-        const size_t j = jb + k;
-        const int in = j < e;
-        const double rx = xi - x[j], rz = zi - z[j];
-        const double r2 = rx * rx + rz * rz;
-        const double F = in ? pair_f(&Xl, r2) : 0.0;
-        const double inv_r2e = 1.0 / (r2 + Xl.eta2);
-        const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
-        const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
-        /* pressure */
-        double fr = -vv * (pi + p[j]);
-        /* artificial viscosity: approaching pairs of one fluid medium, or fluid and wall */
-        double vdotr = (vxi - vx[j]) * rx + (vzi - vz[j]) * rz;
-        vdotr = vdotr < 0.0 ? vdotr : 0.0;
-        const double same = (tag[j] == ti || walli + wallj > 0.0) ? 1.0 : 0.0;
-        const double avc_ij = avci > avc[j] ? avci : avc[j];
-        fr += same * (1.0 - walli * wallj) * avc_ij * mi * m[j] * vdotr * inv_r2e * 0.5 * (irhoi + irho[j]);
-        /* laminar viscosity, pairwise harmonic mean (a wall takes the viscosity of the particle
-         * it meets): mu_i + mu_j of Morris is replaced by 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j) */
-        const double muj = mu[j] + wallj * mui, mu_i = mui + walli * mu[j];
-        const double musum = 4.0 * mu_i * muj / (mu_i + muj + 1e-300);
-        const double fv = vv * musum * r2 * inv_r2e;
-        const double fx = F * (fr * rx + fv * (uvxi - uvx[j]));
-        const double fz = F * (fr * rz + fv * (uvzi - uvz[j]));
-        sx[k] += fx;
-        sz[k] += fz;
-        if (in) {
-            ax[j] -= fx * im[j];
-            az[j] -= fz * im[j];
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
+            const double in = FORCES_LANE_IN(k, n);
+            const double rx = xi - x[j], rz = zi - z[j];
+            const double r2 = rx * rx + rz * rz;
+            const double F = pair_f(&Xl, r2, wendland) * in;
+            const double inv_r2e = 1.0 / (r2 + Xl.eta2);
+            const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
+            const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
+            /* pressure */
+            double fr = -vv * (pi + p[j]);
+            /* artificial viscosity: approaching pairs of one fluid medium, or fluid and wall */
+            double vdotr = (vxi - vx[j]) * rx + (vzi - vz[j]) * rz;
+            vdotr = vdotr < 0.0 ? vdotr : 0.0;
+            const double same = (tag[j] == ti ? 1.0 : 0.0) + walli + wallj > 0.0 ? 1.0 : 0.0;
+            const double avc_ij = avci > avc[j] ? avci : avc[j];
+            fr += same * (1.0 - walli * wallj) * avc_ij * mi * m[j] * vdotr * inv_r2e * 0.5 * (irhoi + irho[j]);
+            /* laminar viscosity, pairwise harmonic mean (a wall takes the viscosity of the
+             * particle it meets): mu_i + mu_j of Morris is replaced by 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j) */
+            const double muj = mu[j] + wallj * mui, mu_i = mui + walli * mu[j];
+            const double musum = 4.0 * mu_i * muj / (mu_i + muj + 1e-300);
+            const double fv = vv * musum * r2 * inv_r2e;
+            const double fx = F * (fr * rx + fv * (uvxi - uvx[j]));
+            const double fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+            sx[k] += fx;
+            sz[k] += fz;
+            ajx[k] = -fx * im[j];
+            ajz[k] = -fz * im[j];
         }
-    }
+        chunk_add(P->ax, jb, n, ajx);
+        chunk_add(P->az, jb, n, ajz);
     }
     double tx = 0.0, tz = 0.0;
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -243,42 +241,63 @@ FORCES_INLINE void half_ranges(const struct cells *C, size_t i, struct range *a,
     *b = cells_row(C, ix, iz, 1);
 }
 
-FORCES_CLONES
-static void continuity_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
-                            struct kinematics *restrict K, size_t b0, size_t b1)
+/* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
+FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                                   size_t b0, size_t b1, const int wendland)
 {
     for (size_t i = b0; i < b1; i++) {
         struct range ra, rb;
         half_ranges(C, i, &ra, &rb);
         double di = 0.0, ni = 0.0;
-        continuity_range(X, P, i, ra.begin, ra.end, &di, &ni);
-        continuity_range(X, P, i, rb.begin, rb.end, &di, &ni);
-        (void)K;
+        continuity_range(X, P, i, ra.begin, ra.end, &di, &ni, wendland);
+        continuity_range(X, P, i, rb.begin, rb.end, &di, &ni, wendland);
         P->drho[i] += di;
         P->ax[i] += ni;
     }
 }
 
 FORCES_CLONES
-static void kinematics_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
-                            struct kinematics *restrict K, size_t b0, size_t b1)
+static void gradient_particle(const struct pair_ctx *X, const struct cells *C, const struct particles *restrict P,
+                              struct kinematics *restrict K, size_t i)
+{
+    double acc[7] = {0};
+    int ix, iz;
+    cells_coords(C, P->x[i], P->z[i], &ix, &iz);
+    for (int row = -1; row <= 1; row++) {
+        const struct range rg = cells_row(C, ix, iz, row);
+        if (X->wendland) gradient_range(X, P, i, rg.begin, rg.end, acc, 1);
+        else gradient_range(X, P, i, rg.begin, rg.end, acc, 0);
+    }
+    K->gux[i] = acc[0];
+    K->guz[i] = acc[1];
+    K->gwx[i] = acc[2];
+    K->gwz[i] = acc[3];
+    K->lxx[i] = acc[4];
+    K->lxz[i] = acc[5];
+    K->lzz[i] = acc[6];
+}
+
+FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                                 size_t b0, size_t b1, const int wendland)
 {
     for (size_t i = b0; i < b1; i++) {
         struct range ra, rb;
         half_ranges(C, i, &ra, &rb);
-        double acc[9] = {0};
-        kinematics_range(X, P, K, i, ra.begin, ra.end, acc);
-        kinematics_range(X, P, K, i, rb.begin, rb.end, acc);
-        P->drho[i] += acc[0];
-        P->ax[i] += acc[1];
-        K->gux[i] += acc[2];
-        K->guz[i] += acc[3];
-        K->gwx[i] += acc[4];
-        K->gwz[i] += acc[5];
-        K->lxx[i] += acc[6];
-        K->lxz[i] += acc[7];
-        K->lzz[i] += acc[8];
+        double sx = 0.0, sz = 0.0;
+        momentum_range(X, P, i, ra.begin, ra.end, &sx, &sz, wendland);
+        momentum_range(X, P, i, rb.begin, rb.end, &sx, &sz, wendland);
+        P->ax[i] += sx * P->inv_m[i];
+        P->az[i] += sz * P->inv_m[i];
     }
+}
+
+FORCES_CLONES
+static void continuity_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+                            struct kinematics *restrict K, size_t b0, size_t b1)
+{
+    (void)K;
+    if (X->wendland) continuity_walk(X, C, P, b0, b1, 1);
+    else continuity_walk(X, C, P, b0, b1, 0);
 }
 
 FORCES_CLONES
@@ -286,15 +305,8 @@ static void momentum_band(const struct pair_ctx *X, const struct cells *C, struc
                           struct kinematics *restrict K, size_t b0, size_t b1)
 {
     (void)K;
-    for (size_t i = b0; i < b1; i++) {
-        struct range ra, rb;
-        half_ranges(C, i, &ra, &rb);
-        double sx = 0.0, sz = 0.0;
-        momentum_range(X, P, i, ra.begin, ra.end, &sx, &sz);
-        momentum_range(X, P, i, rb.begin, rb.end, &sx, &sz);
-        P->ax[i] += sx * P->inv_m[i];
-        P->az[i] += sz * P->inv_m[i];
-    }
+    if (X->wendland) momentum_walk(X, C, P, b0, b1, 1);
+    else momentum_walk(X, C, P, b0, b1, 0);
 }
 
 typedef void (*band_fn)(const struct pair_ctx *, const struct cells *, struct particles *restrict,
@@ -328,13 +340,14 @@ int forces_continuity(mixsph_sim *s)
     const size_t n = s->C.start[s->C.ncell];
     memset(P->drho, 0, n * sizeof(double));
     memset(P->ax, 0, n * sizeof(double));
+    for_bands(s, continuity_band, &X);
     if (s->has_granular) {
+        const struct medium *M = s->cfg.media;
         struct kinematics *K = &s->kin;
-        double *f[7] = {K->gux, K->guz, K->gwx, K->gwz, K->lxx, K->lxz, K->lzz};
-        for (int k = 0; k < 7; k++) memset(f[k], 0, n * sizeof(double));
-        for_bands(s, kinematics_band, &X);
-    } else {
-        for_bands(s, continuity_band, &X);
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+        for (size_t i = 0; i < n; i++)
+            if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
+                gradient_particle(&X, &s->C, P, K, i);
     }
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
@@ -377,12 +390,12 @@ void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, d
     struct particles *P = (struct particles *)&s->P;
     const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
     double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
-    momentum_range(&X, P, i, j, j + 1, &sx, &sz);
+    momentum_range(&X, P, i, j, j + 1, &sx, &sz, X.wendland);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
     P->az[j] = save[1];
-    continuity_range(&X, P, i, j, j + 1, &di, &ni);
+    continuity_range(&X, P, i, j, j + 1, &di, &ni, X.wendland);
     *drho = P->rho[i] * di;
     P->ax[j] = save[0];
     P->drho[j] = save[2];

@@ -1,0 +1,724 @@
+#!/usr/bin/env python3
+"""Erosive dam break: run the mixture-model runs of Manenti et al. (2018), Section 3.1, Tables 1-2,
+and compare them with the paper.
+
+    python tools/erosive_dambreak.py [--runs 2,5,6,7] [--dx 0.01] [--out out/erosive]
+                                     [--threads N] [--jobs J] [--reuse] [--mixsph build/mixsph]
+                                     [--case cases/erosive_dambreak.json] [--t-end T] [--at 0.5]
+
+Each selected run k is ``mixsph run CASE --out OUT/run<k>_dx<D> --set numerics.dx=D --set
+media.sediment.mu_thr=... --set media.sediment.mu0=... --threads N --quiet`` (stdout and stderr in
+OUT/run<k>_dx<D>/mixsph.log). The paper's runs (viscosities in kPa s; the case takes Pa s):
+
+    run  mu_thr  mu0    paper elapsed s  aver. err. %   reference
+    1    10      10.7   12,478           5.97           Run 4
+    2    20      20.7   24,224           4.97           Run 4 (and the reference of Runs 5-7)
+    3    40      40.7   44,777           4.92           Run 4
+    4    80      80.7   77,299           (reference)    -
+    5    20      15     19,163           5.4            Run 2
+    6    20      5      7,089            5.7            Run 2
+    7    mu1 = 5 (mu_thr = 5 kPa s, mu0 = 1e12 Pa s, i.e. no limit)   7,098   -   Run 2
+
+``--jobs J`` runs up to J runs at once, each with max(1, cores // J) threads unless ``--threads``
+is given. ``--reuse`` keeps a run whose summary.json says "ok" for the same t_end (and the same
+settings, recorded in OUT/run<k>_dx<D>/erosive_run.json). ``--t-end T`` shortens every run (for
+tests: the profiles at t = 0.5 s then do not exist and the columns that need them say n/a).
+
+Printed table, one row per run, ours beside the paper's:
+
+- wall time of the run (summary.json ``wall_time_s``) and the paper's total elapsed time;
+- saving versus the reference run, 100 (1 - wall / wall_ref), ours and the paper's (Run 6 vs
+  Run 2: 71 %; Run 2 vs Run 4: 69 %);
+- interface error versus the reference run, ours and the paper's "aver. err.": the mean, over the
+  0.01 m bins of the interface profile (top of the sediment, i.e. the mixture-water interface) at
+  t = 0.5 s with bin centre x <= 0.25 m (near the left corner, where the paper compares), of
+  |z_run - z_ref| / z_ref * 100, bins empty in either run left out. The reference is Run 4 for
+  Runs 1-3 and Run 2 for Runs 5-7, as in the paper; it must be among --runs (with --reuse an
+  earlier run of it costs nothing), else the cell says "n/a (reference not run)";
+- the maximum rise of the bed load at the left wall (summary ``bedload_rise_left_wall`` max: top
+  of the sediment within x < 0.02 m, over the run) and its time, paper ~0.3 m;
+- the peak left-wall pressure (summary ``left_wall_pressure`` max) and its time, paper ~10 kPa;
+- the time the water reaches the left wall: first monitor sample (monitors.csv, every 0.005 s)
+  with ``water_front`` < 0.02 m, paper ~0.29 s.
+
+Writes OUT/erosive_table.csv (the same, one row per run) and OUT/erosive_profiles.png: the
+interface (solid) and the free surface (dashed) at t = 0.5 s of every run for 0 <= x <= 0.5 m,
+like the paper's Figs 3 (Runs 1-4) and 4 (Runs 2, 5-7).
+
+Exit status: 0 ok; 1 a mixsph run failed (the table of the others is still printed); 2 bad
+usage or input; 130 interrupted.
+
+Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
+modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mixsph_tools as mt  # noqa: E402
+
+PROG = "erosive_dambreak.py"
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+KPA = 1e3  # Pa s per kPa s, Pa per kPa
+
+
+@dataclass(frozen=True)
+class PaperRun:
+    run: int
+    mu_thr: float         # [Pa s] passed to the case
+    mu0: float            # [Pa s]
+    elapsed_s: float      # paper's total elapsed time [s]
+    err_percent: float    # paper's aver. err. [%] (nan: none)
+    ref: int              # reference run of the comparison (0: none, this is a reference)
+    label_thr: str        # how the table shows mu_thr, mu0 [kPa s]
+    label_mu0: str
+
+
+PAPER = {
+    1: PaperRun(1, 10e3, 10.7e3, 12478, 5.97, 4, "10", "10.7"),
+    2: PaperRun(2, 20e3, 20.7e3, 24224, 4.97, 4, "20", "20.7"),
+    3: PaperRun(3, 40e3, 40.7e3, 44777, 4.92, 4, "40", "40.7"),
+    4: PaperRun(4, 80e3, 80.7e3, 77299, math.nan, 0, "80", "80.7"),
+    5: PaperRun(5, 20e3, 15e3, 19163, 5.4, 2, "20", "15"),
+    6: PaperRun(6, 20e3, 5e3, 7089, 5.7, 2, "20", "5"),
+    7: PaperRun(7, 5e3, 1e12, 7098, math.nan, 2, "mu1=5", "off"),
+}
+PAPER_DX = 0.005           # [m] the paper's resolution
+PAPER_BEDLOAD_RISE = 0.3   # [m] max rise of the bed-load layer at the left wall (converged runs)
+PAPER_PEAK_P_KPA = 10.0    # [kPa] peak pressure on the left wall
+PAPER_T_IMPACT = 0.29      # [s] plunging wave hits the left wall
+ERR_X_MAX = 0.25           # [m] interface error over bins with centre x <= this
+WALL_REACH_X = 0.02        # [m] water "at the left wall" when water_front < this
+PLOT_X_MAX = 0.5           # [m]
+TABLE1 = (1, 2, 3, 4)      # paper Fig. 3
+TABLE2 = (2, 5, 6, 7)      # paper Fig. 4
+T_TOL = 1e-3               # [s] a summary's simulated time matches t_end within this
+
+
+def fail(msg, code=2):
+    print(f"{PROG}: error: {msg}", file=sys.stderr)
+    sys.exit(code)
+
+
+def warn(msg):
+    print(f"{PROG}: warning: {msg}", file=sys.stderr)
+
+
+def show(path):
+    """A path as short as it reads: relative to the current folder when inside it."""
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
+
+
+def num(v):
+    """A number for the command line: 0.01 -> '0.01', 20700.0 -> '20700', 1e12 -> '1000000000000'."""
+    v = float(v)
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
+def fmt(v, spec, na="n/a"):
+    return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na
+
+
+def fmt_duration(s):
+    s = int(round(s))
+    if s < 60:
+        return f"{s}s"
+    if s < 3600:
+        return f"{s // 60}m{s % 60:02d}s"
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
+# ---- one run --------------------------------------------------------------------------------------
+
+
+@dataclass
+class Job:
+    paper: PaperRun
+    outdir: str
+    cmd: list
+    stamp: dict
+    threads: int
+    proc: subprocess.Popen = None
+    log: object = None
+    t0: float = 0.0
+    source: str = ""      # "ran", "reused", "FAILED"
+    message: str = ""     # why it failed
+
+
+@dataclass
+class Result:
+    paper: PaperRun
+    outdir: str
+    source: str
+    status: str = "missing"
+    threads: int = 0
+    sim_time: float = math.nan
+    wall: float = math.nan
+    psteps: float = math.nan
+    rise: float = math.nan
+    rise_t: float = math.nan
+    p_peak: float = math.nan     # [Pa]
+    p_peak_t: float = math.nan
+    t_wall: float = math.nan     # water reaches the left wall [s]
+    interface: mt.Profile = None
+    free_surface: mt.Profile = None
+    cells: dict = field(default_factory=dict)   # computed comparison cells
+
+    @property
+    def ok(self):
+        return self.status == "ok"
+
+
+OUTPUT_PATTERNS = ("summary.json", "monitors.csv", "mixsph.log", "erosive_run.json")
+
+
+def clean_outdir(d):
+    """Remove the files an earlier run left (a shorter run must not show stale profiles)."""
+    if not os.path.isdir(d):
+        return
+    for name in os.listdir(d):
+        if name in OUTPUT_PATTERNS or (name.endswith(".csv") and name.startswith(("profile_", "snap_"))):
+            os.remove(os.path.join(d, name))
+
+
+def reusable(job, t_end):
+    """(True, why) when OUT/run<k>_dx<D> already holds this run, finished ok."""
+    summ_path = os.path.join(job.outdir, "summary.json")
+    if not os.path.isfile(summ_path):
+        return False, "no summary.json"
+    try:
+        summ = mt.read_summary(summ_path)
+    except mt.ToolError as e:
+        return False, str(e)
+    if summ.get("status") != "ok":
+        return False, f"its summary.json says status '{summ.get('status')}'"
+    st = summ.get("simulated_time_s")
+    if not isinstance(st, (int, float)) or abs(st - t_end) > T_TOL:
+        return False, f"it ran to t = {st} s, not t_end = {t_end:g} s"
+    stamp_path = os.path.join(job.outdir, "erosive_run.json")
+    if os.path.isfile(stamp_path):
+        try:
+            with open(stamp_path) as f:
+                old = json.load(f)
+        except (OSError, ValueError):
+            old = None
+        keys = ("run", "dx", "mu_thr", "mu0", "t_end", "case")
+        if not isinstance(old, dict) or any(old.get(k) != job.stamp.get(k) for k in keys):
+            return False, f"{show(stamp_path)} records other settings"
+    return True, f"summary ok, t = {st:.4g} s"
+
+
+def last_time(monitors_csv):
+    """Simulated time of the last complete line of a growing monitors.csv (nan if none)."""
+    try:
+        with open(monitors_csv, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            n = f.tell()
+            f.seek(max(0, n - 4096))
+            raw = f.read()
+    except OSError:
+        return math.nan
+    lines = raw.decode(errors="replace").split("\n")
+    lines = lines[1:-1] if n > 4096 else lines[:-1]   # drop a cut first line and the unfinished last one
+    for line in reversed(lines):
+        try:
+            return float(line.split(",", 1)[0])
+        except ValueError:
+            continue
+    return math.nan
+
+
+def tail(path, n=8):
+    try:
+        with open(path, errors="replace") as f:
+            return f.read().splitlines()[-n:]
+    except OSError:
+        return []
+
+
+def run_jobs(jobs, n_parallel, t_end, progress_every):
+    """Run the jobs, at most n_parallel at once. Returns the failed ones."""
+    pending = list(jobs)
+    running = []
+    failed = []
+    t_start = time.monotonic()
+    last_progress = t_start
+    try:
+        while pending or running:
+            while pending and len(running) < n_parallel and not failed:
+                job = pending.pop(0)
+                os.makedirs(job.outdir, exist_ok=True)
+                clean_outdir(job.outdir)
+                with open(os.path.join(job.outdir, "erosive_run.json"), "w") as f:
+                    json.dump(job.stamp, f, indent=2)
+                    f.write("\n")
+                job.log = open(os.path.join(job.outdir, "mixsph.log"), "w")
+                job.log.write("$ " + " ".join(job.cmd) + "\n")
+                job.log.flush()
+                job.t0 = time.monotonic()
+                try:
+                    job.proc = subprocess.Popen(job.cmd, stdout=job.log, stderr=subprocess.STDOUT,
+                                                stdin=subprocess.DEVNULL)
+                except OSError as e:
+                    job.log.close()
+                    fail(f"cannot start {job.cmd[0]}: {e}")
+                running.append(job)
+                print(f"run {job.paper.run}: started ({job.threads} thread{'s' if job.threads > 1 else ''}) "
+                      f"-> {show(job.outdir)}/  (log: mixsph.log)", flush=True)
+            if pending and failed and not running:
+                break
+            time.sleep(0.5)
+            for job in list(running):
+                rc = job.proc.poll()
+                if rc is None:
+                    continue
+                running.remove(job)
+                job.log.close()
+                el = time.monotonic() - job.t0
+                if rc == 0:
+                    job.source = "ran"
+                    print(f"run {job.paper.run}: done in {fmt_duration(el)}", flush=True)
+                else:
+                    job.source = "FAILED"
+                    what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
+                    job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else \
+                        f"mixsph was killed by signal {-rc}"
+                    failed.append(job)
+                    print(f"run {job.paper.run}: FAILED after {fmt_duration(el)}: {job.message}; "
+                          f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
+                    for line in tail(os.path.join(job.outdir, "mixsph.log")):
+                        print(f"    | {line}", flush=True)
+                    if pending:
+                        print(f"{PROG}: not starting the remaining runs "
+                              f"({', '.join(str(j.paper.run) for j in pending)})", flush=True)
+            now = time.monotonic()
+            if progress_every > 0 and running and now - last_progress >= progress_every:
+                last_progress = now
+                parts = []
+                for job in running:
+                    ts = last_time(os.path.join(job.outdir, "monitors.csv"))
+                    el = now - job.t0
+                    eta = fmt_duration(el * (t_end - ts) / ts) if math.isfinite(ts) and ts > 0 else "--"
+                    parts.append(f"run {job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s (ETA {eta})")
+                print(f"  [{fmt_duration(now - t_start)}] " + ", ".join(parts), flush=True)
+    except KeyboardInterrupt:
+        for job in running:
+            job.proc.terminate()
+        for job in running:
+            try:
+                job.proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                job.proc.kill()
+                job.proc.wait()
+        print(f"\n{PROG}: interrupted; stopped run(s) {', '.join(str(j.paper.run) for j in running)}",
+              file=sys.stderr)
+        sys.exit(130)
+    for job in pending:
+        job.source = "not run"
+    return failed
+
+
+# ---- analysis -------------------------------------------------------------------------------------
+
+
+def load_result(job, at):
+    r = Result(job.paper, job.outdir, job.source)
+    summ_path = os.path.join(job.outdir, "summary.json")
+    if job.source == "not run":
+        r.status = "not run"
+        return r
+    if not os.path.isfile(summ_path):
+        r.status = "no summary"
+        return r
+    summ = mt.read_summary(summ_path)
+    r.status = str(summ.get("status"))
+    r.threads = int(summ.get("threads") or 0)
+    r.sim_time = float(summ.get("simulated_time_s") or math.nan)
+    r.wall = float(summ.get("wall_time_s") or math.nan)
+    r.psteps = float(summ.get("particle_steps_per_s") or math.nan)
+    r.rise = mt.summary_value(summ, "bedload_rise_left_wall", "max")
+    r.rise_t = mt.summary_value(summ, "bedload_rise_left_wall", "t_max")
+    r.p_peak = mt.summary_value(summ, "left_wall_pressure", "max")
+    r.p_peak_t = mt.summary_value(summ, "left_wall_pressure", "t_max")
+    mon_path = os.path.join(job.outdir, "monitors.csv")
+    if os.path.isfile(mon_path):
+        mon = mt.read_monitors(mon_path)
+        if "water_front" in mon:
+            r.t_wall = mt.first_time_below(mon["t"], mon["water_front"], WALL_REACH_X)
+        else:
+            warn(f"{show(mon_path)}: no column 'water_front'")
+    r.interface = mt.find_profile(job.outdir, "interface", at)
+    r.free_surface = mt.find_profile(job.outdir, "free_surface", at)
+    return r
+
+
+def interface_error(run_prof, ref_prof, x_max=ERR_X_MAX):
+    """(mean |z - z_ref| / z_ref * 100 over the common finite bins with x <= x_max, bins used)."""
+    ref = {round(x, 9): z for x, z in zip(ref_prof.x, ref_prof.z)}
+    errs = []
+    for x, z in zip(run_prof.x, run_prof.z):
+        zr = ref.get(round(x, 9))
+        if x <= x_max + 1e-12 and zr is not None and math.isfinite(z) and math.isfinite(zr) and zr > 0:
+            errs.append(abs(z - zr) / zr * 100.0)
+    return (float(np.mean(errs)), len(errs)) if errs else (math.nan, 0)
+
+
+def compare(results, at):
+    """Fill r.cells: saving and interface error versus the reference run, with the reason when n/a."""
+    by_run = {r.paper.run: r for r in results}
+    for r in results:
+        p = r.paper
+        c = r.cells
+        if p.ref == 0:
+            c["ref"] = "-"
+            c["saving"] = c["paper_saving"] = c["err"] = "(reference)"
+            c["paper_err"] = "(ref)"
+            c.update(saving_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0)
+            continue
+        c["ref"] = str(p.ref)
+        paper_ref = PAPER[p.ref]
+        c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / paper_ref.elapsed_s)
+        c["paper_saving"] = f"{c['paper_saving_v']:.0f}"
+        c["paper_err"] = fmt(p.err_percent, ".2f", "-")
+        c["saving_v"] = c["err_v"] = math.nan
+        c["err_bins"] = 0
+        ref = by_run.get(p.ref)
+        if not r.ok:
+            c["saving"] = c["err"] = "n/a (run failed)" if r.status not in ("not run", "missing") else "n/a"
+            continue
+        if ref is None:
+            c["saving"] = c["err"] = "n/a (reference not run)"
+            continue
+        if not ref.ok:
+            c["saving"] = c["err"] = "n/a (reference failed)" if ref.status != "not run" else \
+                "n/a (reference not run)"
+            continue
+        if math.isfinite(r.wall) and math.isfinite(ref.wall) and ref.wall > 0:
+            c["saving_v"] = 100.0 * (1.0 - r.wall / ref.wall)
+            c["saving"] = f"{c['saving_v']:.0f}"
+        else:
+            c["saving"] = "n/a"
+        if r.interface is None:
+            c["err"] = f"n/a (no profile at t={at:g} s)"
+        elif ref.interface is None:
+            c["err"] = f"n/a (ref. has no profile at t={at:g} s)"
+        else:
+            e, n = interface_error(r.interface, ref.interface)
+            c["err_v"], c["err_bins"] = e, n
+            c["err"] = f"{e:.2f}" if n else "n/a (no common bins)"
+
+
+# ---- table ----------------------------------------------------------------------------------------
+
+
+def print_table(columns, rows, footer_rows=()):
+    """columns: (group, header, align) per column; rows: lists of cell strings."""
+    n = len(columns)
+    width = [max([len(columns[k][1])] + [len(row[k]) for row in list(rows) + list(footer_rows)]) for k in range(n)]
+    # groups: consecutive columns with the same group label; widen the last column to fit the label
+    groups = []
+    for k, (g, _, _) in enumerate(columns):
+        if groups and groups[-1][0] == g:
+            groups[-1][2] = k
+        else:
+            groups.append([g, k, k])
+    for g, a, b in groups:
+        span = sum(width[a:b + 1]) + 2 * (b - a)
+        if len(g) > span:
+            width[b] += len(g) - span
+
+    def line(cells):
+        out = []
+        for g, a, b in groups:
+            part = []
+            for k in range(a, b + 1):
+                s = cells[k]
+                part.append(s.rjust(width[k]) if columns[k][2] == ">" else s.ljust(width[k]))
+            out.append("  ".join(part))
+        return " | ".join(out).rstrip()
+
+    head = []
+    for g, a, b in groups:
+        span = sum(width[a:b + 1]) + 2 * (b - a)
+        head.append(g.center(span) if g else " " * span)
+    text = [" | ".join(head).rstrip(), line([c[1] for c in columns])]
+    rule = "-" * max(len(s) for s in text)
+    text.append(rule)
+    text += [line(r) for r in rows]
+    if footer_rows:
+        text.append(rule)
+        text += [line(r) for r in footer_rows]
+    text.append(rule)
+    print("\n".join(text))
+
+
+def table(results, at, dx, t_end, threads_note):
+    cols = [
+        ("", "run", ">"), ("", "mu_thr", ">"), ("", "mu0", ">"), ("", "status", "<"),
+        ("wall time [s]", "mixsph", ">"), ("wall time [s]", "paper", ">"),
+        ("saving vs ref [%]", "ref", ">"), ("saving vs ref [%]", "mixsph", ">"), ("saving vs ref [%]", "paper", ">"),
+        (f"interface err [%], t={at:g} s", "mixsph", ">"), (f"interface err [%], t={at:g} s", "paper", ">"),
+        ("bed-load rise, wall", "max [m]", ">"), ("bed-load rise, wall", "t [s]", ">"),
+        ("peak p, left wall", "[kPa]", ">"), ("peak p, left wall", "t [s]", ">"),
+        ("water at wall", "t [s]", ">"),
+    ]
+    rows = []
+    for r in results:
+        p, c = r.paper, r.cells
+        status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
+        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 0.5) > T_TOL:
+            status += f", t={r.sim_time:.3g} s"
+        rows.append([
+            str(p.run), p.label_thr, p.label_mu0, status,
+            fmt(r.wall, ".1f"), f"{p.elapsed_s:,.0f}",
+            c["ref"], c["saving"], c["paper_saving"],
+            c["err"], c["paper_err"],
+            fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
+            fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
+            fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"),
+        ])
+    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "",
+                 f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}"]
+    print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
+          f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
+    print("mu_thr, mu0 in kPa s; the paper's times are SPHERA v8's, on hardware it does not state")
+    print()
+    print_table(cols, rows, [paper_row])
+    print(f"interface err: mean over the 0.01 m bins with x <= {ERR_X_MAX:g} m of |z_run - z_ref| / z_ref * 100, "
+          f"z = top of the sediment at t = {at:g} s;")
+    print("               reference Run 4 for Runs 1-3, Run 2 for Runs 5-7 (the paper's 'aver. err.').")
+    print("saving:        100 (1 - wall / wall of the reference run), the paper's from its elapsed times.")
+    print(f"bed-load rise: max over the run of the top of the sediment within x < 0.02 m "
+          f"(paper: ~{PAPER_BEDLOAD_RISE:g} m for the converged runs).")
+    print(f"water at wall: first monitor sample with water_front < {WALL_REACH_X:g} m "
+          f"(paper: the plunging wave hits the left wall at ~{PAPER_T_IMPACT:g} s).")
+    print("Run 7:         mu1 rheology, mu1 = 5 kPa s, given as mu_thr = 5 kPa s and mu0 = 1e12 Pa s (no limit).")
+
+
+def write_csv(path, results, dx, t_end, at):
+    fields = ["run", "mu_thr_Pa_s", "mu0_Pa_s", "dx_m", "t_end_s", "status", "source", "threads",
+              "simulated_time_s", "wall_time_s", "particle_steps_per_s", "paper_elapsed_s",
+              "ref_run", "saving_percent", "paper_saving_percent",
+              "compare_time_s", "interface_err_percent", "interface_err_bins", "paper_err_percent",
+              "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
+              "water_at_left_wall_t_s", "outdir"]
+
+    def v(x):
+        if isinstance(x, float):
+            return f"{x:.6g}" if math.isfinite(x) else "nan"
+        return str(x)
+
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(fields)
+        for r in results:
+            p, c = r.paper, r.cells
+            w.writerow([v(x) for x in (
+                p.run, p.mu_thr, p.mu0, dx, t_end, r.status, r.source, r.threads,
+                r.sim_time, r.wall, r.psteps, float(p.elapsed_s),
+                p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
+                at, c["err_v"], c["err_bins"], p.err_percent,
+                r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir)])
+
+
+# ---- figure ---------------------------------------------------------------------------------------
+
+
+def plot(path, results, at, dx):
+    runs = [r.paper.run for r in results]
+    sets = []
+    if any(k in runs for k in (1, 3, 4)) and any(k in runs for k in (5, 6, 7)):
+        sets = [("Runs 1-4 (paper Fig. 3: threshold viscosity)", [r for r in results if r.paper.run in TABLE1]),
+                ("Runs 2, 5-7 (paper Fig. 4: limiting viscosity)", [r for r in results if r.paper.run in TABLE2])]
+    else:
+        sets = [("Runs " + ", ".join(str(k) for k in runs), results)]
+    fig, axes = plt.subplots(1, len(sets), figsize=(7.5 * len(sets), 5.2), squeeze=False, constrained_layout=True)
+    any_profile = False
+    for ax, (title, rs) in zip(axes[0], sets):
+        ax.axhline(0.067, color="0.7", lw=0.8, ls=":", label="initial bed (0.067 m)")
+        for r in rs:
+            color = f"C{r.paper.run - 1}"
+            name = f"Run {r.paper.run}"
+            drew = False
+            for prof, style in ((r.interface, "-"), (r.free_surface, "--")):
+                if prof is None:
+                    continue
+                m = (prof.x >= 0) & (prof.x <= PLOT_X_MAX)
+                ax.plot(prof.x[m], prof.z[m], style, color=color, lw=1.6 if style == "-" else 1.2)
+                drew = True
+            any_profile |= drew
+            # one legend entry per run (colour); the line styles are explained once below
+            ax.plot([], [], "-", color=color, label=name if drew else f"{name} (no profile at t = {at:g} s)")
+        ax.plot([], [], "-", color="k", label="interface (bls), solid")
+        ax.plot([], [], "--", color="k", label="free surface (fs), dashed")
+        ax.set_xlim(0, PLOT_X_MAX)
+        ax.set_ylim(0, 0.6)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("z [m]")
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        ax.legend(loc="upper right", fontsize=8)
+    if not any_profile:
+        ended = [r.sim_time for r in results if math.isfinite(r.sim_time)]
+        why = f" (runs ended at t = {max(ended):.3g} s)" if ended else ""
+        for ax in axes[0]:
+            ax.text(0.5, 0.5, f"no profiles at t = {at:g} s{why}", transform=ax.transAxes, ha="center",
+                    va="center", color="0.4")
+    fig.suptitle(f"Erosive dam break at t = {at:g} s, dx = {dx:g} m\n"
+                 f"mixture-water interface (solid), free surface (dashed)")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+# ---- main -----------------------------------------------------------------------------------------
+
+
+def parse_runs(text):
+    if text.strip().lower() == "all":
+        return sorted(PAPER)
+    runs = []
+    for part in text.split(","):
+        part = part.strip()
+        if not part:
+            continue
+        if not part.isdigit() or int(part) not in PAPER:
+            fail(f"--runs: '{part}' is not a run number 1-7 (e.g. --runs 2,5,6,7 or --runs all)")
+        if int(part) not in runs:
+            runs.append(int(part))
+    if not runs:
+        fail("--runs: no run given")
+    return sorted(runs)
+
+
+def main():
+    ap = argparse.ArgumentParser(
+        prog=PROG,
+        description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.")
+    ap.add_argument("--runs", default="2,5,6,7", help="paper runs to do, 1-7, comma-separated or 'all' (default 2,5,6,7)")
+    ap.add_argument("--dx", type=float, default=0.01, help="particle spacing [m] (default 0.01; the paper's is 0.005)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "erosive"), help="output folder (default out/erosive)")
+    ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default max(1, cores // jobs))")
+    ap.add_argument("--jobs", type=int, default=1, help="runs at once (default 1)")
+    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings)")
+    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable (default build/mixsph)")
+    ap.add_argument("--case", default=os.path.join(ROOT, "cases", "erosive_dambreak.json"),
+                    help="case file (default cases/erosive_dambreak.json)")
+    ap.add_argument("--t-end", type=float, help="end time [s] of every run (default: the case's, 0.5 s); for short tests")
+    ap.add_argument("--at", type=float, default=0.5,
+                    help="time [s] of the profiles compared and plotted, one of the case's profile times (default 0.5)")
+    ap.add_argument("--progress", type=float, default=300.0,
+                    help="print the simulated time of the running runs every this many seconds (default 300, 0: never)")
+    args = ap.parse_args()
+
+    runs = parse_runs(args.runs)
+    if not (args.dx > 0 and math.isfinite(args.dx)):
+        fail("--dx must be a positive number of metres")
+    if args.jobs < 1:
+        fail("--jobs must be at least 1")
+    if args.threads is not None and args.threads < 1:
+        fail("--threads must be at least 1")
+    if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
+        fail("--t-end must be a positive number of seconds")
+    mixsph = os.path.abspath(args.mixsph)
+    if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
+        fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
+    case = os.path.abspath(args.case)
+    try:
+        with open(case) as f:
+            case_json = json.load(f)
+    except (OSError, ValueError) as e:
+        fail(f"{show(case)}: cannot read the case: {e}")
+    t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
+    if not math.isfinite(t_end):
+        fail(f"{show(case)}: no numerics.t_end (give --t-end)")
+    prof_times = [float(t) for t in case_json.get("monitors", {}).get("interface", {}).get("times", [])]
+    if not any(abs(t - args.at) < 1e-9 for t in prof_times):
+        fail(f"--at {args.at:g}: the case's interface profile is written at t = "
+             f"{', '.join(f'{t:g}' for t in prof_times) or '(never)'} s only")
+    if args.at > t_end + 1e-12:
+        warn(f"the runs end at t = {t_end:g} s, before the profiles at t = {args.at:g} s: "
+             "the interface errors and the plot will say n/a")
+
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:
+        cores = os.cpu_count() or 1
+    jobs_n = min(args.jobs, len(runs))
+    threads = args.threads if args.threads is not None else max(1, cores // jobs_n)
+    out = os.path.abspath(args.out)
+    os.makedirs(out, exist_ok=True)
+
+    jobs = []
+    for k in runs:
+        p = PAPER[k]
+        d = os.path.join(out, f"run{k}_dx{args.dx:g}")
+        cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(args.dx)}",
+               "--set", f"media.sediment.mu_thr={num(p.mu_thr)}", "--set", f"media.sediment.mu0={num(p.mu0)}"]
+        if args.t_end is not None:
+            cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
+        cmd += ["--threads", str(threads), "--quiet"]
+        stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
+                 "threads": threads, "command": cmd}
+        jobs.append(Job(p, d, cmd, stamp, threads))
+
+    to_run = []
+    for job in jobs:
+        if args.reuse:
+            ok, why = reusable(job, t_end)
+            if ok:
+                job.source = "reused"
+                print(f"run {job.paper.run}: reused {show(job.outdir)}/ ({why})")
+                continue
+            if os.path.isdir(job.outdir):
+                print(f"run {job.paper.run}: not reused ({why}): running it again")
+        to_run.append(job)
+    if to_run:
+        print(f"{len(to_run)} run(s) of {show(case)} at dx = {args.dx:g} m to t = {t_end:g} s, "
+              f"{min(jobs_n, len(to_run))} at a time, {threads} thread(s) each, {cores} core(s)", flush=True)
+    failed = run_jobs(to_run, jobs_n, t_end, args.progress)
+
+    try:
+        results = [load_result(job, args.at) for job in jobs]
+    except mt.ToolError as e:
+        fail(str(e))
+    compare(results, args.at)
+    used_threads = sorted({r.threads for r in results if r.ok})
+    threads_note = f"threads {','.join(str(t) for t in used_threads) or threads}"
+    if len(to_run) > 1 and jobs_n > 1:
+        threads_note += f", up to {jobs_n} runs at once (wall times share the machine)"
+    print()
+    table(results, args.at, args.dx, t_end, threads_note)
+    if len(used_threads) > 1:
+        warn("the runs used different thread counts: the savings compare unlike wall times")
+
+    csv_path = os.path.join(out, "erosive_table.csv")
+    png_path = os.path.join(out, "erosive_profiles.png")
+    write_csv(csv_path, results, args.dx, t_end, args.at)
+    plot(png_path, results, args.at, args.dx)
+    print()
+    print(f"table: {show(csv_path)}")
+    print(f"plot:  {show(png_path)}")
+    if failed:
+        fail("mixsph failed for run(s) " + "; ".join(
+            f"{j.paper.run}: {j.message} (log {show(os.path.join(j.outdir, 'mixsph.log'))})" for j in failed), code=1)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,145 @@
+"""Readers of the files a ``mixsph run`` writes into its output folder, for the tools/ scripts.
+
+    import mixsph_tools as mt
+    mon = mt.read_monitors("out/x/monitors.csv")        # {"t": array, "water_front": array, ...}
+    summ = mt.read_summary("out/x/summary.json")        # dict; JSON null -> nan in "outputs"
+    prof = mt.find_profile("out/x", "interface", 0.5)   # Profile or None (not written)
+
+Every reader raises ``ToolError`` with a message naming the file and what is wrong; the scripts
+catch it and print it (no traceback for a user's mistake).
+
+File formats (cli/main.c, lib/src/monitors.c):
+
+- ``monitors.csv``: header ``t,step,<output>...``, one row per monitor interval, ``nan`` where a
+  monitor has no value (e.g. no particle in its window);
+- ``summary.json``: ``status`` ("ok" or the failure), ``wall_time_s``, ``particle_steps_per_s``,
+  ``simulated_time_s``, ``threads``, ``outputs{name: {final, max, t_max, min, t_min}}`` (null when
+  the output never had a value);
+- ``profile_<name>_<k>.csv``: first line ``# profile <name> of <medium> at t = <t> s (requested
+  <t_req> s): ...``, then ``x,z_top`` per x bin (``nan`` where the bin holds no particle).
+"""
+
+import glob
+import json
+import math
+import os
+import re
+from dataclasses import dataclass
+
+import numpy as np
+
+
+class ToolError(Exception):
+    """A readable problem with an input file (message names the file)."""
+
+
+def read_monitors(path):
+    """Columns of monitors.csv as a dict of float arrays (at least 't')."""
+    if not os.path.isfile(path):
+        raise ToolError(f"{path} not found")
+    with open(path) as f:
+        lines = f.read().splitlines()
+    if not lines:
+        raise ToolError(f"{path}: empty")
+    header = lines[0].strip().split(",")
+    body = [(n, ln.strip()) for n, ln in enumerate(lines[1:], start=2) if ln.strip()]
+    rows = []
+    for k, (lineno, line) in enumerate(body):
+        parts = line.split(",")
+        if len(parts) != len(header):
+            if k == len(body) - 1:
+                break  # a run still writing (or killed) may leave a partial last line
+            raise ToolError(f"{path}:{lineno}: {len(parts)} fields but {len(header)} names in the header")
+        try:
+            rows.append([float(v) for v in parts])
+        except ValueError as e:
+            if k == len(body) - 1:
+                break
+            raise ToolError(f"{path}:{lineno}: not a number: {e}") from None
+    if "t" not in header:
+        raise ToolError(f"{path}: no column 't' (header: {','.join(header)})")
+    data = np.array(rows, dtype=float).reshape(len(rows), len(header))
+    return {name: data[:, k] for k, name in enumerate(header)}
+
+
+def read_summary(path):
+    """summary.json as a dict; the numbers of 'outputs' that are null become nan."""
+    if not os.path.isfile(path):
+        raise ToolError(f"{path} not found")
+    try:
+        with open(path) as f:
+            s = json.load(f)
+    except (OSError, ValueError) as e:
+        raise ToolError(f"{path}: cannot read: {e}") from None
+    if not isinstance(s, dict) or "status" not in s:
+        raise ToolError(f"{path}: not a mixsph summary (no 'status')")
+    outs = s.get("outputs") or {}
+    for name, rec in outs.items():
+        if isinstance(rec, dict):
+            for k, v in rec.items():
+                if v is None:
+                    rec[k] = math.nan
+    s["outputs"] = outs
+    return s
+
+
+def summary_value(summary, output, field):
+    """summary['outputs'][output][field] as float, nan when absent."""
+    rec = summary.get("outputs", {}).get(output)
+    if not isinstance(rec, dict):
+        return math.nan
+    v = rec.get(field)
+    return float(v) if isinstance(v, (int, float)) else math.nan
+
+
+@dataclass
+class Profile:
+    path: str
+    name: str
+    t: float            # time the profile was taken [s]
+    t_requested: float  # time the case asked for [s]
+    x: np.ndarray       # bin centres [m]
+    z: np.ndarray       # top of the medium per bin [m], nan where empty
+
+
+_PROFILE_HEAD = re.compile(r"#\s*profile\s+(\S+).*?\bat t\s*=\s*([-+0-9.eE]+)\s*s\s*\(requested\s+([-+0-9.eE]+)\s*s\)")
+
+
+def read_profile(path):
+    """One profile_<name>_<k>.csv."""
+    if not os.path.isfile(path):
+        raise ToolError(f"{path} not found")
+    with open(path) as f:
+        first = f.readline()
+        header = f.readline().strip()
+    m = _PROFILE_HEAD.match(first)
+    if not m:
+        raise ToolError(f"{path}: first line '{first.strip()}' is not '# profile NAME of MEDIUM at t = T s (requested T s) ...'")
+    if header != "x,z_top":
+        raise ToolError(f"{path}: second line '{header}' is not 'x,z_top'")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=2, ndmin=2)
+    except ValueError as e:
+        raise ToolError(f"{path}: cannot read: {e}") from None
+    if data.size == 0:
+        data = np.zeros((0, 2))
+    if data.shape[1] != 2:
+        raise ToolError(f"{path}: {data.shape[1]} columns, expected 2 (x,z_top)")
+    return Profile(path, m.group(1), float(m.group(2)), float(m.group(3)), data[:, 0], data[:, 1])
+
+
+def find_profile(outdir, name, t_requested, tol=1e-9):
+    """The profile <name> that the case requested at t_requested, or None if it was not written."""
+    for path in sorted(glob.glob(os.path.join(outdir, f"profile_{glob.escape(name)}_*.csv"))):
+        if not re.fullmatch(rf"profile_{re.escape(name)}_\d+\.csv", os.path.basename(path)):
+            continue
+        p = read_profile(path)
+        if abs(p.t_requested - t_requested) <= tol * max(1.0, abs(t_requested)):
+            return p
+    return None
+
+
+def first_time_below(t, v, threshold):
+    """First t at which v < threshold (nan values never count), nan if never."""
+    idx = np.flatnonzero(np.isfinite(v) & (v < threshold))
+    return float(t[idx[0]]) if idx.size else math.nan
