@@ -45,8 +45,8 @@ Writes OUT/erosive_table.csv (the same, one row per run) and OUT/erosive_profile
 interface (solid) and the free surface (dashed) at t = 0.5 s of every run for 0 <= x <= 0.5 m,
 like the paper's Figs 3 (Runs 1-4) and 4 (Runs 2, 5-7).
 
-Exit status: 0 ok; 1 a mixsph run failed (the table of the others is still printed); 2 bad
-usage or input; 130 interrupted.
+Exit status: 0 ok; 1 a mixsph run failed (the others still run, unless mixsph reported bad
+usage or input, and the table is still printed); 2 bad usage or input; 130 interrupted.
 
 Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
@@ -57,6 +57,7 @@ import csv
 import json
 import math
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -254,15 +255,17 @@ def tail(path, n=8):
 
 
 def run_jobs(jobs, n_parallel, t_end, progress_every):
-    """Run the jobs, at most n_parallel at once. Returns the failed ones."""
+    """Run the jobs, at most n_parallel at once; a failed run does not stop the others, except
+    for bad usage or input (exit 2), which would repeat. Returns the failed jobs."""
     pending = list(jobs)
     running = []
     failed = []
+    stop = False
     t_start = time.monotonic()
     last_progress = t_start
     try:
         while pending or running:
-            while pending and len(running) < n_parallel and not failed:
+            while pending and len(running) < n_parallel and not stop:
                 job = pending.pop(0)
                 os.makedirs(job.outdir, exist_ok=True)
                 clean_outdir(job.outdir)
@@ -282,7 +285,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                 running.append(job)
                 print(f"run {job.paper.run}: started ({job.threads} thread{'s' if job.threads > 1 else ''}) "
                       f"-> {show(job.outdir)}/  (log: mixsph.log)", flush=True)
-            if pending and failed and not running:
+            if pending and stop and not running:
                 break
             time.sleep(0.5)
             for job in list(running):
@@ -305,7 +308,9 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                           f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
                     for line in tail(os.path.join(job.outdir, "mixsph.log")):
                         print(f"    | {line}", flush=True)
-                    if pending:
+                    if rc == 2 and pending:
+                        # bad usage or input: the other runs would fail the same way
+                        stop = True
                         print(f"{PROG}: not starting the remaining runs "
                               f"({', '.join(str(j.paper.run) for j in pending)})", flush=True)
             now = time.monotonic()
@@ -388,8 +393,8 @@ def compare(results, at):
         c = r.cells
         if p.ref == 0:
             c["ref"] = "-"
-            c["saving"] = c["paper_saving"] = c["err"] = "(reference)"
-            c["paper_err"] = "(ref)"
+            c["saving"] = c["err"] = "(reference)"
+            c["paper_saving"] = c["paper_err"] = "(ref)"
             c.update(saving_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0)
             continue
         c["ref"] = str(p.ref)
@@ -560,8 +565,10 @@ def plot(path, results, at, dx):
             for prof, style in ((r.interface, "-"), (r.free_surface, "--")):
                 if prof is None:
                     continue
-                m = (prof.x >= 0) & (prof.x <= PLOT_X_MAX)
-                ax.plot(prof.x[m], prof.z[m], style, color=color, lw=1.6 if style == "-" else 1.2)
+                # empty bins (nan) are skipped, not drawn as gaps: at dx > bin every other bin is empty
+                m = (prof.x >= 0) & (prof.x <= PLOT_X_MAX) & np.isfinite(prof.z)
+                ax.plot(prof.x[m], prof.z[m], style, color=color, lw=1.6 if style == "-" else 1.2,
+                        marker="." if style == "-" else None, ms=3)
                 drew = True
             any_profile |= drew
             # one legend entry per run (colour); the line styles are explained once below
@@ -588,6 +595,11 @@ def plot(path, results, at, dx):
 
 
 # ---- main -----------------------------------------------------------------------------------------
+
+
+def on_sigterm(signum, frame):
+    """SIGTERM like Ctrl-C: run_jobs then stops its own mixsph runs instead of leaving them running."""
+    raise KeyboardInterrupt
 
 
 def parse_runs(text):
@@ -692,6 +704,7 @@ def main():
     if to_run:
         print(f"{len(to_run)} run(s) of {show(case)} at dx = {args.dx:g} m to t = {t_end:g} s, "
               f"{min(jobs_n, len(to_run))} at a time, {threads} thread(s) each, {cores} core(s)", flush=True)
+    signal.signal(signal.SIGTERM, on_sigterm)
     failed = run_jobs(to_run, jobs_n, t_end, args.progress)
 
     try:

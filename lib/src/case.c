@@ -281,6 +281,10 @@ static mixsph_status get_bool(struct reader *r, const cJSON *obj, const char *pa
 {
     const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
     if (!it) return MIXSPH_OK;
+    if (cJSON_IsNumber(it) && (it->valuedouble == 0.0 || it->valuedouble == 1.0)) { /* from a parameter */
+        *out = it->valuedouble != 0.0;
+        return MIXSPH_OK;
+    }
     if (!cJSON_IsBool(it)) return FAIL(r, "%s: %s%s%s: expected true or false", r->origin, path, *path ? "." : "", key);
     *out = cJSON_IsTrue(it);
     return MIXSPH_OK;
@@ -558,10 +562,48 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
     return MIXSPH_OK;
 }
 
+/* ---- parameters ----------------------------------------------------------------------------
+ * "parameters": {"reservoir_level": 0.46, ...} names numbers that other values use as the string
+ * "$reservoir_level" (e.g. the water's z_max and the saturated part of a landslide), so one
+ * override (--set parameters.reservoir_level=0.40) moves all of them. Substituted after the
+ * overrides, before validation. */
+static mixsph_status substitute(struct reader *r, const cJSON *params, cJSON *node, char *path, size_t len)
+{
+    for (cJSON *it = node->child; it; it = it->next) {
+        const size_t l0 = strlen(path);
+        if (it->string) snprintf(path + l0, len - l0, "%s%s", l0 ? "." : "", it->string);
+        if (cJSON_IsString(it) && it->valuestring[0] == '$') {
+            const cJSON *p = params ? cJSON_GetObjectItemCaseSensitive(params, it->valuestring + 1) : NULL;
+            if (!cJSON_IsNumber(p))
+                return FAIL(r, "%s: %s: '%s' is not one of the numeric parameters", r->origin, path, it->valuestring);
+            cJSON *num = cJSON_CreateNumber(p->valuedouble);
+            const int ok = num && (it->string ? cJSON_ReplaceItemInObjectCaseSensitive(node, it->string, num)
+                                              : cJSON_ReplaceItemViaPointer(node, it, num));
+            if (!ok) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+            it = num;
+        } else if (cJSON_IsObject(it) || cJSON_IsArray(it)) {
+            TRY(substitute(r, params, it, path, len));
+        }
+        path[l0] = '\0';
+    }
+    return MIXSPH_OK;
+}
+
+static mixsph_status apply_parameters(struct reader *r, cJSON *root)
+{
+    const cJSON *params = cJSON_GetObjectItemCaseSensitive(root, "parameters");
+    if (params && !cJSON_IsObject(params)) return FAIL(r, "%s: parameters: expected an object of numbers", r->origin);
+    for (const cJSON *p = params ? params->child : NULL; p; p = p->next)
+        if (!cJSON_IsNumber(p) || !isfinite(p->valuedouble))
+            return FAIL(r, "%s: parameters.%s: expected a number", r->origin, p->string);
+    char path[512] = "";
+    return substitute(r, params, root, path, sizeof path);
+}
+
 static mixsph_status read_root(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"name", "description", "gravity", "numerics", "domain", "media", "bodies",
-                                       "walls", "motions", "monitors", "output", NULL};
+    static const char *const keys[] = {"name", "description", "parameters", "gravity", "numerics", "domain", "media",
+                                       "bodies", "walls", "motions", "monitors", "output", NULL};
     static const char *const dkeys[] = {"x_min", "x_max", "z_min", "z_max", NULL};
     static const char *const okeys[] = {"monitor_interval", "snapshot_interval", NULL};
     if (!cJSON_IsObject(root)) return FAIL(r, "%s: the case must be a JSON object", r->origin);
@@ -615,6 +657,7 @@ mixsph_status case_parse(const char *json_text, const char *origin, const mixsph
     }
     mixsph_status st = MIXSPH_OK;
     for (size_t k = 0; k < n_ov && st == MIXSPH_OK; k++) st = apply_override(&r, root, &ov[k]);
+    if (st == MIXSPH_OK) st = apply_parameters(&r, root);
     if (st == MIXSPH_OK) st = read_root(&r, root, c);
     cJSON_Delete(root);
     if (st != MIXSPH_OK) case_free(c);

@@ -1,0 +1,423 @@
+/* test_mixture.c - the granular phase of the mixture model (Manenti et al. 2018, Section 2.1;
+ * MODEL.md sections 5-6): case reading of granular media (case.c), the regime of every grain
+ * and the fixed/mobile transitions both ways, the pressure of the fixed grains, the pore
+ * pressure of a saturated bed (mixture.c), and the time step bound of fixed grains (integrate.c).
+ *
+ * The regime tests drive the internals directly (sim.h): they impose a linear velocity field
+ * u = (G z, 0) on every particle (grains and walls), run the continuity pass (which gives the
+ * velocity gradient and its correction matrix) and mixture_update. The first-order-corrected
+ * gradient reproduces a linear field exactly, so every grain has sqrt(II_D) = G/2 and
+ *     mu_app = eps_f mu_f + sigma' sin(phi) / G
+ * with sigma' = p - p_w from the particle's own pressure: the expected regime and viscosity of
+ * each grain follow by hand (rheology.h is tested on its own in test_rheology.c). */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "kernel.h"
+#include "sim.h"
+
+#define G_ACC 9.81   /* [m/s2] */
+#define DX 0.01      /* [m] */
+#define RHO_S 2650.0 /* grain density [kg/m3] */
+#define K_S 4.24e6   /* grain bulk modulus [Pa]: c = sqrt(K_s / rho_s) = 40 m/s */
+#define POR 0.35     /* porosity n */
+#define PHI 35.0     /* [deg] */
+#define MU_THR 320e3 /* [Pa s] Vajont values */
+#define MU0 5e3      /* [Pa s] */
+#define REL 1e-9     /* relative tolerance where the code and the test sum the same terms in another order */
+
+/* A 0.4 x 0.1 m bed of medium "sand" in a box (walls on three sides), dx = 0.01: 400 grains. */
+static const char *const CASE_FMT =
+    "{\n"
+    "  \"name\": \"granular_bed\",\n"
+    "  \"gravity\": 9.81,\n"
+    "  \"numerics\": { \"dx\": 0.01, \"t_end\": 1.0 },\n"
+    "  \"media\": { %s },\n"
+    "  \"bodies\": { \"bed\": { \"medium\": \"sand\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.4, 0.1], [0.0, 0.1]] } },\n"
+    "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.3], [0.0, 0.0], [0.4, 0.0], [0.4, 0.3]], \"fluid_side\": \"left\" } },\n"
+    "  \"domain\": { \"x_min\": -0.05, \"x_max\": 0.45, \"z_min\": -0.05, \"z_max\": 0.3 }\n"
+    "}\n";
+
+#define WATER "\"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 40.0, \"mu\": 1.0e-3 }"
+#define DRY_SAND                                                                                                      \
+    "\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "         \
+    "\"d50\": 0.001, \"mu_thr\": 320e3, \"mu0\": 5e3 }"
+#define WET_SAND                                                                                                      \
+    "\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "         \
+    "\"saturated\": true, \"pore_fluid\": \"water\", \"mu_thr\": 320e3, \"mu0\": 5e3 }"
+
+static mixsph_status create(const char *media, mixsph_sim **s, char *err, size_t err_len)
+{
+    char text[4096];
+    snprintf(text, sizeof text, CASE_FMT, media);
+    const mixsph_status st = mixsph_sim_create_from_text(text, "granular_bed.json", NULL, 0, s, err, err_len);
+    if (st == MIXSPH_OK) mixsph_sim_set_threads(*s, 2);
+    return st;
+}
+
+static mixsph_sim *create_ok(const char *media)
+{
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = create(media, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    return s;
+}
+
+/* The case must be refused with a message naming `key`. */
+static void expect_error(const char *media, const char *key)
+{
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    assert_int_equal(create(media, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    assert_null(s);
+    print_message("  refused: %s\n", err);
+    assert_non_null(strstr(err, key));
+}
+
+static int is_grain(const mixsph_sim *s, size_t i)
+{
+    return s->P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->P.medium[i]].kind == MEDIUM_GRANULAR;
+}
+
+static void assert_rel(double got, double want, double rel)
+{
+    if (!(fabs(got - want) <= rel * fabs(want))) {
+        print_error("got %.17g, expected %.17g\n", got, want);
+        fail();
+    }
+}
+
+/* ---- (a) case reading ---------------------------------------------------------------------- */
+
+static void test_parse_dry(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create_ok(DRY_SAND);
+    const struct medium *m = &s->cfg.media[0];
+    assert_int_equal(m->kind, MEDIUM_GRANULAR);
+    assert_rel(m->rho0, (1.0 - POR) * RHO_S, 1e-15);   /* (5), dry: (1 - n) rho_s = 1722.5 */
+    assert_rel(m->c, sqrt(K_S / RHO_S), 1e-15);         /* sqrt(K_s / rho_s) = 40 m/s, not of the mixture */
+    assert_rel(m->sin_phi, sin(PHI * KERNEL_PI / 180.0), 1e-15);
+    assert_true(m->eps_f_mu_f == 0.0);                  /* no pore fluid */
+    assert_int_equal(m->saturated, 0);
+    assert_true(m->mu_thr == MU_THR && m->mu0 == MU0);
+    assert_int_equal(m->mu1_mode, 0);
+    /* particles: 40 x 10 grains at the mixture density (hydrostatic p / c^2 <= 1.7 kg/m3 above it) */
+    assert_int_equal(mixsph_sim_particles(s), 400);
+    for (size_t i = 0; i < s->P.n; i++) {
+        if (!is_grain(s, i)) continue;
+        assert_true(s->P.rho[i] >= m->rho0 && s->P.rho[i] <= m->rho0 + 1.7);
+        assert_rel(s->P.m[i], s->P.rho[i] * DX * DX, 1e-15);
+    }
+    mixsph_sim_destroy(s);
+    /* no mu0: no limit (+inf) */
+    s = create_ok("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"c\": 40.0, \"porosity\": 0.35, \"phi\": 35.0, "
+                  "\"mu_thr\": 20e3 }");
+    assert_true(isinf(s->cfg.media[0].mu0) && s->cfg.media[0].mu_thr == 20e3);
+    assert_rel(s->cfg.media[0].c, 40.0, 1e-15);
+    mixsph_sim_destroy(s);
+}
+
+static void test_parse_saturated(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create_ok(WATER ", " WET_SAND);
+    const struct medium *m = &s->cfg.media[1];
+    assert_int_equal(m->kind, MEDIUM_GRANULAR);
+    assert_int_equal(m->saturated, 1);
+    assert_int_equal(m->pore_fluid, 0);
+    assert_rel(m->rho0, POR * 1000.0 + (1.0 - POR) * RHO_S, 1e-15); /* (5), saturated: 2072.5 kg/m3 */
+    assert_true(m->rho_f == 1000.0);
+    assert_rel(m->eps_f_mu_f, POR * 1.0e-3, 1e-15);                 /* eps_f mu_f of (12) */
+    assert_rel(m->c, 40.0, 1e-15);                                  /* sqrt(K_s / rho_s) */
+    mixsph_sim_destroy(s);
+}
+
+static void test_parse_mu1(void **state)
+{
+    (void)state;
+    /* Run 7's rheology: mu1 alone = a threshold without limit */
+    mixsph_sim *s = create_ok("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, "
+                              "\"phi\": 35.0, \"mu1\": 5e3 }");
+    const struct medium *m = &s->cfg.media[0];
+    assert_int_equal(m->mu1_mode, 1);
+    assert_true(m->mu_thr == 5e3 && isinf(m->mu0));
+    /* at rest every grain is held fixed with mu = mu1 */
+    assert_int_equal(s->n_fixed, 400);
+    for (size_t i = 0; i < s->P.n; i++)
+        if (is_grain(s, i)) assert_true(s->P.mu[i] == 5e3);
+    mixsph_sim_destroy(s);
+    /* with mu_thr or mu0 beside it: refused */
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu1\": 5e3, \"mu_thr\": 20e3 }",
+                 "mu1");
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu1\": 5e3, \"mu0\": 1e3 }",
+                 "mu1");
+}
+
+static void test_parse_errors(void **state)
+{
+    (void)state;
+    /* saturated without a pore fluid */
+    expect_error(WATER ", \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, "
+                 "\"phi\": 35.0, \"saturated\": true, \"mu_thr\": 320e3 }",
+                 "media.sand.pore_fluid");
+    /* pore fluid that is not a fluid (a granular medium), or not defined (before this one) */
+    expect_error("\"gravel\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu_thr\": 320e3 }, "
+                 "\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"saturated\": true, \"pore_fluid\": \"gravel\", \"mu_thr\": 320e3 }",
+                 "media.sand.pore_fluid");
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"saturated\": true, \"pore_fluid\": \"water\", \"mu_thr\": 320e3 }",
+                 "media.sand.pore_fluid");
+    /* no threshold viscosity at all; both K and c; a key of fluids only */
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0 }",
+                 "mu_thr");
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"c\": 40.0, \"porosity\": 0.35, "
+                 "\"phi\": 35.0, \"mu_thr\": 320e3 }",
+                 "media.sand");
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu_thr\": 320e3, \"mu\": 1.0 }",
+                 "mu");
+}
+
+/* ---- (b) regimes and transitions ----------------------------------------------------------- */
+
+/* u = (G z, 0) on every particle (walls' viscous velocity included), then the continuity pass
+ * and the mixture update, from the pressure of the grains' own density (integrate_eos). */
+static void impose_shear(mixsph_sim *s, double G)
+{
+    struct particles *P = &s->P;
+    for (size_t i = 0; i < P->n; i++) {
+        P->vx[i] = P->uvx[i] = G * P->z[i];
+        P->vz[i] = P->uvz[i] = 0.0;
+    }
+    integrate_eos(s);
+}
+
+static void update(mixsph_sim *s)
+{
+    assert_int_equal(forces_continuity(s), 0);
+    mixture_update(s);
+}
+
+struct counts {
+    long fixed, limited, frictional;
+};
+
+/* Check every grain against the regime of Fig. 1 for mu_app = eps_f mu_f + (p - p_w) sin(phi) / G
+ * (p_w given per grain, NULL for dry); p0 is the pressure of every particle before the update. */
+static struct counts check_regimes(const mixsph_sim *s, double G, const double *p0, const double *pw)
+{
+    const struct particles *P = &s->P;
+    struct counts c = {0, 0, 0};
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i)) continue;
+        const struct medium *m = &s->cfg.media[P->medium[i]];
+        double sig = p0[i] - (pw ? pw[i] : 0.0);
+        sig = sig > 0.0 ? sig : 0.0;
+        const double app = m->eps_f_mu_f + sig * m->sin_phi / G;
+        if (app >= m->mu_thr) {
+            assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
+            assert_true(P->mu[i] == m->mu_thr);
+            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->uvx[i] == 0.0 && P->uvz[i] == 0.0); /* held */
+            c.fixed++;
+            continue;
+        }
+        assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE);
+        assert_true(P->vx[i] == G * P->z[i]); /* a mobile grain keeps its velocity */
+        assert_true(P->p[i] == p0[i]);        /* and its pressure */
+        if (app > m->mu0) {
+            assert_true(P->mu[i] == m->mu0);
+            c.limited++;
+        } else {
+            /* tolerance: the corrected gradient reproduces u = G z up to round-off */
+            assert_rel(P->mu[i], app, REL);
+            c.frictional++;
+        }
+    }
+    return c;
+}
+
+static double *save_p(const mixsph_sim *s)
+{
+    double *p = malloc(s->P.n * sizeof *p);
+    assert_non_null(p);
+    memcpy(p, s->P.p, s->P.n * sizeof *p);
+    return p;
+}
+
+/* Pressure of the fixed grains: sum_j (p_j + rho_j g (z_j - z_i)) W_ij / sum_j W_ij over the
+ * mobile grains j within 2h (brute force over all particles), else the grain's own. */
+static long check_fixed_pressure(const mixsph_sim *s, const double *p0)
+{
+    const struct particles *P = &s->P;
+    long n_extra = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i) || P->state[i] != MIXSPH_STATE_FIXED) continue;
+        double sw = 0.0, sp = 0.0;
+        for (size_t j = 0; j < P->n; j++) {
+            if (!is_grain(s, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
+            const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
+            if (r2 >= s->K.r2max) continue;
+            const double w = kernel_w(&s->K, sqrt(r2));
+            sw += w;
+            sp += (p0[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
+        }
+        if (sw > 0.0) {
+            assert_rel(P->p[i], sp / sw, REL);
+            n_extra++;
+        } else {
+            assert_true(P->p[i] == p0[i]);
+        }
+        assert_true(isfinite(P->p[i]) && P->p[i] > 0.0);
+    }
+    return n_extra;
+}
+
+static void test_transitions(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create_ok(DRY_SAND);
+    struct particles *P = &s->P;
+    const long n = 400;
+    const size_t out_fixed = (size_t)mixsph_sim_output_find(s, "fixed_particles");
+
+    /* at rest after creation: strain rate 0 -> mu_app = mu_thr -> every grain FIXED */
+    assert_int_equal(s->n_fixed, n);
+    assert_true(mixsph_sim_output_value(s, out_fixed) == (double)n);
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i)) continue;
+        assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
+        assert_true(P->mu[i] == MU_THR);
+    }
+    /* (4): fixed grains bound dt with min(mu0, mu_thr) = mu0: 0.05 2 h^2 rho / mu0 (1.169e-5 s at
+     * h = 0.013 m, rho = 1722.5), far below the acoustic 0.1 2h / c = 6.5e-5 s */
+    double dt_ref = 0.1 * 2.0 * s->h / s->c_max;
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i)) dt_ref = fmin(dt_ref, 0.05 * 2.0 * s->h * s->h * P->rho[i] / MU0);
+    print_message("dt at rest: %.6g s (bound of the fixed grains with mu0: %.6g s)\n", s->dt, dt_ref);
+    assert_rel(s->dt, dt_ref, 1e-14);
+
+    /* strong shear G = 0.1 1/s: mu_app = p sin(phi) / G <= 1700 * 0.574 / 0.1 = 9.7e3 < mu_thr:
+     * every grain mobile, FRICTIONAL near the top (p < 872 Pa) and LIMITED (mu0) below */
+    impose_shear(s, 0.1);
+    double *p0 = save_p(s);
+    update(s);
+    struct counts c = check_regimes(s, 0.1, p0, NULL);
+    print_message("G = 0.1 1/s:   %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
+    assert_int_equal(c.fixed, 0);
+    assert_true(c.limited > 0 && c.frictional > 0);
+    assert_int_equal(s->n_fixed, 0);
+    free(p0);
+
+    /* back to rest: every grain FIXED again with mu = mu_thr */
+    impose_shear(s, 0.0);
+    p0 = save_p(s);
+    update(s);
+    c = check_regimes(s, 1e-300, p0, NULL); /* G -> 0: mu_app -> infinity, all fixed */
+    assert_int_equal(c.fixed, n);
+    assert_int_equal(s->n_fixed, n);
+    free(p0);
+
+    /* creeping shear G = 1e-6 1/s (sqrt(II_D) = 5e-7 >= 1e-12): mu_app >= 84 * 0.574 / 1e-6 =
+     * 4.8e7 >= mu_thr: FIXED, and the (nonzero) velocities are zeroed */
+    impose_shear(s, 1e-6);
+    p0 = save_p(s);
+    update(s);
+    c = check_regimes(s, 1e-6, p0, NULL);
+    assert_int_equal(c.fixed, n);
+    free(p0);
+
+    /* moderate shear G = 0.002 1/s: mu_app >= mu_thr where p >= 1116 Pa (about 0.066 m deep):
+     * the deep grains stay fixed, the shallow ones are mobilised (LIMITED); the pressure of the
+     * fixed grains next to mobile ones follows them */
+    impose_shear(s, 0.002);
+    p0 = save_p(s);
+    update(s);
+    c = check_regimes(s, 0.002, p0, NULL);
+    print_message("G = 0.002 1/s: %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
+    assert_true(c.fixed > 0 && c.limited > 0);
+    assert_int_equal(s->n_fixed, c.fixed);
+    const long n_extra = check_fixed_pressure(s, p0);
+    print_message("  %ld fixed grains took the pressure of mobile neighbours\n", n_extra);
+    assert_true(n_extra > 0);
+    /* the extrapolation is hydrostatic: within 5% of the grain's own pressure (the hydrostatic
+     * state it was created in; tolerance: kernel sums truncated at the free surface) */
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i) && P->state[i] == MIXSPH_STATE_FIXED) assert_true(fabs(P->p[i] - p0[i]) <= 0.05 * p0[i]);
+    free(p0);
+    mixsph_sim_destroy(s);
+}
+
+/* ---- (c) pore pressure --------------------------------------------------------------------- */
+
+/* A saturated flat bed at rest (cos^2 alpha = 1): p_w = rho_f g (z_top - z) with z_top the top
+ * particle of the column + dx/2 = 0.1 m, and sigma' = p - p_w (the buoyant weight of the grains).
+ * Imposing G = 0.1 1/s makes every grain mobile and FRICTIONAL (mu_app <= 0.1 m * 1072.5 * 9.81
+ * * 0.574 / 0.1 = 6.0e3, just above mu0 at the bottom), so mu reveals sigma' grain by grain. */
+static void test_pore_pressure(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create_ok(WATER ", " WET_SAND);
+    const struct particles *P = &s->P;
+    impose_shear(s, 0.1);
+    double *p0 = save_p(s);
+    double *pw = calloc(P->n, sizeof *pw);
+    assert_non_null(pw);
+    double ztop = -INFINITY;
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i)) ztop = fmax(ztop, P->z[i] + 0.5 * DX);
+    assert_rel(ztop, 0.1, 1e-12);
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i)) pw[i] = 1000.0 * G_ACC * (ztop - P->z[i]);
+    update(s);
+    const struct counts c = check_regimes(s, 0.1, p0, pw);
+    print_message("saturated bed, G = 0.1 1/s: %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
+    assert_int_equal(c.fixed, 0);
+    assert_true(c.frictional > 0);
+    /* one column: sigma' back from mu, against the buoyant weight (rho_mix - rho_f) g (z_top - z) */
+    print_message("   z [m]    p [Pa]   p_w [Pa]   sigma' from mu [Pa]   (rho_mix - rho_f) g (z_top - z) [Pa]\n");
+    const struct medium *m = &s->cfg.media[1];
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i) || fabs(P->x[i] - 0.205) > 1e-9 || P->mu[i] == m->mu0) continue;
+        const double sig = (P->mu[i] - m->eps_f_mu_f) * 0.1 / m->sin_phi;
+        print_message("  %.3f  %8.2f  %8.2f     %8.2f               %8.2f\n", P->z[i], p0[i], pw[i], sig,
+                      (m->rho0 - 1000.0) * G_ACC * (ztop - P->z[i]));
+    }
+    free(p0);
+    free(pw);
+    mixsph_sim_destroy(s);
+
+    /* the same bed dry: no pore pressure, sigma' = p (mu_app up to 9.7e3: some grains LIMITED) */
+    s = create_ok(DRY_SAND);
+    impose_shear(s, 0.1);
+    p0 = save_p(s);
+    update(s);
+    const struct counts d = check_regimes(s, 0.1, p0, NULL);
+    assert_true(d.limited > c.limited); /* the dry bed is stiffer: more grains at the limit */
+    free(p0);
+    mixsph_sim_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_parse_dry),      cmocka_unit_test(test_parse_saturated),
+        cmocka_unit_test(test_parse_mu1),      cmocka_unit_test(test_parse_errors),
+        cmocka_unit_test(test_transitions),    cmocka_unit_test(test_pore_pressure),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
