@@ -101,6 +101,7 @@ PAPER = {
     7: PaperRun(7, 5e3, 1e12, 7098, math.nan, 2, "mu1=5", "off"),
 }
 PAPER_DX = 0.005           # [m] the paper's resolution
+PAPER_T_END = 0.5          # [s] the paper's runs (and its comparison time)
 PAPER_BEDLOAD_RISE = 0.3   # [m] max rise of the bed-load layer at the left wall (converged runs)
 PAPER_PEAK_P_KPA = 10.0    # [kPa] peak pressure on the left wall
 PAPER_T_IMPACT = 0.29      # [s] plunging wave hits the left wall
@@ -488,7 +489,7 @@ def table(results, at, dx, t_end, threads_note):
     for r in results:
         p, c = r.paper, r.cells
         status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
-        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 0.5) > T_TOL:
+        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - PAPER_T_END) > T_TOL:
             status += f", t={r.sim_time:.3g} s"
         rows.append([
             str(p.run), p.label_thr, p.label_mu0, status,
@@ -623,16 +624,19 @@ def main():
     ap = argparse.ArgumentParser(
         prog=PROG,
         description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.")
-    ap.add_argument("--runs", default="2,5,6,7", help="paper runs to do, 1-7, comma-separated or 'all' (default 2,5,6,7)")
+    ap.add_argument("--runs", default="2,5,6,7",
+                    help="paper runs to do, 1-7, comma-separated or 'all' (default 2,5,6,7)")
     ap.add_argument("--dx", type=float, default=0.01, help="particle spacing [m] (default 0.01; the paper's is 0.005)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "erosive"), help="output folder (default out/erosive)")
     ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default max(1, cores // jobs))")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once (default 1)")
     ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings)")
-    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable (default build/mixsph)")
+    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"),
+                    help="mixsph executable (default build/mixsph)")
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", "erosive_dambreak.json"),
                     help="case file (default cases/erosive_dambreak.json)")
-    ap.add_argument("--t-end", type=float, help="end time [s] of every run (default: the case's, 0.5 s); for short tests")
+    ap.add_argument("--t-end", type=float,
+                    help="end time [s] of every run (default: the case's, 0.5 s); for short tests")
     ap.add_argument("--at", type=float, default=0.5,
                     help="time [s] of the profiles compared and plotted, one of the case's profile times (default 0.5)")
     ap.add_argument("--progress", type=float, default=300.0,

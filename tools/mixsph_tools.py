@@ -114,7 +114,8 @@ def read_profile(path):
         header = f.readline().strip()
     m = _PROFILE_HEAD.match(first)
     if not m:
-        raise ToolError(f"{path}: first line '{first.strip()}' is not '# profile NAME of MEDIUM at t = T s (requested T s) ...'")
+        raise ToolError(f"{path}: first line '{first.strip()}' is not "
+                        "'# profile NAME of MEDIUM at t = T s (requested T s) ...'")
     if header != "x,z_top":
         raise ToolError(f"{path}: second line '{header}' is not 'x,z_top'")
     try:
