@@ -31,7 +31,8 @@
  * threads: results are bit-identical for any thread count.
  *
  * Two passes per step: continuity (with the newest velocities) before the EOS, momentum after;
- * see integrate.c for why. */
+ * see integrate.c for why. With granular media the velocity gradient of each grain (for its
+ * strain rate) is gathered right after the continuity pass, over the grains only. */
 #include <math.h>
 #include <string.h>
 
