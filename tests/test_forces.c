@@ -121,7 +121,7 @@ static void test_setup_is_wall_free(void **state)
  * across the two media; the continuity terms obey drho_ij / (rho_i V_j) = drho_ji / (rho_j V_i). */
 static void test_pair_symmetry(void **state)
 {
-    const mixsph_sim *s = *state;
+    mixsph_sim *s = *state;
     const struct particles *P = &s->P;
     size_t pairs = 0, cross = 0;
     for (size_t i = 0; i < P->n; i++) {

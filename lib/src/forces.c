@@ -384,11 +384,11 @@ int forces_compute(mixsph_sim *s)
 
 /* Test hook: the acceleration (without gravity) and the density rate particle j gives i,
  * evaluated by the same pair code (on a scratch copy of the rate arrays). */
-void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho)
+void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho)
 {
     struct pair_ctx X;
     pair_ctx_init(s, &X);
-    struct particles *P = (struct particles *)&s->P;
+    struct particles *P = &s->P;
     const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
     double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
     momentum_range(&X, P, i, j, j + 1, &sx, &sz, X.wendland);

@@ -35,7 +35,6 @@ mixsph_status mixture_alloc(mixsph_sim *s)
         *f[k] = calloc(n, sizeof(double));
         if (!*f[k]) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (strain rates)");
     }
-    K->cap = n;
     K->nbins = (size_t)ceil((s->domain[1] - s->domain[0]) / s->dx) + 1;
     K->ztop = calloc(K->nbins, sizeof(double));
     if (!K->ztop) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (pore pressure bins)");

@@ -28,7 +28,6 @@ struct wall_state {
 
 /* Per-step scratch of the granular strain rate (not permuted: filled and used within a step). */
 struct kinematics {
-    size_t cap;
     double *gux, *guz, *gwx, *gwz; /* uncorrected velocity gradient du/dx, du/dz, dw/dx, dw/dz [1/s] */
     double *lxx, *lxz, *lzz;       /* correction matrix L (symmetric) [-] */
     double *ztop;                  /* per x-bin of width dx: top of the saturated granular column [m] */
@@ -82,7 +81,7 @@ void walls_pressure(mixsph_sim *s);
 /* forces.c */
 int forces_compute(mixsph_sim *s);
 int forces_continuity(mixsph_sim *s);
-void forces_pair_for_test(const mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
+void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
 
 /* mixture.c */
 mixsph_status mixture_alloc(mixsph_sim *s);
