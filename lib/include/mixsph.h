@@ -124,6 +124,43 @@ enum { MIXSPH_STATE_MOBILE = 0, MIXSPH_STATE_FIXED = 1, MIXSPH_STATE_WALL = 2, M
 
 mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v);
 
+/* ---- external wall motion (co-simulation input) ------------------------------------------- */
+
+/** Replace the prescribed motion law of the moving wall `wall` (its name in the case) by the
+ *  constant velocity (vx, vz) [m/s] from now on, until mixsph_sim_release_wall_velocity. Only
+ *  walls that have a motion in the case can be driven. Returns MIXSPH_ERR_ARG for an unknown or
+ *  fixed wall or a non-finite velocity. */
+mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, double vx, double vz);
+/** Give the wall back to its prescribed motion law (no-op if it was not driven). */
+mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall);
+
+/* ---- state: save, restore, restart --------------------------------------------------------- */
+
+/**
+ * Serialise the complete state of a simulation (the case text and overrides that created it,
+ * time, step, time step, every particle field, the walls' positions and external velocities, the
+ * outputs' extremes and the output schedule) into a buffer allocated by the library
+ * (*buf, *len; release it with mixsph_state_free). Continuing from a restored state gives the
+ * same trajectory as continuing the original (bit-identical with the same thread count; the
+ * pair loops are thread-count independent, so with any count). The format is versioned and
+ * checksummed; it is meant for the same build on the same machine type (native byte order).
+ */
+mixsph_status mixsph_sim_save_state(const mixsph_sim *s, void **buf, size_t *len);
+void mixsph_state_free(void *buf);
+
+/** Restore a state saved from a simulation of the same case and overrides (checked: otherwise
+ *  MIXSPH_ERR_ARG and the simulation is unchanged). Output files and thread count are kept. */
+mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len);
+
+/** Create a simulation from a saved state alone (restart): the case is rebuilt from the text
+ *  stored in the state, then the state is loaded. */
+mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err,
+                                           size_t err_len);
+
+/** The JSON text and origin (file name) the simulation was created from (for metadata). */
+const char *mixsph_sim_case_text(const mixsph_sim *s);
+const char *mixsph_sim_case_origin(const mixsph_sim *s);
+
 #ifdef __cplusplus
 }
 #endif

@@ -8,9 +8,6 @@
 
 #define PARTICLES_PAD 8
 
-#define PARTICLES_DOUBLE_FIELDS(X) \
-    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc)
-
 static int grow(void **ptr, size_t cap, size_t elem)
 {
     void *q = realloc(*ptr, cap * elem);

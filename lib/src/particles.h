@@ -27,6 +27,10 @@ struct particles {
     uint32_t *id;         /* stable id */
 };
 
+/* The double-valued fields, for code that treats them all alike (permute, copy, state). */
+#define PARTICLES_DOUBLE_FIELDS(X) \
+    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc)
+
 /** Allocate room for cap particles (n = 0). Returns 0 on success. */
 int particles_alloc(struct particles *P, size_t cap);
 void particles_free(struct particles *P);

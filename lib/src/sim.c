@@ -113,7 +113,15 @@ static mixsph_status fill_bodies(mixsph_sim *s)
 static void set_domain(mixsph_sim *s)
 {
     if (s->cfg.has_domain) {
+        /* the case's domain bounds the fluids; the wall layers behind the walls may reach past
+         * it at coarse dx (layers x dx), so it grows to hold every wall particle */
         memcpy(s->domain, s->cfg.domain, sizeof s->domain);
+        for (size_t i = s->n_fluid; i < s->P.n; i++) {
+            s->domain[0] = fmin(s->domain[0], s->P.x[i] - s->dx);
+            s->domain[1] = fmax(s->domain[1], s->P.x[i] + s->dx);
+            s->domain[2] = fmin(s->domain[2], s->P.z[i] - s->dx);
+            s->domain[3] = fmax(s->domain[3], s->P.z[i] + s->dx);
+        }
         return;
     }
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
@@ -197,6 +205,32 @@ static mixsph_status sim_init(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
+static char *dup_string(const char *t)
+{
+    const size_t n = strlen(t) + 1;
+    char *d = malloc(n);
+    if (d) memcpy(d, t, n);
+    return d;
+}
+
+/* Keep a copy of the case text and the overrides (state save/restore and metadata). */
+static mixsph_status sim_keep_source(mixsph_sim *s, const char *text, const char *origin, const mixsph_override *ov,
+                                     size_t n_ov)
+{
+    s->case_text = dup_string(text);
+    s->case_origin = dup_string(origin ? origin : "");
+    s->ov_key = calloc(n_ov + 1, sizeof *s->ov_key);
+    s->ov_value = calloc(n_ov + 1, sizeof *s->ov_value);
+    if (!s->case_text || !s->case_origin || !s->ov_key || !s->ov_value)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    for (size_t k = 0; k < n_ov; k++) {
+        if (!(s->ov_key[k] = dup_string(ov[k].key ? ov[k].key : ""))) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+        s->ov_value[k] = ov[k].value;
+        s->n_ov = k + 1;
+    }
+    return MIXSPH_OK;
+}
+
 mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov,
                                           size_t n_ov, mixsph_sim **out, char *err, size_t err_len)
 {
@@ -206,6 +240,7 @@ mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *ori
     mixsph_sim *s = calloc(1, sizeof *s);
     if (!s) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
     mixsph_status st = case_parse(json_text, origin, ov, n_ov, &s->cfg, s->err, sizeof s->err);
+    if (st == MIXSPH_OK) st = sim_keep_source(s, json_text, origin, ov, n_ov);
     if (st == MIXSPH_OK) st = sim_init(s);
     if (st != MIXSPH_OK) {
         status_set(err, err_len, st, "%s", s->err);
@@ -237,6 +272,11 @@ void mixsph_sim_destroy(mixsph_sim *s)
     particles_free(&s->P);
     cells_free(&s->C);
     case_free(&s->cfg);
+    for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
+    free(s->ov_key);
+    free(s->ov_value);
+    free(s->case_text);
+    free(s->case_origin);
     free(s);
 }
 
@@ -316,6 +356,47 @@ uint64_t mixsph_sim_steps(const mixsph_sim *s) { return s->step; }
 size_t mixsph_sim_particles(const mixsph_sim *s) { return s->n_fluid; }
 size_t mixsph_sim_wall_particles(const mixsph_sim *s) { return s->n_wall; }
 const char *mixsph_sim_name(const mixsph_sim *s) { return s->cfg.name; }
+const char *mixsph_sim_case_text(const mixsph_sim *s) { return s ? s->case_text : NULL; }
+const char *mixsph_sim_case_origin(const mixsph_sim *s) { return s ? s->case_origin : NULL; }
+
+/* The moving wall named `wall`, or -1 with a message. */
+static long sim_moving_wall(mixsph_sim *s, const char *wall)
+{
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        if (strcmp(s->cfg.walls[w].name, wall) != 0) continue;
+        if (s->cfg.walls[w].motion < 0) {
+            SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s is fixed (it has no motion in the case), it cannot be driven", wall);
+            return -1;
+        }
+        return (long)w;
+    }
+    SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s: no such wall in case %s", wall, s->cfg.origin);
+    return -1;
+}
+
+mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, double vx, double vz)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    if (!wall) return SIM_FAIL(s, MIXSPH_ERR_ARG, "set_wall_velocity: no wall name");
+    if (!isfinite(vx) || !isfinite(vz))
+        return SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s: external velocity (%g, %g) m/s is not finite", wall, vx, vz);
+    const long w = sim_moving_wall(s, wall);
+    if (w < 0) return MIXSPH_ERR_ARG;
+    s->walls[w].ext = 1;
+    s->walls[w].ext_vx = vx;
+    s->walls[w].ext_vz = vz;
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    if (!wall) return SIM_FAIL(s, MIXSPH_ERR_ARG, "release_wall_velocity: no wall name");
+    const long w = sim_moving_wall(s, wall);
+    if (w < 0) return MIXSPH_ERR_ARG;
+    s->walls[w].ext = 0;
+    return MIXSPH_OK;
+}
 size_t mixsph_sim_output_count(const mixsph_sim *s) { return s->n_out; }
 
 const char *mixsph_sim_output_name(const mixsph_sim *s, size_t k) { return k < s->n_out ? s->out_name[k] : NULL; }

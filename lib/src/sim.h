@@ -24,6 +24,8 @@ struct wall_state {
     double ox, oz;   /* displacement of the wall since t = 0 [m] */
     double vx, vz;   /* current velocity [m/s] */
     double ax, az;   /* current acceleration [m/s2] */
+    int ext;         /* driven by an external velocity (ext_vx, ext_vz) instead of its motion law */
+    double ext_vx, ext_vz; /* [m/s] */
 };
 
 /* Per-step scratch of the granular strain rate (not permuted: filled and used within a step). */
@@ -36,6 +38,11 @@ struct kinematics {
 
 struct mixsph_sim {
     struct case_def cfg;
+    /* what the simulation was created from (kept for state save/restore and metadata) */
+    char *case_text, *case_origin;
+    size_t n_ov;
+    char **ov_key;
+    double *ov_value;
     struct kernel K;
     double dx, h;
     double c_max;                 /* highest sound speed [m/s] */
@@ -69,6 +76,9 @@ struct mixsph_sim {
 
     char err[1024];
 };
+
+/* state.c */
+int state_same_case(const mixsph_sim *s, const char *text, const char *const *keys, const double *values, size_t n_ov);
 
 /* walls.c */
 mixsph_status walls_generate(mixsph_sim *s);

@@ -81,13 +81,19 @@ void walls_move(mixsph_sim *s, double t_from, double dt)
         const struct motion *m = &s->cfg.motions[mo];
         struct wall_state *ws = &s->walls[w];
         double vx, vz;
-        case_motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
+        if (ws->ext) { /* external velocity (co-simulation input): constant over the step */
+            vx = ws->vx = ws->ext_vx;
+            vz = ws->vz = ws->ext_vz;
+            ws->ax = ws->az = 0.0;
+        } else {
+            case_motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
+            case_motion_velocity(m, t_from + dt, &ws->vx, &ws->vz);
+            case_motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
+        }
         dxw[w] = vx * dt;
         dzw[w] = vz * dt;
         ws->ox += dxw[w];
         ws->oz += dzw[w];
-        case_motion_velocity(m, t_from + dt, &ws->vx, &ws->vz);
-        case_motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
         moving = 1;
     }
     if (!moving) return;

@@ -1,0 +1,391 @@
+/* state.c - save and restore the complete state of a simulation (FMU get/set/serialise state,
+ * checkpoint and restart). Public API of mixsph.h.
+ *
+ * Layout (native byte order, checked by a marker): a header "MIXSPHST", format version, byte
+ * order marker; the case text, origin and overrides the simulation was created from; the
+ * scalar state (time, step, time step, counters, output extremes and schedule); the walls'
+ * displacement, velocity and external drive; every particle field; a 64-bit FNV-1a checksum of
+ * all preceding bytes. Derived data (cell list, kernel, media constants) is rebuilt from the case
+ * on load, so a restored simulation continues exactly as the saved one would have. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+#include "status.h"
+
+#define STATE_MAGIC "MIXSPHST"
+#define STATE_VERSION 1u
+#define STATE_ORDER 0x01020304u
+
+/* ---- writer ------------------------------------------------------------------------------- */
+
+struct writer {
+    unsigned char *buf;
+    size_t len, cap;
+    int bad;
+};
+
+static void put(struct writer *w, const void *data, size_t n)
+{
+    if (w->bad || n == 0) return;
+    if (w->len + n > w->cap) {
+        size_t cap = w->cap ? w->cap : 4096;
+        while (cap < w->len + n) cap *= 2;
+        unsigned char *q = realloc(w->buf, cap);
+        if (!q) {
+            w->bad = 1;
+            return;
+        }
+        w->buf = q;
+        w->cap = cap;
+    }
+    memcpy(w->buf + w->len, data, n);
+    w->len += n;
+}
+
+static void put_u64(struct writer *w, uint64_t v) { put(w, &v, sizeof v); }
+static void put_f64(struct writer *w, double v) { put(w, &v, sizeof v); }
+
+static void put_str(struct writer *w, const char *t)
+{
+    const size_t n = t ? strlen(t) : 0;
+    put_u64(w, n);
+    put(w, t, n);
+}
+
+static uint64_t fnv1a(const unsigned char *p, size_t n)
+{
+    uint64_t h = 1469598103934665603ull;
+    for (size_t k = 0; k < n; k++) {
+        h ^= p[k];
+        h *= 1099511628211ull;
+    }
+    return h;
+}
+
+/* ---- reader ------------------------------------------------------------------------------- */
+
+struct reader {
+    const unsigned char *buf;
+    size_t len, pos;
+    int bad;
+};
+
+static void get(struct reader *r, void *data, size_t n)
+{
+    if (r->bad || n > r->len - r->pos) {
+        r->bad = 1;
+        if (data && n) memset(data, 0, n);
+        return;
+    }
+    if (n) memcpy(data, r->buf + r->pos, n);
+    r->pos += n;
+}
+
+static uint64_t get_u64(struct reader *r)
+{
+    uint64_t v;
+    get(r, &v, sizeof v);
+    return v;
+}
+
+static double get_f64(struct reader *r)
+{
+    double v;
+    get(r, &v, sizeof v);
+    return v;
+}
+
+/* A string in place (not NUL-terminated): its start and length. */
+static const char *get_str(struct reader *r, size_t *n)
+{
+    const uint64_t len = get_u64(r);
+    if (r->bad || len > r->len - r->pos) {
+        r->bad = 1;
+        *n = 0;
+        return "";
+    }
+    const char *t = (const char *)r->buf + r->pos;
+    r->pos += (size_t)len;
+    *n = (size_t)len;
+    return t;
+}
+
+/* ---- what is saved ------------------------------------------------------------------------ */
+
+static void put_source(struct writer *w, const mixsph_sim *s)
+{
+    put(w, STATE_MAGIC, 8);
+    const uint32_t head[2] = {STATE_VERSION, STATE_ORDER};
+    put(w, head, sizeof head);
+    put_str(w, s->case_text);
+    put_str(w, s->case_origin);
+    put_u64(w, s->n_ov);
+    for (size_t k = 0; k < s->n_ov; k++) {
+        put_str(w, s->ov_key[k]);
+        put_f64(w, s->ov_value[k]);
+    }
+}
+
+/* Scalars, walls and particles, in one order used by both directions: `io` copies between the
+ * simulation's field and the stream (writer or reader). */
+#define STATE_SCALARS(IO, s)                                           \
+    IO(&(s)->t, sizeof(s)->t) IO(&(s)->dt, sizeof(s)->dt)              \
+    IO(&(s)->step, sizeof(s)->step) IO(&(s)->n_lost, sizeof(s)->n_lost) \
+    IO(&(s)->n_clipped, sizeof(s)->n_clipped) IO(&(s)->n_fixed, sizeof(s)->n_fixed) \
+    IO(&(s)->n_samples, sizeof(s)->n_samples) IO(&(s)->next_sample, sizeof(s)->next_sample) \
+    IO(&(s)->next_snapshot, sizeof(s)->next_snapshot) IO(&(s)->snap_index, sizeof(s)->snap_index)
+
+static void put_dynamic(struct writer *w, const mixsph_sim *s)
+{
+#define W(ptr, n) put(w, (ptr), (n));
+    STATE_SCALARS(W, s)
+#undef W
+    put_u64(w, s->n_out);
+    put(w, s->out_max, s->n_out * sizeof(double));
+    put(w, s->out_tmax, s->n_out * sizeof(double));
+    put(w, s->out_min, s->n_out * sizeof(double));
+    put(w, s->out_tmin, s->n_out * sizeof(double));
+    put_u64(w, s->cfg.n_monitors);
+    put(w, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
+    put_u64(w, s->cfg.n_walls);
+    for (size_t k = 0; k < s->cfg.n_walls; k++) {
+        const struct wall_state *ws = &s->walls[k];
+        const double v[8] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz};
+        put(w, v, sizeof v);
+        put_u64(w, (uint64_t)ws->ext);
+    }
+    const struct particles *P = &s->P;
+    put_u64(w, P->n);
+    put_u64(w, s->n_fluid);
+    put_u64(w, s->n_wall);
+#define W(f) put(w, P->f, P->n * sizeof(double));
+    PARTICLES_DOUBLE_FIELDS(W)
+#undef W
+    put(w, P->medium, P->n);
+    put(w, P->state, P->n);
+    put(w, P->nneigh, P->n * sizeof(uint16_t));
+    put(w, P->id, P->n * sizeof(uint32_t));
+}
+
+mixsph_status mixsph_sim_save_state(const mixsph_sim *s, void **buf, size_t *len)
+{
+    if (!s || !buf || !len) return MIXSPH_ERR_ARG;
+    *buf = NULL;
+    *len = 0;
+    struct writer w = {0};
+    put_source(&w, s);
+    put_dynamic(&w, s);
+    put_u64(&w, fnv1a(w.buf, w.len));
+    if (w.bad) {
+        free(w.buf);
+        return MIXSPH_ERR_NOMEM;
+    }
+    *buf = w.buf;
+    *len = w.len;
+    return MIXSPH_OK;
+}
+
+void mixsph_state_free(void *buf) { free(buf); }
+
+/* ---- loading ------------------------------------------------------------------------------ */
+
+/* Check header and checksum; leave the reader after the header. */
+static mixsph_status check_header(struct reader *r, char *err, size_t err_len)
+{
+    if (!r->buf || r->len < 8 + 8 + 8)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "state: %zu bytes is too short to be a mixsph state", r->len);
+    char magic[8];
+    uint32_t head[2];
+    get(r, magic, 8);
+    get(r, head, sizeof head);
+    if (memcmp(magic, STATE_MAGIC, 8) != 0) return status_set(err, err_len, MIXSPH_ERR_ARG, "state: not a mixsph state (bad marker)");
+    if (head[1] != STATE_ORDER)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "state: saved on a machine of another byte order");
+    if (head[0] != STATE_VERSION)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "state: format version %u, this build reads version %u", head[0],
+                          STATE_VERSION);
+    uint64_t sum;
+    memcpy(&sum, r->buf + r->len - 8, 8);
+    if (sum != fnv1a(r->buf, r->len - 8))
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "state: checksum mismatch (truncated or corrupted)");
+    r->len -= 8; /* the checksum is not part of the payload */
+    return MIXSPH_OK;
+}
+
+/* The case source stored in a state: text and origin copied (NUL-terminated), overrides. */
+struct source {
+    char *text, *origin;
+    size_t n_ov;
+    char **keys;
+    double *values;
+};
+
+static void source_free(struct source *src)
+{
+    for (size_t k = 0; k < src->n_ov; k++) free(src->keys[k]);
+    free(src->keys);
+    free(src->values);
+    free(src->text);
+    free(src->origin);
+    memset(src, 0, sizeof *src);
+}
+
+static char *copy_str(struct reader *r)
+{
+    size_t n;
+    const char *t = get_str(r, &n);
+    char *d = malloc(n + 1);
+    if (!d) return NULL;
+    memcpy(d, t, n);
+    d[n] = '\0';
+    return d;
+}
+
+static mixsph_status read_source(struct reader *r, struct source *src, char *err, size_t err_len)
+{
+    memset(src, 0, sizeof *src);
+    src->text = copy_str(r);
+    src->origin = copy_str(r);
+    const uint64_t n_ov = get_u64(r);
+    if (r->bad || n_ov > 4096) return status_set(err, err_len, MIXSPH_ERR_ARG, "state: malformed case section");
+    src->keys = calloc(n_ov + 1, sizeof *src->keys);
+    src->values = calloc(n_ov + 1, sizeof *src->values);
+    if (!src->text || !src->origin || !src->keys || !src->values) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    for (size_t k = 0; k < n_ov; k++) {
+        if (!(src->keys[k] = copy_str(r))) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+        src->n_ov = k + 1;
+        src->values[k] = get_f64(r);
+    }
+    if (r->bad) return status_set(err, err_len, MIXSPH_ERR_ARG, "state: malformed case section");
+    return MIXSPH_OK;
+}
+
+int state_same_case(const mixsph_sim *s, const char *text, const char *const *keys, const double *values, size_t n_ov)
+{
+    if (!s->case_text || strcmp(s->case_text, text) != 0 || s->n_ov != n_ov) return 0;
+    for (size_t k = 0; k < n_ov; k++)
+        if (strcmp(s->ov_key[k], keys[k]) != 0 || memcmp(&s->ov_value[k], &values[k], sizeof(double)) != 0) return 0;
+    return 1;
+}
+
+/* Read the dynamic part into s (same case, checked by the caller). On a malformed stream s may
+ * be partly overwritten: the caller restores from its own copy. */
+static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
+{
+#define R(ptr, n) get(r, (ptr), (n));
+    STATE_SCALARS(R, s)
+#undef R
+    if (get_u64(r) != s->n_out) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: output count differs from the case's");
+    get(r, s->out_max, s->n_out * sizeof(double));
+    get(r, s->out_tmax, s->n_out * sizeof(double));
+    get(r, s->out_min, s->n_out * sizeof(double));
+    get(r, s->out_tmin, s->n_out * sizeof(double));
+    if (get_u64(r) != s->cfg.n_monitors) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: monitor count differs from the case's");
+    get(r, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
+    if (get_u64(r) != s->cfg.n_walls) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: wall count differs from the case's");
+    for (size_t k = 0; k < s->cfg.n_walls; k++) {
+        struct wall_state *ws = &s->walls[k];
+        double v[8];
+        get(r, v, sizeof v);
+        ws->ox = v[0];
+        ws->oz = v[1];
+        ws->vx = v[2];
+        ws->vz = v[3];
+        ws->ax = v[4];
+        ws->az = v[5];
+        ws->ext_vx = v[6];
+        ws->ext_vz = v[7];
+        ws->ext = get_u64(r) != 0;
+    }
+    struct particles *P = &s->P;
+    const uint64_t n = get_u64(r), n_fluid = get_u64(r), n_wall = get_u64(r);
+    if (r->bad || n != P->n || n_fluid != s->n_fluid || n_wall != s->n_wall)
+        return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particle counts differ from the case's (%llu vs %zu)", (unsigned long long)n,
+                        P->n);
+#define R(f) get(r, P->f, P->n * sizeof(double));
+    PARTICLES_DOUBLE_FIELDS(R)
+#undef R
+    get(r, P->medium, P->n);
+    get(r, P->state, P->n);
+    get(r, P->nneigh, P->n * sizeof(uint16_t));
+    get(r, P->id, P->n * sizeof(uint32_t));
+    if (r->bad || r->pos != r->len) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: malformed particle section");
+    /* the saved order is the cell order of the saved step: rebuilding the list keeps it */
+    if (cells_build(&s->C, P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    struct reader r = {buf, len, 0, 0};
+    mixsph_status st = check_header(&r, s->err, sizeof s->err);
+    if (st != MIXSPH_OK) return st;
+    struct source src;
+    st = read_source(&r, &src, s->err, sizeof s->err);
+    if (st == MIXSPH_OK && !state_same_case(s, src.text, (const char *const *)src.keys, src.values, src.n_ov))
+        st = SIM_FAIL(s, MIXSPH_ERR_ARG,
+                      "state: saved from another case or other overrides (%s) than this simulation's (%s); create a "
+                      "new simulation from the state instead",
+                      src.origin, s->case_origin);
+    source_free(&src);
+    if (st != MIXSPH_OK) return st;
+    /* keep a copy so that a malformed payload leaves the simulation unchanged */
+    mixsph_sim *keep = malloc(sizeof *keep);
+    struct particles Pk;
+    if (!keep || particles_copy(&Pk, &s->P) != 0) {
+        free(keep);
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    }
+    memcpy(keep, s, sizeof *s);
+    st = read_dynamic(&r, s);
+    if (st != MIXSPH_OK) {
+        char msg[sizeof s->err];
+        memcpy(msg, s->err, sizeof msg);
+        struct particles P = s->P;
+        memcpy(s, keep, sizeof *s);
+        s->P = P;
+        const size_t n = P.n;
+#define C(f) memcpy(s->P.f, Pk.f, n * sizeof(double));
+        PARTICLES_DOUBLE_FIELDS(C)
+#undef C
+        memcpy(s->P.medium, Pk.medium, n);
+        memcpy(s->P.state, Pk.state, n);
+        memcpy(s->P.nneigh, Pk.nneigh, n * sizeof(uint16_t));
+        memcpy(s->P.id, Pk.id, n * sizeof(uint32_t));
+        cells_build(&s->C, &s->P);
+        memcpy(s->err, msg, sizeof msg);
+    }
+    particles_free(&Pk);
+    free(keep);
+    return st;
+}
+
+mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
+{
+    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
+    *out = NULL;
+    struct reader r = {buf, len, 0, 0};
+    mixsph_status st = check_header(&r, err, err_len);
+    if (st != MIXSPH_OK) return st;
+    struct source src;
+    st = read_source(&r, &src, err, err_len);
+    mixsph_override *ov = NULL;
+    if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    if (st == MIXSPH_OK) {
+        for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
+        st = mixsph_sim_create_from_text(src.text, src.origin, ov, src.n_ov, out, err, err_len);
+    }
+    free(ov);
+    source_free(&src);
+    if (st != MIXSPH_OK) return st;
+    st = mixsph_sim_load_state(*out, buf, len);
+    if (st != MIXSPH_OK) {
+        status_set(err, err_len, st, "%s", (*out)->err);
+        mixsph_sim_destroy(*out);
+        *out = NULL;
+    }
+    return st;
+}

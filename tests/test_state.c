@@ -1,0 +1,198 @@
+/* test_state.c - state save/restore (state.c) and the external wall drive (sim.c, walls.c):
+ * a restored state continues bit for bit as the original (in place and in a new simulation
+ * created from the state alone), a state of another case or a damaged buffer is refused with a
+ * message and leaves the simulation unchanged, and a wall driven by an external velocity moves
+ * by exactly v t. Case: the Vajont Padua case (granular landslide, water, moving plate) at a
+ * coarse dx, so every part of the state (fixed grains, wall motion, monitors) is exercised. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "mixsph.h"
+
+#define VAJONT MIXSPH_SOURCE_DIR "/cases/vajont_padua.json"
+
+static mixsph_sim *make(double dx, double phi)
+{
+    const mixsph_override ov[2] = {{"numerics.dx", dx}, {"parameters.phi", phi}};
+    mixsph_sim *s = NULL;
+    char err[512];
+    const mixsph_status st = mixsph_sim_create(VAJONT, ov, 2, &s, err, sizeof err);
+    if (st != MIXSPH_OK) fprintf(stderr, "%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    return s;
+}
+
+/* Bitwise equality of everything observable: time, step, dt, all particle fields (the order is
+ * part of the state), every output's value and extremes. */
+static int same(const mixsph_sim *a, const mixsph_sim *b)
+{
+    if (mixsph_sim_time(a) != mixsph_sim_time(b) || mixsph_sim_steps(a) != mixsph_sim_steps(b) ||
+        mixsph_sim_dt(a) != mixsph_sim_dt(b))
+        return 0;
+    mixsph_particles_view u, v;
+    mixsph_sim_particles_view(a, &u);
+    mixsph_sim_particles_view(b, &v);
+    if (u.n != v.n) return 0;
+    const double *fu[7] = {u.x, u.z, u.vx, u.vz, u.rho, u.p, u.mu}, *fv[7] = {v.x, v.z, v.vx, v.vz, v.rho, v.p, v.mu};
+    for (int k = 0; k < 7; k++)
+        if (memcmp(fu[k], fv[k], u.n * sizeof(double)) != 0) return 0;
+    if (memcmp(u.state, v.state, u.n) || memcmp(u.medium, v.medium, u.n) || memcmp(u.id, v.id, u.n * sizeof(uint32_t)))
+        return 0;
+    for (size_t k = 0; k < mixsph_sim_output_count(a); k++) {
+        double ea[4], eb[4];
+        mixsph_sim_output_extremes(a, k, &ea[0], &ea[1], &ea[2], &ea[3]);
+        mixsph_sim_output_extremes(b, k, &eb[0], &eb[1], &eb[2], &eb[3]);
+        const double va = mixsph_sim_output_value(a, k), vb = mixsph_sim_output_value(b, k);
+        if (memcmp(ea, eb, sizeof ea) != 0 || memcmp(&va, &vb, sizeof va) != 0) return 0;
+    }
+    return 1;
+}
+
+/* save at t1, run to t2 (A); restore, run to t2 again (B): A == B bit for bit; a second
+ * simulation created from the state alone and run to t2 equals A too. */
+static void test_restore_continues_identically(void **state)
+{
+    (void)state;
+    mixsph_sim *s = make(0.03, 35.0), *ref = make(0.03, 35.0);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.1), MIXSPH_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    assert_int_equal(mixsph_sim_save_state(s, &buf, &len), MIXSPH_OK);
+    assert_non_null(buf);
+    assert_true(len > 1000);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(ref, 0.2), MIXSPH_OK);
+    assert_true(same(s, ref)); /* saving does not disturb the run */
+
+    assert_int_equal(mixsph_sim_load_state(s, buf, len), MIXSPH_OK);
+    assert_true(mixsph_sim_time(s) < 0.1 + 1e-3 && mixsph_sim_time(s) >= 0.1);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.2), MIXSPH_OK);
+    assert_true(same(s, ref));
+
+    mixsph_sim *c = NULL;
+    char err[512];
+    assert_int_equal(mixsph_sim_create_from_state(buf, len, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(c, 2), MIXSPH_OK); /* pair loops do not depend on it */
+    assert_string_equal(mixsph_sim_case_origin(c), VAJONT);
+    assert_int_equal(mixsph_sim_advance_to(c, 0.2), MIXSPH_OK);
+    assert_true(same(c, ref));
+    mixsph_state_free(buf);
+    mixsph_sim_destroy(c);
+    mixsph_sim_destroy(s);
+    mixsph_sim_destroy(ref);
+}
+
+/* Refusals: another case's state, a flipped byte, a truncated buffer, garbage. Each leaves the
+ * simulation as it was (it then continues exactly as an untouched twin). */
+static void test_bad_states_are_refused(void **state)
+{
+    (void)state;
+    mixsph_sim *s = make(0.03, 35.0), *twin = make(0.03, 35.0), *other = make(0.03, 25.0);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.05), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(twin, 0.05), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(other, 0.02), MIXSPH_OK);
+    void *buf = NULL;
+    size_t len = 0;
+    assert_int_equal(mixsph_sim_save_state(other, &buf, &len), MIXSPH_OK);
+
+    assert_int_equal(mixsph_sim_load_state(s, buf, len), MIXSPH_ERR_ARG);
+    assert_non_null(strstr(mixsph_sim_last_error(s), "another case"));
+
+    unsigned char *bad = malloc(len);
+    assert_non_null(bad);
+    memcpy(bad, buf, len);
+    bad[len / 2] ^= 0x10;
+    assert_int_equal(mixsph_sim_load_state(other, bad, len), MIXSPH_ERR_ARG);
+    assert_non_null(strstr(mixsph_sim_last_error(other), "checksum"));
+    assert_int_equal(mixsph_sim_load_state(other, buf, len - 100), MIXSPH_ERR_ARG);
+    assert_int_equal(mixsph_sim_load_state(other, "not a state at all, not a state", 31), MIXSPH_ERR_ARG);
+    assert_non_null(strstr(mixsph_sim_last_error(other), "not a mixsph state"));
+    mixsph_sim *c = NULL;
+    char err[512] = "";
+    assert_int_equal(mixsph_sim_create_from_state(bad, len, &c, err, sizeof err), MIXSPH_ERR_ARG);
+    assert_null(c);
+    assert_non_null(strstr(err, "checksum"));
+    free(bad);
+    mixsph_state_free(buf);
+
+    assert_int_equal(mixsph_sim_advance_to(s, 0.1), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(twin, 0.1), MIXSPH_OK);
+    assert_true(same(s, twin));
+    mixsph_sim_destroy(s);
+    mixsph_sim_destroy(twin);
+    mixsph_sim_destroy(other);
+}
+
+/* Mean x of the plate's wall particles (medium = wall index of "plate", the second wall). */
+static double plate_x(const mixsph_sim *s)
+{
+    mixsph_particles_view v;
+    mixsph_sim_particles_view(s, &v);
+    double sum = 0.0;
+    size_t n = 0;
+    for (size_t i = 0; i < v.n; i++)
+        if (v.state[i] == MIXSPH_STATE_WALL && v.medium[i] == 1) {
+            sum += v.x[i];
+            n++;
+        }
+    assert_true(n > 0);
+    return sum / (double)n;
+}
+
+/* An external velocity replaces the plate's law: over [t0, t1] the plate moves by vx (t1 - t0)
+ * (to rounding: reference is the exact displacement of a constant velocity); released, it
+ * follows its law again (which is still accelerating at t = 0.1 s, so it moves further). Bad
+ * requests are refused. The drive is part of the saved state. */
+static void test_external_wall_velocity(void **state)
+{
+    (void)state;
+    mixsph_sim *s = make(0.03, 35.0);
+    assert_int_equal(mixsph_sim_set_wall_velocity(s, "bed", 0.1, 0.0), MIXSPH_ERR_ARG);
+    assert_non_null(strstr(mixsph_sim_last_error(s), "fixed"));
+    assert_int_equal(mixsph_sim_set_wall_velocity(s, "nope", 0.1, 0.0), MIXSPH_ERR_ARG);
+    assert_non_null(strstr(mixsph_sim_last_error(s), "no such wall"));
+    assert_int_equal(mixsph_sim_set_wall_velocity(s, "plate", NAN, 0.0), MIXSPH_ERR_ARG);
+    assert_int_equal(mixsph_sim_set_wall_velocity(s, "plate", 0.05, 0.0), MIXSPH_OK);
+    const double x0 = plate_x(s), t0 = mixsph_sim_time(s);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.05), MIXSPH_OK);
+    const double moved = plate_x(s) - x0, expected = 0.05 * (mixsph_sim_time(s) - t0);
+    assert_true(fabs(moved - expected) < 1e-9); /* constant velocity: exact up to rounding */
+
+    void *buf = NULL;
+    size_t len = 0;
+    assert_int_equal(mixsph_sim_save_state(s, &buf, &len), MIXSPH_OK);
+    mixsph_sim *c = NULL;
+    assert_int_equal(mixsph_sim_create_from_state(buf, len, &c, NULL, 0), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(c, 1), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.08), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(c, 0.08), MIXSPH_OK);
+    assert_true(same(s, c)); /* the restored simulation is still driven */
+    mixsph_state_free(buf);
+
+    assert_int_equal(mixsph_sim_release_wall_velocity(s, "plate"), MIXSPH_OK);
+    const double x1 = plate_x(s), t1 = mixsph_sim_time(s);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.2), MIXSPH_OK);
+    /* the law's speed at t in [0.1, 0.2] is above 0.2 m/s, four times the drive */
+    assert_true(plate_x(s) - x1 > 0.15 * (mixsph_sim_time(s) - t1));
+    mixsph_sim_destroy(c);
+    mixsph_sim_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_restore_continues_identically),
+        cmocka_unit_test(test_bad_states_are_refused),
+        cmocka_unit_test(test_external_wall_velocity),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
