@@ -184,6 +184,11 @@ static mixsph_status sim_init(mixsph_sim *s)
     set_domain(s);
     for (size_t k = 0; k < s->cfg.n_media; k++) s->has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
     if (s->has_granular && (st = mixture_alloc(s)) != MIXSPH_OK) return st;
+    const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
+    for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */
+        if (!(s->P.x[i] >= dom[0] && s->P.x[i] < dom[1] && s->P.z[i] >= dom[2] && s->P.z[i] < dom[3]))
+            return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
+                            s->P.x[i], s->P.z[i]);
     if (cells_init(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->domain[0], s->domain[1], s->domain[2], s->domain[3]);
