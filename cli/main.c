@@ -58,6 +58,25 @@ static void json_number(FILE *f, double v)
     else fprintf(f, "null");
 }
 
+/* The full-scale report of the case (key full_scale): outputs <m>_Z (full-scale elevation of the
+ * max_elevation monitor m) and <m>_d_eta (the error (13) of Manenti et al. 2018 of its maximum).
+ * Returns 1 and the indices of m, <m>_Z and <m>_d_eta for the k-th output named <m>_d_eta. */
+static int full_scale_outputs(const mixsph_sim *s, size_t k, long *km, long *kz)
+{
+    static const char suffix[] = "_d_eta";
+    const char *name = mixsph_sim_output_name(s, k);
+    const size_t n = strlen(name), ns = sizeof suffix - 1;
+    if (n <= ns || strcmp(name + n - ns, suffix) != 0) return 0;
+    char base[128];
+    if (n - ns + 3 > sizeof base) return 0;
+    memcpy(base, name, n - ns);
+    base[n - ns] = '\0';
+    *km = mixsph_sim_output_find(s, base);
+    strcat(base, "_Z");
+    *kz = mixsph_sim_output_find(s, base);
+    return *km >= 0 && *kz >= 0;
+}
+
 static int write_summary(const char *dir, const mixsph_sim *s, const char *case_path, int threads, double wall,
                          const char *status_text)
 {
@@ -95,7 +114,26 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
         json_number(f, tmn);
         fprintf(f, "}%s\n", k + 1 < n ? "," : "");
     }
-    fprintf(f, "  }\n}\n");
+    fprintf(f, "  },\n  \"full_scale\": [");
+    int first = 1;
+    for (size_t k = 0; k < n; k++) {
+        long km, kz;
+        if (!full_scale_outputs(s, k, &km, &kz)) continue;
+        double mx, tmx, mn, tmn, zmx, ztmx;
+        mixsph_sim_output_extremes(s, (size_t)km, &mx, &tmx, &mn, &tmn);
+        mixsph_sim_output_extremes(s, (size_t)kz, &zmx, &ztmx, &mn, &tmn);
+        fprintf(f, "%s\n    {\"monitor\": \"%s\", \"max\": ", first ? "" : ",", mixsph_sim_output_name(s, (size_t)km));
+        json_number(f, mx);
+        fprintf(f, ", \"t_max\": ");
+        json_number(f, tmx);
+        fprintf(f, ", \"Z_max\": ");
+        json_number(f, zmx);
+        fprintf(f, ", \"d_eta_percent\": ");
+        json_number(f, mixsph_sim_output_value(s, k));
+        fprintf(f, "}");
+        first = 0;
+    }
+    fprintf(f, "%s]\n}\n", first ? "" : "\n  ");
     return fclose(f) == 0 ? 0 : -1;
 }
 
@@ -202,6 +240,15 @@ static int cmd_run(int argc, char **argv)
         mixsph_sim_output_extremes(s, k, &mx, &tmx, &mn, &tmn);
         printf("  %-18s final %-12.6g max %-12.6g (t = %.4g s)  min %-12.6g (t = %.4g s)\n", mixsph_sim_output_name(s, k),
                mixsph_sim_output_value(s, k), mx, tmx, mn, tmn);
+    }
+    for (size_t k = 0; k < mixsph_sim_output_count(s); k++) {
+        long km, kz;
+        if (!full_scale_outputs(s, k, &km, &kz)) continue;
+        double mx, tmx, mn, tmn, zmx;
+        mixsph_sim_output_extremes(s, (size_t)km, &mx, &tmx, &mn, &tmn);
+        mixsph_sim_output_extremes(s, (size_t)kz, &zmx, &tmn, &mn, &tmn);
+        printf("  %s: max %.4g at t = %.4g s, full scale Z = %.1f, d_eta = %.1f %% (error (13))\n",
+               mixsph_sim_output_name(s, (size_t)km), mx, tmx, zmx, mixsph_sim_output_value(s, k));
     }
     printf("  summary: %s/summary.json, monitors: %s/monitors.csv\n", dir, dir);
     mixsph_sim_destroy(s);

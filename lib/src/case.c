@@ -489,10 +489,13 @@ static int find_wall(const struct case_def *c, const char *name)
     return -1;
 }
 
+static int find_monitor(const struct case_def *c, const char *name);
+
 static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct case_def *c)
 {
     static const char *const keys[] = {"type", "medium", "wall", "direction", "x_min", "x_max", "z_min", "z_max",
-                                       "min_neighbours", "bin", "times", NULL};
+                                       "min_neighbours", "bin", "times", "at_max_of", NULL};
+    const char *at_max_of[CASE_MAX_MONITORS] = {NULL};
     const cJSON *m;
     TRY(get_obj(r, root, "", "monitors", 0, &m));
     if (!m) return MIXSPH_OK;
@@ -506,7 +509,10 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
         TRY(check_keys(r, it, path, keys));
         const char *type = NULL, *medium = NULL, *dir = "+x", *wall = NULL;
         TRY(get_str(r, it, path, "type", 1, &type));
+        if (strcmp(type, "profile") != 0 && cJSON_HasObjectItem(it, "at_max_of"))
+            return FAIL(r, "%s: %s.at_max_of: only a profile takes at_max_of", r->origin, path);
         md->medium = md->wall = -1;
+        md->at_max_of = -1;
         md->x_min = md->z_min = -INFINITY;
         md->x_max = md->z_max = INFINITY;
         double mn = 3;
@@ -542,14 +548,16 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
                 return FAIL(r, "%s: %s: a profile needs x_min and x_max", r->origin, path);
             md->bin = c->dx;
             TRY(get_num(r, it, path, "bin", 0, 0.0, 1, 1e3, &md->bin));
+            TRY(get_str(r, it, path, "at_max_of", 0, &at_max_of[c->n_monitors - 1]));
             double *t = NULL;
             size_t nt = 0;
-            TRY(get_numbers(r, it, path, "times", 1, &t, &nt));
+            if (!at_max_of[c->n_monitors - 1] || cJSON_HasObjectItem(it, "times"))
+                TRY(get_numbers(r, it, path, "times", 1, &t, &nt));
             if (nt > CASE_MAX_PROFILE_TIMES) {
                 free(t);
                 return FAIL(r, "%s: %s.times: at most %d times", r->origin, path, CASE_MAX_PROFILE_TIMES);
             }
-            for (size_t k = 0; k < nt; k++) md->times[k] = t[k];
+            for (size_t k = 0; k < nt; k++) md->times[k] = t[k];  /* nt = 0: at_max_of only */
             md->n_times = nt;
             free(t);
             for (size_t k = 1; k < nt; k++)
@@ -559,7 +567,92 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
                         r->origin, path, type);
         }
     }
+    /* at_max_of may name a monitor listed later in the file */
+    for (size_t k = 0; k < c->n_monitors; k++) {
+        if (!at_max_of[k]) continue;
+        const int j = find_monitor(c, at_max_of[k]);
+        if (j < 0 || c->monitors[j].kind != MONITOR_MAX_ELEVATION)
+            return FAIL(r, "%s: monitors.%s.at_max_of: '%s' is not one of the max_elevation monitors", r->origin,
+                        c->monitors[k].name, at_max_of[k]);
+        c->monitors[k].at_max_of = j;
+    }
     return MIXSPH_OK;
+}
+
+static int find_monitor(const struct case_def *c, const char *name)
+{
+    for (size_t i = 0; i < c->n_monitors; i++)
+        if (strcmp(c->monitors[i].name, name) == 0) return (int)i;
+    return -1;
+}
+
+/* ---- full-scale report -------------------------------------------------------------------------
+ * "full_scale": {"z_scale": 1211.8, "z_offset": 0.3, "unit": "m a.m.s.l.",
+ *                "reference": {"monitor": "run_up", "observed": 863.0, "still": 700.0}}
+ * Z = z_scale z + z_offset for every max_elevation monitor (output <m>_Z); with the reference,
+ * the error (13) of Manenti et al. (2018) of the reference monitor's highest value (<m>_d_eta). */
+static mixsph_status read_full_scale(struct reader *r, const cJSON *root, struct case_def *c)
+{
+    static const char *const keys[] = {"z_scale", "z_offset", "unit", "reference", NULL};
+    static const char *const rkeys[] = {"monitor", "observed", "still", NULL};
+    struct full_scale *fs = &c->full_scale;
+    fs->on = 0;
+    fs->ref_monitor = -1;
+    const cJSON *f, *ref;
+    TRY(get_obj(r, root, "", "full_scale", 0, &f));
+    size_t n_scalar = 0;
+    for (size_t k = 0; k < c->n_monitors; k++) n_scalar += c->monitors[k].kind != MONITOR_PROFILE;
+    if (!f) return MIXSPH_OK;
+    TRY(check_keys(r, f, "full_scale", keys));
+    fs->z_offset = 0.0;
+    TRY(get_num(r, f, "full_scale", "z_scale", 1, 0.0, 1, 1e9, &fs->z_scale));
+    TRY(get_num(r, f, "full_scale", "z_offset", 0, -1e9, 0, 1e9, &fs->z_offset));
+    const char *unit = "m";
+    TRY(get_str(r, f, "full_scale", "unit", 0, &unit));
+    if (strlen(unit) >= CASE_NAME_LEN)
+        return FAIL(r, "%s: full_scale.unit: expected at most %d characters", r->origin, CASE_NAME_LEN - 1);
+    strcpy(fs->unit, unit);
+    for (size_t k = 0; k < c->n_monitors; k++) {
+        if (c->monitors[k].kind != MONITOR_MAX_ELEVATION) continue;
+        n_scalar++;
+        if (strlen(c->monitors[k].name) + strlen(CASE_FULL_SCALE_SUFFIX_ERR) >= CASE_NAME_LEN)
+            return FAIL(r, "%s: full_scale: the monitor name '%s' is too long for its full-scale outputs '%s%s', "
+                        "'%s%s' (expected at most %d characters)", r->origin, c->monitors[k].name, c->monitors[k].name,
+                        CASE_FULL_SCALE_SUFFIX_Z, c->monitors[k].name, CASE_FULL_SCALE_SUFFIX_ERR,
+                        (int)(CASE_NAME_LEN - 1 - strlen(CASE_FULL_SCALE_SUFFIX_ERR)));
+    }
+    TRY(get_obj(r, f, "full_scale", "reference", 0, &ref));
+    if (ref) {
+        TRY(check_keys(r, ref, "full_scale.reference", rkeys));
+        const char *mon = NULL;
+        TRY(get_str(r, ref, "full_scale.reference", "monitor", 1, &mon));
+        fs->ref_monitor = find_monitor(c, mon);
+        if (fs->ref_monitor < 0 || c->monitors[fs->ref_monitor].kind != MONITOR_MAX_ELEVATION)
+            return FAIL(r, "%s: full_scale.reference.monitor: '%s' is not one of the max_elevation monitors", r->origin, mon);
+        TRY(get_num(r, ref, "full_scale.reference", "observed", 1, -1e9, 0, 1e9, &fs->observed));
+        TRY(get_num(r, ref, "full_scale.reference", "still", 1, -1e9, 0, 1e9, &fs->still));
+        if (!(fs->observed > fs->still))
+            return FAIL(r, "%s: full_scale.reference: observed (%g) must lie above still (%g), in full-scale units",
+                        r->origin, fs->observed, fs->still);
+        n_scalar++;
+    }
+    if (n_scalar > CASE_MAX_SCALAR_OUTPUTS)
+        return FAIL(r, "%s: full_scale: %zu scalar monitors and full-scale outputs (expected at most %d; "
+                    "fewer max_elevation monitors)", r->origin, n_scalar, CASE_MAX_SCALAR_OUTPUTS);
+    fs->on = 1;
+    return MIXSPH_OK;
+}
+
+double case_full_scale_z(const struct case_def *c, double z)
+{
+    return c->full_scale.on ? c->full_scale.z_scale * z + c->full_scale.z_offset : z;
+}
+
+double case_full_scale_error(const struct case_def *c, double Z)
+{
+    const struct full_scale *fs = &c->full_scale;
+    if (!fs->on || fs->ref_monitor < 0) return NAN;
+    return 100.0 * fabs(Z - fs->observed) / (fs->observed - fs->still);
 }
 
 /* ---- parameters ----------------------------------------------------------------------------
@@ -603,7 +696,7 @@ static mixsph_status apply_parameters(struct reader *r, cJSON *root)
 static mixsph_status read_root(struct reader *r, const cJSON *root, struct case_def *c)
 {
     static const char *const keys[] = {"name", "description", "parameters", "gravity", "numerics", "domain", "media",
-                                       "bodies", "walls", "motions", "monitors", "output", NULL};
+                                       "bodies", "walls", "motions", "monitors", "full_scale", "output", NULL};
     static const char *const dkeys[] = {"x_min", "x_max", "z_min", "z_max", NULL};
     static const char *const okeys[] = {"monitor_interval", "snapshot_interval", NULL};
     if (!cJSON_IsObject(root)) return FAIL(r, "%s: the case must be a JSON object", r->origin);
@@ -629,6 +722,7 @@ static mixsph_status read_root(struct reader *r, const cJSON *root, struct case_
     TRY(read_motions(r, root, c));
     TRY(read_walls(r, root, c));
     TRY(read_monitors(r, root, c));
+    TRY(read_full_scale(r, root, c));
     const cJSON *o;
     TRY(get_obj(r, root, "", "output", 0, &o));
     c->monitor_interval = c->t_end / 200.0;

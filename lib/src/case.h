@@ -79,6 +79,29 @@ struct monitor_def {
     double bin;               /* profile: bin width [m] */
     size_t n_times;           /* profile: times at which it is written [s] */
     double times[CASE_MAX_PROFILE_TIMES];
+    int at_max_of;            /* profile: max_elevation monitor at whose every new maximum the profile is
+                                 rewritten (profile_<name>_atmax.csv), -1 for none */
+};
+
+/* Scalar outputs that the case's monitors may add (the scalar monitors and the full-scale
+ * outputs below); monitors.c adds its diagnostics and checks that all fit in SIM_MAX_OUTPUTS. */
+#define CASE_MAX_SCALAR_OUTPUTS (CASE_MAX_MONITORS + 1)
+#define CASE_FULL_SCALE_SUFFIX_Z "_Z"        /* output <m>_Z: full-scale elevation of monitor m */
+#define CASE_FULL_SCALE_SUFFIX_ERR "_d_eta"  /* output <m>_d_eta: error (13) [%] of its highest value */
+
+/* Optional full-scale report: an affine map from a lab elevation z [m] to a full-scale elevation
+ * Z = z_scale z + z_offset (e.g. metres a.m.s.l.; Vajont: Z = 1211.8 z + 0.3, fitted to Manenti
+ * et al. 2018, Table 5). Every max_elevation monitor <m> gets the output <m>_Z; the reference
+ * monitor also gets <m>_d_eta, the paper's error (13) of its highest value so far,
+ * 100 |Z_max - observed| / (observed - still) [%]. */
+struct full_scale {
+    int on;
+    double z_scale;           /* [full-scale unit per m], > 0 */
+    double z_offset;          /* [full-scale unit] */
+    char unit[CASE_NAME_LEN]; /* e.g. "m a.m.s.l." (for reports) */
+    int ref_monitor;          /* index into monitors (a max_elevation monitor), -1 for no reference */
+    double observed;          /* observed highest elevation Z_exp [full-scale unit] */
+    double still;             /* still-water elevation Z_still [full-scale unit] of the error (13) */
 };
 
 struct case_def {
@@ -102,6 +125,7 @@ struct case_def {
     struct wall walls[CASE_MAX_WALLS];
     struct motion motions[CASE_MAX_MOTIONS];
     struct monitor_def monitors[CASE_MAX_MONITORS];
+    struct full_scale full_scale;
 };
 
 /** Read and validate a case from JSON text; `origin` names it in messages. */
@@ -112,6 +136,11 @@ mixsph_status case_parse(const char *json_text, const char *origin, const mixsph
 mixsph_status case_read_file(const char *path, char **text, char *err, size_t err_len);
 
 void case_free(struct case_def *c);
+
+/** Full-scale elevation of a lab elevation z [m] (the case's full_scale map; z itself without one). */
+double case_full_scale_z(const struct case_def *c, double z);
+/** The error (13) [%] of a full-scale elevation Z against the case's reference (NAN without one). */
+double case_full_scale_error(const struct case_def *c, double Z);
 
 /** Velocity of a motion law at time t (linear between rows, held at the ends). */
 void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz);

@@ -7,6 +7,13 @@
  *   profile        - at given times, the top of a medium (highest particle centre + dx/2) in bins
  *                    of x, written to profile_<name>_<k>.csv (free surface, landslide surface,
  *                    mixture-water interface).
+ *                    A profile with at_max_of = <m> is also rewritten as
+ *                    profile_<name>_atmax.csv whenever the max_elevation monitor m reaches a new
+ *                    highest value (so it holds the profile at the time of the maximum run-up).
+ * Full-scale outputs (case key full_scale, case.h): <m>_Z = z_scale z + z_offset of every
+ * max_elevation monitor m, and <m>_d_eta of the reference monitor: the error (13) of Manenti et
+ * al. (2018), 100 |Z_max - Z_observed| / (Z_observed - Z_still) [%], with Z_max the highest value
+ * of <m>_Z over the samples so far (its final value is the run's error).
  * Particle monitors ignore spray: a particle counts only if it has at least min_neighbours
  * particles of its own medium within the kernel support 2h (counted in the last pass).
  * Samples are taken every output.monitor_interval of simulated time; the extremes over the
@@ -25,6 +32,25 @@ enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_N
 static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt", "lost_particles", "wall_corrections",
                                                    "max_speed", "fixed_particles"};
 
+/* out_monitor[k] of a monitor output: the case monitor m plus CASE_MAX_MONITORS times the kind
+ * of output (the monitor's value, its full-scale elevation, the error (13) of its maximum). */
+enum { OUTK_VALUE = 0, OUTK_FULL_Z = 1, OUTK_FULL_ERR = 2 };
+#define OUT_CODE(m, kind) ((int)(m) + CASE_MAX_MONITORS * (kind))
+
+_Static_assert(OUT_N_DIAG + CASE_MAX_SCALAR_OUTPUTS <= SIM_MAX_OUTPUTS, "outputs do not fit in SIM_MAX_OUTPUTS");
+
+/* Add the output <monitor m's name><suffix> of the given kind. */
+static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffix)
+{
+    char name[2 * CASE_NAME_LEN];
+    const size_t a = strlen(s->cfg.monitors[m].name), b = strlen(suffix);
+    memcpy(name, s->cfg.monitors[m].name, a);
+    memcpy(name + a, suffix, b + 1);
+    name[CASE_NAME_LEN - 1] = '\0'; /* never cut: case.c checked the length */
+    s->out_monitor[s->n_out] = OUT_CODE(m, kind);
+    memcpy(s->out_name[s->n_out++], name, CASE_NAME_LEN);
+}
+
 void monitors_init(mixsph_sim *s)
 {
     s->n_out = 0;
@@ -35,9 +61,14 @@ void monitors_init(mixsph_sim *s)
     for (size_t k = 0; k < s->cfg.n_monitors; k++) {
         s->profile_next[k] = 0;
         if (s->cfg.monitors[k].kind == MONITOR_PROFILE) continue;
-        s->out_monitor[s->n_out] = (int)k;
+        s->out_monitor[s->n_out] = OUT_CODE(k, OUTK_VALUE);
         snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
     }
+    /* case.c checked that the names fit and that there are at most CASE_MAX_SCALAR_OUTPUTS */
+    const struct full_scale *fs = &s->cfg.full_scale;
+    for (size_t k = 0; fs->on && k < s->cfg.n_monitors; k++)
+        if (s->cfg.monitors[k].kind == MONITOR_MAX_ELEVATION) out_add_full_scale(s, (int)k, OUTK_FULL_Z, CASE_FULL_SCALE_SUFFIX_Z);
+    if (fs->on && fs->ref_monitor >= 0) out_add_full_scale(s, fs->ref_monitor, OUTK_FULL_ERR, CASE_FULL_SCALE_SUFFIX_ERR);
     for (size_t k = 0; k < s->n_out; k++) {
         s->out_max[k] = s->out_min[k] = NAN;
         s->out_tmax[k] = s->out_tmin[k] = NAN;
@@ -78,7 +109,19 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 double monitors_value(const mixsph_sim *s, size_t k)
 {
     const struct particles *P = &s->P;
-    if (k >= OUT_N_DIAG) return monitor_eval(s, &s->cfg.monitors[s->out_monitor[k]]);
+    if (k >= OUT_N_DIAG) {
+        const int m = s->out_monitor[k] % CASE_MAX_MONITORS, kind = s->out_monitor[k] / CASE_MAX_MONITORS;
+        if (kind == OUTK_FULL_ERR) {
+            /* the error (13) of the highest value so far of the monitor's own output */
+            for (size_t j = OUT_N_DIAG; j < s->n_out; j++)
+                if (s->out_monitor[j] == OUT_CODE(m, OUTK_VALUE))
+                    return isnan(s->out_max[j]) ? NAN
+                                                : case_full_scale_error(&s->cfg, case_full_scale_z(&s->cfg, s->out_max[j]));
+            return NAN;
+        }
+        const double v = monitor_eval(s, &s->cfg.monitors[m]);
+        return kind == OUTK_FULL_Z && !isnan(v) ? case_full_scale_z(&s->cfg, v) : v;
+    }
     if (k == OUT_DT) return s->dt;
     if (k == OUT_LOST) return (double)s->n_lost;
     if (k == OUT_CLIPS) return (double)s->n_clipped;
@@ -107,48 +150,70 @@ mixsph_status monitors_open(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
+/* Write profile monitor md as <out_dir>/profile_<name>_<tag>.csv, taken now, requested at t_req. */
+static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, const char *tag, double t_req,
+                                   const char *note)
+{
+    const struct particles *P = &s->P;
+    const size_t nb = (size_t)ceil((md->x_max - md->x_min) / md->bin);
+    double *top = malloc((nb ? nb : 1) * sizeof *top);
+    if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
+    for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
+        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
+        size_t b = (size_t)((P->x[i] - md->x_min) / md->bin);
+        if (b >= nb) b = nb - 1;
+        if (P->z[i] + 0.5 * s->dx > top[b]) top[b] = P->z[i] + 0.5 * s->dx;
+    }
+    char path[700];
+    snprintf(path, sizeof path, "%s/profile_%s_%s.csv", s->out_dir, md->name, tag);
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        free(top);
+        return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    }
+    fprintf(f, "# profile %s of %s at t = %.9g s (requested %.9g s): top of the medium per x bin%s\nx,z_top\n",
+            md->name, s->cfg.media[md->medium].name, s->t, t_req, note);
+    for (size_t b = 0; b < nb; b++) {
+        fprintf(f, "%.7g,", md->x_min + (b + 0.5) * md->bin);
+        if (isfinite(top[b])) fprintf(f, "%.7g\n", top[b]);
+        else fprintf(f, "nan\n");
+    }
+    free(top);
+    const int bad = ferror(f);
+    if (fclose(f) != 0 || bad) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: write failed", path);
+    return MIXSPH_OK;
+}
+
 /* Write the profiles that are due (needs an output folder). */
 mixsph_status monitors_profiles(mixsph_sim *s)
 {
-    const struct particles *P = &s->P;
     for (size_t k = 0; k < s->cfg.n_monitors; k++) {
         const struct monitor_def *md = &s->cfg.monitors[k];
         if (md->kind != MONITOR_PROFILE || s->profile_next[k] >= md->n_times || s->t < md->times[s->profile_next[k]])
             continue;
-        const size_t nb = (size_t)ceil((md->x_max - md->x_min) / md->bin);
-        double *top = malloc((nb ? nb : 1) * sizeof *top);
-        if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
-        for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
-        for (size_t i = 0; i < P->n; i++) {
-            if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-            if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
-            size_t b = (size_t)((P->x[i] - md->x_min) / md->bin);
-            if (b >= nb) b = nb - 1;
-            if (P->z[i] + 0.5 * s->dx > top[b]) top[b] = P->z[i] + 0.5 * s->dx;
-        }
         if (s->out_dir[0]) {
-            char path[700];
-            snprintf(path, sizeof path, "%s/profile_%s_%zu.csv", s->out_dir, md->name, s->profile_next[k]);
-            FILE *f = fopen(path, "w");
-            if (!f) {
-                free(top);
-                return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-            }
-            fprintf(f, "# profile %s of %s at t = %.9g s (requested %.9g s): top of the medium per x bin\nx,z_top\n",
-                    md->name, s->cfg.media[md->medium].name, s->t, md->times[s->profile_next[k]]);
-            for (size_t b = 0; b < nb; b++) {
-                fprintf(f, "%.7g,", md->x_min + (b + 0.5) * md->bin);
-                if (isfinite(top[b])) fprintf(f, "%.7g\n", top[b]);
-                else fprintf(f, "nan\n");
-            }
-            const int bad = ferror(f);
-            if (fclose(f) != 0 || bad) {
-                free(top);
-                return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: write failed", path);
-            }
+            char tag[32];
+            snprintf(tag, sizeof tag, "%zu", s->profile_next[k]);
+            mixsph_status st = profile_write(s, md, tag, md->times[s->profile_next[k]], "");
+            if (st != MIXSPH_OK) return st;
         }
-        free(top);
         s->profile_next[k]++;
+    }
+    return MIXSPH_OK;
+}
+
+/* Rewrite the at_max_of profiles of case monitor m, which has just reached a new maximum. */
+static mixsph_status profiles_at_max(mixsph_sim *s, int m)
+{
+    for (size_t k = 0; s->out_dir[0] && k < s->cfg.n_monitors; k++) {
+        const struct monitor_def *md = &s->cfg.monitors[k];
+        if (md->kind != MONITOR_PROFILE || md->at_max_of != m) continue;
+        char note[96];
+        snprintf(note, sizeof note, ", at the maximum of %s so far", s->cfg.monitors[m].name);
+        mixsph_status st = profile_write(s, md, "atmax", s->t, note);
+        if (st != MIXSPH_OK) return st;
     }
     return MIXSPH_OK;
 }
@@ -163,6 +228,11 @@ mixsph_status monitors_sample(mixsph_sim *s)
         if (isnan(s->out_max[k]) || v[k] > s->out_max[k]) {
             s->out_max[k] = v[k];
             s->out_tmax[k] = s->t;
+            const int code = s->out_monitor[k];
+            if (code >= 0 && code < CASE_MAX_MONITORS && s->cfg.monitors[code].kind == MONITOR_MAX_ELEVATION) {
+                mixsph_status st = profiles_at_max(s, code);
+                if (st != MIXSPH_OK) return st;
+            }
         }
         if (isnan(s->out_min[k]) || v[k] < s->out_min[k]) {
             s->out_min[k] = v[k];
