@@ -45,21 +45,24 @@ static const char *const BASE =
     "  \"output\": { \"monitor_interval\": 0.01 }\n"
     "}\n";
 
-/* BASE with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
-static char *edit(const char *old, const char *new_text)
+/* `src` with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
+static char *edit_text(const char *src, const char *old, const char *new_text)
 {
-    const char *at = strstr(BASE, old);
+    const char *at = strstr(src, old);
     assert_non_null(at);
     assert_null(strstr(at + 1, old));
-    const size_t lb = strlen(BASE), lo = strlen(old), ln = strlen(new_text);
+    const size_t lb = strlen(src), lo = strlen(old), ln = strlen(new_text);
     char *out = malloc(lb - lo + ln + 1);
     assert_non_null(out);
-    const size_t head = (size_t)(at - BASE);
-    memcpy(out, BASE, head);
+    const size_t head = (size_t)(at - src);
+    memcpy(out, src, head);
     memcpy(out + head, new_text, ln);
     memcpy(out + head + ln, at + lo, lb - head - lo + 1);
     return out;
 }
+
+/* BASE with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
+static char *edit(const char *old, const char *new_text) { return edit_text(BASE, old, new_text); }
 
 /* Parse `json` (with overrides); 1 if the status is `expect` and the message contains every
  * string of the NULL-terminated list (what is missing is printed). */
@@ -373,6 +376,129 @@ static void test_create(void **state)
     mixsph_sim_destroy(NULL); /* NULL-safe */
 }
 
+/* BASE with a max_elevation monitor "top", a profile "surface" rewritten at its maxima and a
+ * full-scale map Z = 1000 z + 5 with the reference observed 105, still 55 (so d_eta% = 100
+ * |Z - 105| / 50); `full_scale` replaces the map's inner text when not NULL. Caller frees. */
+#define FS_MONITORS                                                                                           \
+    "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\", \"min_neighbours\": 0 },\n"                \
+    "    \"surface\": { \"type\": \"profile\", \"medium\": \"water\", \"x_min\": 0.0, \"x_max\": 0.2, \"at_max_of\": \"top\" },\n" \
+    "    \"front\": { \"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\" }\n"
+#define FS_MAP "\"z_scale\": 1000.0, \"z_offset\": 5.0, \"unit\": \"m a.s.l.\", " \
+               "\"reference\": { \"monitor\": \"top\", \"observed\": 105.0, \"still\": 55.0 }"
+
+static char *full_scale_case(const char *monitors, const char *full_scale)
+{
+    char *a = edit("    \"front\": { \"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\" }\n",
+                   monitors ? monitors : FS_MONITORS);
+    char block[1024];
+    snprintf(block, sizeof block, "  \"full_scale\": { %s },\n  \"output\"", full_scale ? full_scale : FS_MAP);
+    char *b = edit_text(a, "  \"output\"", block);
+    free(a);
+    return b;
+}
+
+#define EXPECT_FULL_SCALE_ERROR(monitors, full_scale, ...)                                          \
+    do {                                                                                           \
+        char *j_ = full_scale_case((monitors), (full_scale));                                      \
+        const int ok_ = error_matches(j_, NULL, 0, MIXSPH_ERR_CASE, __VA_ARGS__, (const char *)NULL); \
+        free(j_);                                                                                  \
+        assert_true(ok_);                                                                          \
+    } while (0)
+
+/* The optional full_scale key: every error names the key path and what was expected. */
+static void test_full_scale_errors(void **state)
+{
+    (void)state;
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_offset\": 0.3", ORIGIN ": full_scale.z_scale: missing (expected a number)");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": -2", ORIGIN ": full_scale.z_scale: -2 is out of range (expected 0 <");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"zoffset\": 1", ORIGIN ": full_scale.zoffset: unknown key");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"unit\": 3", ORIGIN ": full_scale.unit: expected a string");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": 3", ORIGIN ": full_scale.reference: expected an object");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": { \"monitor\": \"top\", \"observed\": 2, \"still\": 1, \"x\": 0 }",
+                            ORIGIN ": full_scale.reference.x: unknown key");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": { \"observed\": 2, \"still\": 1 }",
+                            ORIGIN ": full_scale.reference.monitor: missing (expected a string)");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": { \"monitor\": \"front\", \"observed\": 2, \"still\": 1 }",
+                            ORIGIN ": full_scale.reference.monitor: 'front' is not one of the max_elevation monitors");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": { \"monitor\": \"top\", \"still\": 1 }",
+                            ORIGIN ": full_scale.reference.observed: missing (expected a number)");
+    EXPECT_FULL_SCALE_ERROR(NULL, "\"z_scale\": 2, \"reference\": { \"monitor\": \"top\", \"observed\": 1, \"still\": 2 }",
+                            ORIGIN ": full_scale.reference: observed (1) must lie above still (2)");
+    /* the derived output names must fit */
+    EXPECT_FULL_SCALE_ERROR(
+        "    \"a_monitor_name_of_forty_five_characters_xxxxx\": { \"type\": \"max_elevation\", \"medium\": \"water\" }\n",
+        "\"z_scale\": 2", ORIGIN ": full_scale: the monitor name 'a_monitor_name_of_forty_five_characters_xxxxx' is too long",
+        "(expected at most 41 characters)");
+    /* at_max_of belongs to profiles and names a max_elevation monitor */
+    EXPECT_FULL_SCALE_ERROR(
+        "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\", \"at_max_of\": \"top\" }\n", NULL,
+        ORIGIN ": monitors.top.at_max_of: only a profile takes at_max_of");
+    EXPECT_FULL_SCALE_ERROR(
+        "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\" },\n"
+        "    \"surface\": { \"type\": \"profile\", \"medium\": \"water\", \"x_min\": 0.0, \"x_max\": 0.2, \"at_max_of\": \"fr\" }\n",
+        NULL, ORIGIN ": monitors.surface.at_max_of: 'fr' is not one of the max_elevation monitors");
+    EXPECT_FULL_SCALE_ERROR(
+        "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\" },\n"
+        "    \"surface\": { \"type\": \"profile\", \"medium\": \"water\", \"x_min\": 0.0, \"x_max\": 0.2 }\n",
+        NULL, ORIGIN ": monitors.surface.times: missing (expected an array of numbers)");
+    /* full_scale is a top-level key: a misspelling is caught */
+    EXPECT_EDIT_ERROR("  \"output\"", "  \"full_scal\": { \"z_scale\": 2 },\n  \"output\"", ORIGIN ": full_scal: unknown key");
+}
+
+/* The map, the error (13) and the outputs <m>_Z and <m>_d_eta of a running simulation. */
+static void test_full_scale_map(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    char *j = full_scale_case(NULL, NULL);
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.full_scale.on && c.full_scale.ref_monitor == 0);
+    assert_string_equal(c.full_scale.unit, "m a.s.l.");
+    assert_int_equal(c.monitors[1].at_max_of, 0);
+    assert_int_equal(c.monitors[1].n_times, 0);
+    assert_true(fabs(case_full_scale_z(&c, 0.1) - 105.0) < 1e-12);
+    assert_true(fabs(case_full_scale_error(&c, 95.0) - 20.0) < 1e-12); /* 100 |95 - 105| / 50 */
+    case_free(&c);
+
+    /* a simulation gets top_Z = 1000 top + 5 and top_d_eta from the highest top so far */
+    mixsph_sim *s = NULL;
+    assert_int_equal(mixsph_sim_create_from_text(j, ORIGIN, NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    free(j);
+    const long kt = mixsph_sim_output_find(s, "top"), kz = mixsph_sim_output_find(s, "top_Z"),
+               ke = mixsph_sim_output_find(s, "top_d_eta");
+    assert_true(kt >= 0 && kz > kt && ke > kz);
+    assert_int_equal(mixsph_sim_output_find(s, "front_Z"), -1); /* only max_elevation monitors are mapped */
+    assert_int_equal(mixsph_sim_advance_to(s, 0.03), MIXSPH_OK);
+    const double top = mixsph_sim_output_value(s, (size_t)kt);
+    assert_true(fabs(top - 0.09) < 0.02); /* the pool is 0.1 m deep, top particle centre 0.09 m */
+    assert_true(fabs(mixsph_sim_output_value(s, (size_t)kz) - (1000.0 * top + 5.0)) < 1e-9);
+    double mx, tmx, mn, tmn, zmx, d;
+    mixsph_sim_output_extremes(s, (size_t)kt, &mx, &tmx, &mn, &tmn);
+    mixsph_sim_output_extremes(s, (size_t)kz, &zmx, &d, &mn, &tmn);
+    assert_true(fabs(zmx - (1000.0 * mx + 5.0)) < 1e-9);
+    assert_true(fabs(mixsph_sim_output_value(s, (size_t)ke) - 100.0 * fabs(zmx - 105.0) / 50.0) < 1e-9);
+    mixsph_sim_destroy(s);
+
+    /* the Vajont case: Z = 1211.8 z + 0.3, Z_exp = 863, Z_still = 700, i.e. the lab-frame
+     * d_eta% = 100 |z - 0.712| / 0.1345 of CASES.md (within 0.1 % for the paper's run-ups: the
+     * map puts z = 0.712 at 863.1 and 0.1345 m at 163.0 m) */
+    char *text = NULL;
+    assert_int_equal(case_read_file(MIXSPH_SOURCE_DIR "/cases/vajont_padua.json", &text, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(case_parse(text, "vajont_padua.json", NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    free(text);
+    assert_true(c.full_scale.on);
+    assert_string_equal(c.monitors[c.full_scale.ref_monitor].name, "run_up");
+    const double paper_z[] = {0.718, 0.733, 0.708, 0.701, 0.702, 0.699};
+    const double paper_Z[] = {870.3, 888.5, 858.2, 849.7, 850.9, 847.3}; /* Table 5 */
+    for (size_t k = 0; k < 6; k++) {
+        const double Z = case_full_scale_z(&c, paper_z[k]);
+        assert_true(fabs(Z - paper_Z[k]) < 0.2);  /* the map is a fit to Table 5, within 0.2 m */
+        assert_true(fabs(case_full_scale_error(&c, Z) - 100.0 * fabs(paper_z[k] - 0.712) / 0.1345) < 0.1);
+    }
+    case_free(&c);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -388,6 +514,8 @@ int main(void)
         cmocka_unit_test(test_overrides),
         cmocka_unit_test(test_override_parse),
         cmocka_unit_test(test_create),
+        cmocka_unit_test(test_full_scale_errors),
+        cmocka_unit_test(test_full_scale_map),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
