@@ -1,6 +1,8 @@
 /* mixsph - run a case file.
  *
  *   mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]
+ *              [--checkpoint-every SECONDS]
+ *   mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]
  *
  * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
  * on stdout and summary.json in the output folder. Exit codes: 0 ok, 2 bad usage or input,
@@ -20,10 +22,18 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]\n"
+            "                  [--checkpoint-every SECONDS]\n"
+            "       mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]\n"
             "  --set key=value   override a numeric case value, e.g. --set numerics.dx=0.01\n"
             "  --out DIR         output folder (default: out/<case name>)\n"
             "  --threads N       OpenMP threads (default: all cores)\n"
-            "  --quiet           no progress line\n");
+            "  --quiet           no progress line\n"
+            "  --checkpoint-every SECONDS\n"
+            "                    write DIR/checkpoint.h5 every SECONDS of wall time (0: at every progress\n"
+            "                    step, t_end/1000); it replaces the previous one atomically\n"
+            "  --restart FILE    continue the run saved in checkpoint FILE (the case and overrides come from\n"
+            "                    it); output folder: --out, default the checkpoint's folder, whose files\n"
+            "                    (monitors.csv, run.h5, snapshots) are continued from the checkpoint's time\n");
 }
 
 static int exit_code(mixsph_status st)
@@ -139,14 +149,16 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
 
 static int cmd_run(int argc, char **argv)
 {
-    const char *case_path = NULL, *out_dir = NULL;
+    const char *case_path = NULL, *out_dir = NULL, *restart = NULL;
+    double ckpt_every = -1.0; /* wall seconds between checkpoints, < 0: none */
     mixsph_override sets[MAX_SETS];
     size_t n_sets = 0;
     int threads = 0, quiet = 0;
     char err[1024];
     for (int a = 0; a < argc; a++) {
         const char *arg = argv[a];
-        if (strcmp(arg, "--set") == 0 || strcmp(arg, "--out") == 0 || strcmp(arg, "--threads") == 0) {
+        if (strcmp(arg, "--set") == 0 || strcmp(arg, "--out") == 0 || strcmp(arg, "--threads") == 0 ||
+            strcmp(arg, "--restart") == 0 || strcmp(arg, "--checkpoint-every") == 0) {
             if (a + 1 >= argc) {
                 fprintf(stderr, "mixsph: %s needs a value\n", arg);
                 return 2;
@@ -154,6 +166,15 @@ static int cmd_run(int argc, char **argv)
             char *val = argv[++a];
             if (strcmp(arg, "--out") == 0) {
                 out_dir = val;
+            } else if (strcmp(arg, "--restart") == 0) {
+                restart = val;
+            } else if (strcmp(arg, "--checkpoint-every") == 0) {
+                char *end;
+                ckpt_every = strtod(val, &end);
+                if (*end || !(ckpt_every >= 0.0 && ckpt_every < 1e9)) {
+                    fprintf(stderr, "mixsph: --checkpoint-every: '%s' is not a number of seconds >= 0\n", val);
+                    return 2;
+                }
             } else if (strcmp(arg, "--threads") == 0) {
                 char *end;
                 long v = strtol(val, &end, 10);
@@ -186,21 +207,40 @@ static int cmd_run(int argc, char **argv)
             return 2;
         }
     }
-    if (!case_path) {
+    if (restart && (case_path || n_sets > 0)) {
+        fprintf(stderr, "mixsph: --restart takes the case and its overrides from the checkpoint: give no case file "
+                        "and no --set\n");
+        return 2;
+    }
+    if (!case_path && !restart) {
         fprintf(stderr, "mixsph: run: no case file given\n");
         usage(stderr);
         return 2;
     }
     mixsph_sim *s = NULL;
-    mixsph_status st = mixsph_sim_create(case_path, sets, n_sets, &s, err, sizeof err);
+    mixsph_status st = restart ? mixsph_sim_create_from_checkpoint(restart, &s, err, sizeof err)
+                               : mixsph_sim_create(case_path, sets, n_sets, &s, err, sizeof err);
     if (st != MIXSPH_OK) {
         fprintf(stderr, "mixsph: %s\n", err);
         return exit_code(st);
     }
+    if (restart) case_path = mixsph_sim_case_origin(s);
     char dir[1024];
-    if (out_dir) snprintf(dir, sizeof dir, "%s", out_dir);
-    else snprintf(dir, sizeof dir, "out/%s", mixsph_sim_name(s));
-    if ((st = mixsph_sim_set_threads(s, threads)) != MIXSPH_OK || (st = mixsph_sim_set_output_dir(s, dir)) != MIXSPH_OK) {
+    if (out_dir) {
+        snprintf(dir, sizeof dir, "%s", out_dir);
+    } else if (restart) { /* the checkpoint's folder */
+        snprintf(dir, sizeof dir, "%s", restart);
+        char *slash = strrchr(dir, '/');
+        if (slash == dir) dir[1] = '\0';
+        else if (slash) *slash = '\0';
+        else snprintf(dir, sizeof dir, ".");
+    } else {
+        snprintf(dir, sizeof dir, "out/%s", mixsph_sim_name(s));
+    }
+    char ckpt[1100];
+    snprintf(ckpt, sizeof ckpt, "%s/checkpoint.h5", dir);
+    if ((st = mixsph_sim_set_threads(s, threads)) != MIXSPH_OK ||
+        (st = restart ? mixsph_sim_resume_output_dir(s, dir) : mixsph_sim_set_output_dir(s, dir)) != MIXSPH_OK) {
         fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));
         mixsph_sim_destroy(s);
         return exit_code(st);
@@ -209,11 +249,21 @@ static int cmd_run(int argc, char **argv)
     if (!quiet)
         fprintf(stderr, "mixsph: %s: %zu particles + %zu wall particles, t_end = %g s, output in %s\n", mixsph_sim_name(s),
                 mixsph_sim_particles(s), mixsph_sim_wall_particles(s), mixsph_sim_end_time(s), dir);
+    if (!quiet && restart)
+        fprintf(stderr, "mixsph: restarting from %s at t = %.6g s, step %llu\n", restart, mixsph_sim_time(s),
+                (unsigned long long)mixsph_sim_steps(s));
     const double t_end = mixsph_sim_end_time(s), t0 = now();
-    double last_print = 0.0;
+    double last_print = 0.0, last_ckpt = t0;
+    unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
     for (int c = 1; c <= chunks && st == MIXSPH_OK; c++) {
         st = mixsph_sim_advance_to(s, t_end * c / chunks);
+        if (st == MIXSPH_OK && ckpt_every >= 0.0 && c < chunks && mixsph_sim_steps(s) > ckpt_step &&
+            now() - last_ckpt >= ckpt_every) {
+            st = mixsph_sim_write_checkpoint(s, ckpt);
+            last_ckpt = now();
+            ckpt_step = mixsph_sim_steps(s);
+        }
         const double el = now() - t0;
         if (tty && (el - last_print > 0.5 || c == chunks)) {
             last_print = el;

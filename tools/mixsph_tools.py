@@ -4,6 +4,7 @@
     mon = mt.read_monitors("out/x/monitors.csv")        # {"t": array, "water_front": array, ...}
     summ = mt.read_summary("out/x/summary.json")        # dict; JSON null -> nan in "outputs"
     prof = mt.find_profile("out/x", "interface", 0.5)   # Profile or None (not written)
+    t, snap = mt.read_snapshot("out/x/snap_0003.csv")  # (time, {"x": array, ...})
 
 Every reader raises ``ToolError`` with a message naming the file and what is wrong; the scripts
 catch it and print it (no traceback for a user's mistake).
@@ -144,3 +145,54 @@ def first_time_below(t, v, threshold):
     """First t at which v < threshold (nan values never count), nan if never."""
     idx = np.flatnonzero(np.isfinite(v) & (v < threshold))
     return float(t[idx[0]]) if idx.size else math.nan
+
+
+_SNAP_HEAD = re.compile(r"#\s*t\s*=\s*([-+0-9.eE]+)\s*s")
+SNAP_COLUMNS = ("id", "x", "z", "vx", "vz", "rho", "p", "mu", "medium", "state")
+STATE_MOBILE, STATE_FIXED, STATE_WALL, STATE_LOST = 0, 1, 2, 3
+
+
+def snapshot_time(path):
+    """Simulated time [s] of a snap_NNNN.csv (its first line '# t = <t> s')."""
+    try:
+        with open(path) as f:
+            first = f.readline()
+    except OSError as e:
+        raise ToolError(f"{path}: cannot read: {e}") from None
+    m = _SNAP_HEAD.match(first)
+    if not m:
+        raise ToolError(f"{path}: first line '{first.strip()}' is not '# t = T s'")
+    return float(m.group(1))
+
+
+def list_snapshots(outdir):
+    """[(t, path)] of the snap_NNNN.csv files of an output folder, by time."""
+    snaps = []
+    for path in glob.glob(os.path.join(glob.escape(outdir), "snap_*.csv")):
+        if re.fullmatch(r"snap_\d+\.csv", os.path.basename(path)):
+            snaps.append((snapshot_time(path), path))
+    return sorted(snaps)
+
+
+def read_snapshot(path):
+    """(t, {column: array}) of one snap_NNNN.csv (columns id,x,z,vx,vz,rho,p,mu,medium,state)."""
+    t = snapshot_time(path)
+    with open(path) as f:
+        f.readline()
+        header = f.readline().strip().split(",")
+    if tuple(header) != SNAP_COLUMNS:
+        raise ToolError(f"{path}: second line '{','.join(header)}' is not '{','.join(SNAP_COLUMNS)}'")
+    try:
+        data = np.loadtxt(path, delimiter=",", skiprows=2, ndmin=2)
+    except ValueError as e:
+        raise ToolError(f"{path}: cannot read: {e}") from None
+    data = data.reshape(-1, len(SNAP_COLUMNS))
+    return t, {name: data[:, k] for k, name in enumerate(SNAP_COLUMNS)}
+
+
+def nearest_snapshot(outdir, t):
+    """(t_snap, path) of the snapshot closest in time to t, or None when there is none."""
+    snaps = list_snapshots(outdir)
+    if not snaps:
+        return None
+    return min(snaps, key=lambda s: abs(s[0] - t))

@@ -71,8 +71,9 @@ void mixsph_sim_destroy(mixsph_sim *s);
 /** Number of OpenMP threads used by this simulation (0 = OpenMP default). */
 mixsph_status mixsph_sim_set_threads(mixsph_sim *s, int n_threads);
 
-/** Write monitors (monitors.csv) and particle snapshots (snap_NNNN.csv) into `dir`, which is
- *  created if missing. Checked immediately: an unwritable folder is an error here. */
+/** Write monitors (monitors.csv) and particle snapshots (snap_NNNN.csv, and all of them in the
+ *  HDF5 file run.h5 with its XDMF sidecar run.xdmf for ParaView) into `dir`, which is created if
+ *  missing. Checked immediately: an unwritable folder or file is an error here (MIXSPH_ERR_IO). */
 mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir);
 
 /**
@@ -156,6 +157,25 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len);
  *  stored in the state, then the state is loaded. */
 mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err,
                                            size_t err_len);
+
+/** Write a checkpoint: an HDF5 file holding the state of mixsph_sim_save_state (dataset
+ *  /state) with the time and step as attributes. It is written to `path`.tmp and renamed to
+ *  `path`, so a crash leaves either the previous checkpoint or the new one, never half of one. */
+mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path);
+
+/** Create a simulation from a checkpoint file (restart). */
+mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len);
+
+/** As mixsph_sim_set_output_dir for a simulation restored from a checkpoint, continuing the
+ *  run's files in `dir`: monitors.csv keeps its rows up to the restored state and is appended
+ *  to; run.h5 (if there) must hold the same case and overrides: its snapshots up to the restored
+ *  state are kept, later ones (written by the interrupted run after its checkpoint) are dropped
+ *  and written again as the run continues. Without earlier files they are started anew. */
+mixsph_status mixsph_sim_resume_output_dir(mixsph_sim *s, const char *dir);
+
+/** Wall time this simulation has spent writing CSV snapshots, HDF5 snapshots (with the XDMF
+ *  sidecar) and checkpoints [s] (any pointer may be NULL). */
+void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, double *checkpoint_s);
 
 /** The JSON text and origin (file name) the simulation was created from (for metadata). */
 const char *mixsph_sim_case_text(const mixsph_sim *s);

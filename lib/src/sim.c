@@ -9,6 +9,7 @@
 #include <sys/stat.h>
 
 #include "eos.h"
+#include "output.h"
 #include "status.h"
 
 /* A lattice site of a body, for the hydrostatic initialisation. */
@@ -273,6 +274,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
 {
     if (!s) return;
     if (s->monitor_csv) fclose(s->monitor_csv);
+    output_close(s);
     if (s->has_granular) mixture_free(s);
     particles_free(&s->P);
     cells_free(&s->C);
@@ -293,7 +295,9 @@ mixsph_status mixsph_sim_set_threads(mixsph_sim *s, int n_threads)
     return MIXSPH_OK;
 }
 
-mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir)
+/* Output folder: created if missing; new files (resume = 0) or the files of the run a restored
+ * state came from continued (resume = 1, output.c). */
+static mixsph_status sim_output_dir(mixsph_sim *s, const char *dir, int resume)
 {
     if (!s || !dir || !*dir) return s ? SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: empty name") : MIXSPH_ERR_ARG;
     if (strlen(dir) >= sizeof s->out_dir) return SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: name too long");
@@ -313,9 +317,21 @@ mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir)
         fclose(s->monitor_csv);
         s->monitor_csv = NULL;
     }
+    output_close(s);
     strcpy(s->out_dir, dir);
-    return monitors_open(s);
+    mixsph_status st = output_open(s, resume); /* first: it refuses the folder of another run */
+    if (st == MIXSPH_OK) st = resume ? output_resume_monitors(s) : monitors_open(s);
+    if (st != MIXSPH_OK) { /* no half-set output folder */
+        if (s->monitor_csv) fclose(s->monitor_csv);
+        s->monitor_csv = NULL;
+        s->out_dir[0] = '\0';
+    }
+    return st;
 }
+
+mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir) { return sim_output_dir(s, dir, 0); }
+
+mixsph_status mixsph_sim_resume_output_dir(mixsph_sim *s, const char *dir) { return sim_output_dir(s, dir, 1); }
 
 /* Take the samples and snapshots that are due at the current time. */
 static mixsph_status sim_outputs_due(mixsph_sim *s)
@@ -326,7 +342,7 @@ static mixsph_status sim_outputs_due(mixsph_sim *s)
         while (s->next_sample <= s->t + 1e-12) s->next_sample += s->cfg.monitor_interval;
     }
     if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out_dir[0] && s->t >= s->next_snapshot - 1e-12) {
-        st = monitors_snapshot(s);
+        st = output_snapshot(s); /* snap_NNNN.csv and run.h5 */
         while (s->next_snapshot <= s->t + 1e-12) s->next_snapshot += s->cfg.snapshot_interval;
     }
     return st;

@@ -73,6 +73,8 @@ struct mixsph_sim {
     int snap_index;
     char out_dir[512];
     FILE *monitor_csv;
+    struct output *h5;            /* run.h5 and run.xdmf (output.c); NULL without an output folder */
+    double out_seconds[3];        /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
 
     char err[1024];
 };

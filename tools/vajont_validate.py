@@ -1,0 +1,714 @@
+#!/usr/bin/env python3
+"""Vajont validation: run the paper's runs V1-V6 of the Padua 1968 experiment (test No. 48) and
+compare them with Manenti et al. (2018), Section 3.2, Tables 3-5 and Figs 7-10.
+
+    python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--out out/vajont]
+                                    [--reuse] [--t-end T] [--plot-runs 1,2,4] [--mixsph build/mixsph]
+                                    [--case cases/vajont_padua.json]
+
+Runs are done one after the other (each with --threads N, default all cores). Run k is
+``mixsph run CASE --out OUT/V<k>_dx<D> --set numerics.dx=... --set parameters.<...>=...
+--threads N --quiet`` (stdout and stderr in OUT/V<k>_dx<D>/mixsph.log):
+
+    run  change from V1 (the case's default)               paper dx
+    V1   -                                                 0.005
+    V2   phi = 25 deg            (parameters.phi)          0.005
+    V3   mu0 = 10 kPa s          (parameters.mu0)          0.005
+    V4   saturated below z = 0.46 (parameters.saturated=1) 0.005
+    V5   as V4, mu0 = 7.5 kPa s, dx x 1.25                 0.00625
+    V6   as V4, mu0 = 10 kPa s,  dx x 1.5                  0.0075
+
+``--dx D`` is the spacing of V1-V4; V5 and V6 keep the paper's ratios to it (1.25 D and 1.5 D), so
+``--dx 0.005`` gives exactly the paper's runs. ``--reuse`` keeps a run whose summary.json says
+"ok" for the same t_end and settings (recorded in OUT/V<k>_dx<D>/vajont_run.json).
+
+Run-up (the case's monitor ``run_up``, lib/src/monitors.c): the highest z of a water particle
+centre over the opposite slope (x in [0.75, 1.81] m) among the water particles that have at least
+3 water neighbours within the kernel support 2h (isolated spray does not count), sampled every
+0.005 s; the maximum over the run and its time. Full scale Z = 1211.8 z + 0.3 m a.m.s.l. (the
+case's ``full_scale`` map, fitted to the paper's Table 5) and the paper's error (13)
+d_eta% = |Z - Z_exp| / (Z_exp - Z_still) * 100 with Z_exp = 863.0, Z_still = 700.0, i.e.
+100 |z - 0.712| / 0.1345 in the lab frame.
+
+Printed: the paper's Tables 4-5 beside ours (elapsed time, max run-up, its time, Z, d_eta%), the
+steps, particles, lost particles, the mass balance (largest relative change of the total mass of
+fluid and granular particles), the wall-crossing corrections and whether the paper's ordering holds
+(lower phi, V2, raises the run-up; saturation, V4, lowers it). Written: OUT/vajont_table.csv,
+OUT/vajont_table.md and OUT/vajont_profiles.png (like the paper's Figs 7-10): per plotted run the
+water surface and the landslide surface at the time of the maximum run-up (the case's profiles
+``*_atmax``, rewritten at every new maximum of ``run_up``) over the bed, with the experimental
+maximum run-up line, and velocity-magnitude snapshots of the first plotted run at the plate's stop
+(t = 0.8 s) and at its maximum run-up (nearest snapshot, one every 0.1 s).
+
+Exit status: 0 ok; 1 a run failed (the others still run and the table is printed); 2 bad usage
+or input; 130 interrupted.
+
+Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
+modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mixsph_tools as mt  # noqa: E402
+
+PROG = "vajont_validate.py"
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+EXP_RUN_UP = 0.712        # [m] lab frame, test No. 48
+EXP_Z = 863.0             # [m a.m.s.l.]
+STILL_LEVEL = 0.46        # [m] reservoir level of the model
+PAPER_DX = 0.005          # [m]
+PLATE_STOP = 0.8          # [s] the plate stops
+T_TOL = 1e-3              # [s]
+
+
+@dataclass(frozen=True)
+class PaperRun:
+    run: int
+    change: str
+    sets: tuple           # (key, value) overrides besides numerics.dx
+    dx_ratio: float       # dx of the run / dx of V1
+    elapsed_s: float      # paper's elapsed time (16 cores, 2.3 GHz) [s]
+    run_up: float         # [m]
+    t_run_up: float       # [s]
+    Z: float              # [m a.m.s.l.]
+    d_eta: float          # [%]
+
+
+PAPER = {
+    1: PaperRun(1, "reference", (), 1.0, 21395, 0.718, 1.35, 870.3, 5),
+    2: PaperRun(2, "phi = 25 deg", (("parameters.phi", 25.0),), 1.0, 22705, 0.733, 1.35, 888.5, 16),
+    3: PaperRun(3, "mu0 = 10 kPa s", (("parameters.mu0", 10e3),), 1.0, 43814, 0.708, 1.35, 858.2, 3),
+    4: PaperRun(4, "saturated", (("parameters.saturated", 1),), 1.0, 21738, 0.701, 1.35, 849.7, 8),
+    5: PaperRun(5, "V4, mu0 = 7.5 kPa s, dx x1.25", (("parameters.saturated", 1), ("parameters.mu0", 7.5e3)), 1.25,
+                14476, 0.702, 1.35, 850.9, 7),
+    6: PaperRun(6, "V4, mu0 = 10 kPa s, dx x1.5", (("parameters.saturated", 1), ("parameters.mu0", 10e3)), 1.5,
+                9334, 0.699, 1.35, 847.3, 9),
+}
+
+
+def fail(msg, code=2):
+    print(f"{PROG}: error: {msg}", file=sys.stderr)
+    sys.exit(code)
+
+
+def warn(msg):
+    print(f"{PROG}: warning: {msg}", file=sys.stderr)
+
+
+def show(path):
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
+
+
+def num(v):
+    v = float(v)
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
+def fmt(v, spec, na="n/a"):
+    return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na
+
+
+def fmt_duration(s):
+    if not math.isfinite(s):
+        return "--"
+    s = int(round(s))
+    if s < 60:
+        return f"{s}s"
+    if s < 3600:
+        return f"{s // 60}m{s % 60:02d}s"
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
+def d_eta(z):
+    """The paper's error (13) in the lab frame [%]."""
+    return 100.0 * abs(z - EXP_RUN_UP) / 0.1345 if math.isfinite(z) else math.nan
+
+
+# ---- runs -----------------------------------------------------------------------------------------
+
+
+@dataclass
+class Job:
+    paper: PaperRun
+    dx: float
+    outdir: str
+    cmd: list
+    stamp: dict
+    source: str = ""       # "ran", "reused", "FAILED", "not run"
+    message: str = ""
+
+
+OUTPUT_FILES = ("summary.json", "monitors.csv", "mixsph.log", "vajont_run.json")
+
+
+def clean_outdir(d):
+    if not os.path.isdir(d):
+        return
+    for name in os.listdir(d):
+        if name in OUTPUT_FILES or (name.endswith(".csv") and name.startswith(("profile_", "snap_"))):
+            os.remove(os.path.join(d, name))
+
+
+def reusable(job, t_end):
+    summ_path = os.path.join(job.outdir, "summary.json")
+    if not os.path.isfile(summ_path):
+        return False, "no summary.json"
+    try:
+        summ = mt.read_summary(summ_path)
+    except mt.ToolError as e:
+        return False, str(e)
+    if summ.get("status") != "ok":
+        return False, f"its summary.json says status '{summ.get('status')}'"
+    st = summ.get("simulated_time_s")
+    if not isinstance(st, (int, float)) or abs(st - t_end) > T_TOL:
+        return False, f"it ran to t = {st} s, not t_end = {t_end:g} s"
+    stamp_path = os.path.join(job.outdir, "vajont_run.json")
+    if os.path.isfile(stamp_path):
+        try:
+            with open(stamp_path) as f:
+                old = json.load(f)
+        except (OSError, ValueError):
+            old = None
+        if not isinstance(old, dict) or any(old.get(k) != job.stamp.get(k) for k in ("run", "dx", "sets", "t_end", "case")):
+            return False, f"{show(stamp_path)} records other settings"
+    return True, f"summary ok, t = {st:.4g} s"
+
+
+def last_time(monitors_csv):
+    try:
+        with open(monitors_csv, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            n = f.tell()
+            f.seek(max(0, n - 4096))
+            raw = f.read()
+    except OSError:
+        return math.nan
+    lines = raw.decode(errors="replace").split("\n")
+    lines = lines[1:-1] if n > 4096 else lines[:-1]
+    for line in reversed(lines):
+        try:
+            return float(line.split(",", 1)[0])
+        except ValueError:
+            continue
+    return math.nan
+
+
+def tail(path, n=8):
+    try:
+        with open(path, errors="replace") as f:
+            return f.read().splitlines()[-n:]
+    except OSError:
+        return []
+
+
+def run_job(job, t_end, progress_every):
+    """Run one job to completion. Returns the exit code of mixsph."""
+    os.makedirs(job.outdir, exist_ok=True)
+    clean_outdir(job.outdir)
+    with open(os.path.join(job.outdir, "vajont_run.json"), "w") as f:
+        json.dump(job.stamp, f, indent=2)
+        f.write("\n")
+    with open(os.path.join(job.outdir, "mixsph.log"), "w") as log:
+        log.write("$ " + " ".join(job.cmd) + "\n")
+        log.flush()
+        t0 = time.monotonic()
+        try:
+            proc = subprocess.Popen(job.cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+        except OSError as e:
+            fail(f"cannot start {job.cmd[0]}: {e}")
+        print(f"V{job.paper.run}: started, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
+        last = t0
+        try:
+            while proc.poll() is None:
+                time.sleep(0.5)
+                now = time.monotonic()
+                if progress_every > 0 and now - last >= progress_every:
+                    last = now
+                    ts = last_time(os.path.join(job.outdir, "monitors.csv"))
+                    el = now - t0
+                    eta = el * (t_end - ts) / ts if math.isfinite(ts) and ts > 0 else math.nan
+                    print(f"  [{fmt_duration(el)}] V{job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s "
+                          f"(ETA {fmt_duration(eta)})", flush=True)
+        except KeyboardInterrupt:
+            proc.terminate()
+            try:
+                proc.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait()
+            print(f"\n{PROG}: interrupted; stopped V{job.paper.run}", file=sys.stderr)
+            sys.exit(130)
+    rc = proc.returncode
+    el = time.monotonic() - t0
+    if rc == 0:
+        job.source = "ran"
+        print(f"V{job.paper.run}: done in {fmt_duration(el)}", flush=True)
+    else:
+        what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
+        job.source = "FAILED"
+        job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else f"killed by signal {-rc}"
+        print(f"V{job.paper.run}: FAILED after {fmt_duration(el)}: {job.message}; "
+              f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
+        for line in tail(os.path.join(job.outdir, "mixsph.log")):
+            print(f"    | {line}", flush=True)
+    return rc
+
+
+# ---- analysis -------------------------------------------------------------------------------------
+
+
+@dataclass
+class Result:
+    paper: PaperRun
+    dx: float
+    outdir: str
+    source: str
+    status: str = "missing"
+    threads: int = 0
+    particles: int = 0
+    steps: int = 0
+    sim_time: float = math.nan
+    wall: float = math.nan
+    psteps: float = math.nan
+    run_up: float = math.nan
+    t_run_up: float = math.nan
+    Z: float = math.nan
+    d_eta: float = math.nan
+    lost: float = math.nan
+    mass_drift: float = math.nan      # max |m - m0| / m0
+    wall_corr: float = math.nan
+    front_max: float = math.nan
+    vmax_stop: float = math.nan       # max speed around the plate's stop [m/s]
+    profiles: dict = field(default_factory=dict)   # name -> mt.Profile at the max run-up
+
+    @property
+    def ok(self):
+        return self.status == "ok"
+
+
+PROFILE_NAMES = ("water_surface", "landslide_surface_above", "landslide_surface_below")
+
+
+def load_result(job):
+    r = Result(job.paper, job.dx, job.outdir, job.source)
+    if job.source == "not run":
+        r.status = "not run"
+        return r
+    summ_path = os.path.join(job.outdir, "summary.json")
+    if not os.path.isfile(summ_path):
+        r.status = "no summary"
+        return r
+    s = mt.read_summary(summ_path)
+    r.status = str(s.get("status"))
+    r.threads = int(s.get("threads") or 0)
+    r.particles = int(s.get("particles") or 0)
+    r.steps = int(s.get("steps") or 0)
+    r.sim_time = float(s.get("simulated_time_s") or math.nan)
+    r.wall = float(s.get("wall_time_s") or math.nan)
+    r.psteps = float(s.get("particle_steps_per_s") or math.nan)
+    r.run_up = mt.summary_value(s, "run_up", "max")
+    r.t_run_up = mt.summary_value(s, "run_up", "t_max")
+    r.Z = mt.summary_value(s, "run_up_Z", "max")
+    r.d_eta = mt.summary_value(s, "run_up_d_eta", "final")
+    if not math.isfinite(r.d_eta):
+        r.d_eta = d_eta(r.run_up)
+    r.lost = mt.summary_value(s, "lost_particles", "max")
+    r.wall_corr = mt.summary_value(s, "wall_corrections", "final")
+    r.front_max = mt.summary_value(s, "landslide_front", "max")
+    mon_path = os.path.join(job.outdir, "monitors.csv")
+    if os.path.isfile(mon_path):
+        mon = mt.read_monitors(mon_path)
+        m = mon.get("mass")
+        if m is not None and m.size and m[0] > 0:
+            r.mass_drift = float(np.nanmax(np.abs(m - m[0])) / m[0])
+        v = mon.get("max_speed")
+        if v is not None:
+            sel = (mon["t"] >= PLATE_STOP - 0.1) & (mon["t"] <= PLATE_STOP + 0.1)
+            if sel.any():
+                r.vmax_stop = float(np.nanmax(v[sel]))
+    for name in PROFILE_NAMES:
+        path = os.path.join(job.outdir, f"profile_{name}_atmax.csv")
+        if os.path.isfile(path):
+            r.profiles[name] = mt.read_profile(path)
+    return r
+
+
+# ---- table ----------------------------------------------------------------------------------------
+
+
+COLUMNS = [
+    ("run", "<"), ("change", "<"), ("status", "<"), ("dx [m]", ">"), ("particles", ">"), ("steps", ">"),
+    ("wall s", ">"), ("paper s", ">"), ("run-up [m]", ">"), ("paper", ">"), ("t [s]", ">"), ("paper ", ">"),
+    ("Z [m asl]", ">"), ("paper  ", ">"), ("d_eta %", ">"), ("paper   ", ">"), ("lost", ">"), ("mass drift", ">"),
+]
+
+
+def rows_of(results):
+    rows = []
+    for r in results:
+        p = r.paper
+        status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
+        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 1.6) > T_TOL:
+            status += f", t={r.sim_time:.3g} s"
+        rows.append([
+            f"V{p.run}", p.change, status, fmt(r.dx, "g"), str(r.particles) if r.particles else "n/a",
+            str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), f"{p.elapsed_s:,.0f}",
+            fmt(r.run_up, ".3f"), f"{p.run_up:.3f}", fmt(r.t_run_up, ".2f"), f"{p.t_run_up:.2f}",
+            fmt(r.Z, ".1f"), f"{p.Z:.1f}", fmt(r.d_eta, ".1f"), f"{p.d_eta:g}",
+            fmt(r.lost, ".0f"), fmt(r.mass_drift, ".1e"),
+        ])
+    rows.append(["exp.", "test No. 48", "", "", "", "", "", "", f"{EXP_RUN_UP:.3f}", "", "", "",
+                 f"{EXP_Z:.1f}", "", "", "", "", ""])
+    return rows
+
+
+def print_table(rows):
+    w = [max(len(c[0]), *(len(row[k]) for row in rows)) for k, c in enumerate(COLUMNS)]
+
+    def line(cells):
+        return "  ".join(s.rjust(w[k]) if COLUMNS[k][1] == ">" else s.ljust(w[k]) for k, s in enumerate(cells)).rstrip()
+
+    head = line([c[0].strip() for c in COLUMNS])
+    rule = "-" * len(head)
+    print("\n".join([head, rule] + [line(r) for r in rows[:-1]] + [rule, line(rows[-1]), rule]))
+
+
+def ordering(results):
+    """The paper's ordering: V2 (lower phi) above V1, V4 (saturated) below V1."""
+    by = {r.paper.run: r for r in results if r.ok and math.isfinite(r.run_up)}
+    out = []
+    if 1 in by and 2 in by:
+        d = by[2].run_up - by[1].run_up
+        out.append(("lower phi (V2) raises the run-up", d > 0, f"V2 - V1 = {d * 1000:+.1f} mm (paper +15 mm)"))
+    if 1 in by and 4 in by:
+        d = by[4].run_up - by[1].run_up
+        out.append(("saturation (V4) lowers the run-up", d < 0, f"V4 - V1 = {d * 1000:+.1f} mm (paper -17 mm)"))
+    return out
+
+
+def write_csv(path, results):
+    fields = ["run", "change", "dx_m", "status", "source", "threads", "particles", "steps", "simulated_time_s",
+              "wall_time_s", "particle_steps_per_s", "paper_elapsed_s", "run_up_m", "paper_run_up_m", "t_run_up_s",
+              "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
+              "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
+              "outdir"]
+
+    def v(x):
+        if isinstance(x, float):
+            return f"{x:.6g}" if math.isfinite(x) else "nan"
+        return str(x)
+
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(fields)
+        for r in results:
+            p = r.paper
+            w.writerow([v(x) for x in (
+                f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
+                r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
+                r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.outdir)])
+
+
+def write_md(path, results, header_lines, checks):
+    rows = rows_of(results)
+    with open(path, "w") as f:
+        for line in header_lines:
+            f.write(line + "\n\n")
+        f.write("| " + " | ".join(c[0].strip() for c in COLUMNS) + " |\n")
+        f.write("|" + "|".join(" --- " for _ in COLUMNS) + "|\n")
+        for row in rows:
+            f.write("| " + " | ".join(c if c else " " for c in row) + " |\n")
+        if checks:
+            f.write("\n")
+            for what, holds, detail in checks:
+                f.write(f"- {what}: {'holds' if holds else 'does NOT hold'} ({detail})\n")
+
+
+# ---- figure ---------------------------------------------------------------------------------------
+
+
+BED = np.array([[0.0, 0.28], [0.66, 0.22], [0.72, 0.0], [0.75, 0.0], [1.02, 0.46], [1.81, 0.878]])
+
+
+def landslide_top(r):
+    """Top of the landslide per x bin: the higher of its dry (above) and wet (below) parts."""
+    a, b = r.profiles.get("landslide_surface_above"), r.profiles.get("landslide_surface_below")
+    if a is None and b is None:
+        return None
+    if a is None or b is None:
+        p = a or b
+        return p.x, p.z
+    with np.errstate(invalid="ignore"):
+        z = np.fmax(a.z, b.z)
+    return a.x, z
+
+
+def bed_at(x):
+    return np.interp(x, BED[:, 0], BED[:, 1])
+
+
+def draw_profiles(ax, r):
+    ax.fill_between(BED[:, 0], BED[:, 1], -0.05, color="0.85", lw=0)
+    ax.plot(BED[:, 0], BED[:, 1], color="0.3", lw=1.2)
+    ax.axhline(EXP_RUN_UP, color="r", ls="--", lw=1.0, label=f"experiment: max run-up {EXP_RUN_UP} m")
+    ax.axhline(STILL_LEVEL, color="0.5", ls=":", lw=0.8, label=f"still water {STILL_LEVEL} m")
+    ls = landslide_top(r)
+    if ls is not None:
+        x, z = ls
+        m = np.isfinite(z)
+        ax.fill_between(x[m], bed_at(x[m]), z[m], color="tan", alpha=0.7, step="mid", lw=0)
+        ax.plot(x[m], z[m], ".-", color="saddlebrown", ms=2, lw=1.2, label="landslide surface")
+    w = r.profiles.get("water_surface")
+    if w is not None:
+        m = np.isfinite(w.z)
+        ax.plot(w.x[m], w.z[m], ".-", color="tab:blue", ms=2, lw=1.2, label="water surface")
+    t = next((p.t for p in r.profiles.values()), math.nan)
+    ax.plot([], [], " ", label=f"max run-up {fmt(r.run_up, '.3f')} m (d_eta {fmt(r.d_eta, '.1f')} %)")
+    ax.set_title(f"V{r.paper.run} ({r.paper.change}), dx = {r.dx:g} m, t = {fmt(t, '.3f')} s (max run-up)",
+                 fontsize=9)
+    ax.set_xlim(-0.05, 1.85)
+    ax.set_ylim(-0.05, 1.0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="upper left", fontsize=7)
+
+
+def draw_snapshot(fig, ax, r, t_want, label, granular):
+    near = mt.nearest_snapshot(r.outdir, t_want)
+    if near is None:
+        ax.text(0.5, 0.5, "no snapshots", transform=ax.transAxes, ha="center")
+        return
+    t, s = mt.read_snapshot(near[1])
+    wall = s["state"] == mt.STATE_WALL
+    live = s["state"] <= mt.STATE_FIXED
+    fixed = s["state"] == mt.STATE_FIXED
+    ax.scatter(s["x"][wall], s["z"][wall], s=1, c="0.6", lw=0)
+    speed = np.hypot(s["vx"], s["vz"])
+    size = max(1.0, 4.0 * (r.dx / 0.01) ** 2)
+    sc = ax.scatter(s["x"][live], s["z"][live], s=size, c=speed[live], cmap="jet", vmin=0.0, vmax=1.2, lw=0)
+    if fixed.any():
+        ax.scatter(s["x"][fixed], s["z"][fixed], s=size, facecolors="none", edgecolors="k", lw=0.3)
+    # the landslide surface: top of the granular particles per x bin of 2 dx
+    gr = live & np.isin(s["medium"], granular)
+    if gr.any():
+        b = np.floor(s["x"][gr] / (2 * r.dx)).astype(int)
+        tops = {}
+        for k, z in zip(b, s["z"][gr]):
+            tops[k] = max(tops.get(k, -np.inf), z)
+        ks = sorted(tops)
+        ax.plot([(k + 0.5) * 2 * r.dx for k in ks], [tops[k] + 0.5 * r.dx for k in ks], "k-", lw=1.0,
+                label="landslide surface")
+        ax.legend(loc="upper left", fontsize=7)
+    ax.axhline(EXP_RUN_UP, color="r", ls="--", lw=0.8)
+    ax.set_title(f"V{r.paper.run}: |u| at t = {t:.2f} s ({label}); black rings: fixed grains", fontsize=9)
+    ax.set_xlim(-0.1, 1.85)
+    ax.set_ylim(-0.08, 1.0)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("z [m]")
+    fig.colorbar(sc, ax=ax, label="|u| [m/s]", shrink=0.8)
+
+
+def plot(path, results, plot_runs, granular):
+    shown = [r for r in results if r.paper.run in plot_runs and r.profiles]
+    first = next((r for r in results if r.paper.run in plot_runs and r.ok), None)
+    n = len(shown) + (2 if first else 0)
+    if n == 0:
+        return False
+    fig, axes = plt.subplots(n, 1, figsize=(9, 4.0 * n), squeeze=False, constrained_layout=True)
+    axes = axes[:, 0]
+    for ax, r in zip(axes, shown):
+        draw_profiles(ax, r)
+    if first:
+        draw_snapshot(fig, axes[len(shown)], first, PLATE_STOP, "the plate stops", granular)
+        draw_snapshot(fig, axes[len(shown) + 1], first, first.t_run_up, "nearest snapshot to the max run-up",
+                      granular)
+    fig.suptitle("Vajont, Padua 1968 test No. 48: profiles at the maximum run-up (paper Figs 7-9) "
+                 "and velocity magnitude (Fig. 10)", fontsize=10)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+# ---- main -----------------------------------------------------------------------------------------
+
+
+def parse_runs(text, what):
+    if text.strip().lower() == "all":
+        return sorted(PAPER)
+    runs = []
+    for part in text.split(","):
+        part = part.strip().upper().lstrip("V")
+        if not part:
+            continue
+        if not part.isdigit() or int(part) not in PAPER:
+            fail(f"{what}: '{part}' is not a run 1-6 (e.g. {what} 1,2,4 or {what} all)")
+        if int(part) not in runs:
+            runs.append(int(part))
+    if not runs:
+        fail(f"{what}: no run given")
+    return sorted(runs)
+
+
+def on_sigterm(signum, frame):
+    raise KeyboardInterrupt
+
+
+def main():
+    ap = argparse.ArgumentParser(prog=PROG, description="Vajont (Manenti et al. 2018, Section 3.2): run V1-V6 "
+                                 "with mixsph and compare with the paper's Tables 4-5.")
+    ap.add_argument("--runs", default="all", help="runs to do, 1-6, comma-separated or 'all' (default all)")
+    ap.add_argument("--dx", type=float, default=0.02,
+                    help="particle spacing of V1-V4 [m] (default 0.02; the paper's is 0.005; V5, V6: x1.25, x1.5)")
+    ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default: all cores)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "out", "vajont"), help="output folder (default out/vajont)")
+    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings)")
+    ap.add_argument("--t-end", type=float, help="end time [s] (default the case's 1.6 s; for short tests)")
+    ap.add_argument("--plot-runs", default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")
+    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable")
+    ap.add_argument("--case", default=os.path.join(ROOT, "cases", "vajont_padua.json"), help="case file")
+    ap.add_argument("--progress", type=float, default=60.0,
+                    help="print the simulated time every this many seconds (default 60, 0: never)")
+    args = ap.parse_args()
+
+    runs = parse_runs(args.runs, "--runs")
+    plot_runs = parse_runs(args.plot_runs, "--plot-runs")
+    if not (args.dx > 0 and math.isfinite(args.dx)):
+        fail("--dx must be a positive number of metres")
+    if args.threads is not None and args.threads < 1:
+        fail("--threads must be at least 1")
+    if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
+        fail("--t-end must be a positive number of seconds")
+    mixsph = os.path.abspath(args.mixsph)
+    if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
+        fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
+    case = os.path.abspath(args.case)
+    try:
+        with open(case) as f:
+            case_json = json.load(f)
+    except (OSError, ValueError) as e:
+        fail(f"{show(case)}: cannot read the case: {e}")
+    t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except AttributeError:
+        cores = os.cpu_count() or 1
+    threads = args.threads or cores
+    out = os.path.abspath(args.out)
+    os.makedirs(out, exist_ok=True)
+
+    jobs = []
+    for k in runs:
+        p = PAPER[k]
+        dx = round(args.dx * p.dx_ratio, 12)
+        d = os.path.join(out, f"V{k}_dx{dx:g}")
+        cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(dx)}"]
+        for key, val in p.sets:
+            cmd += ["--set", f"{key}={num(val)}"]
+        if args.t_end is not None:
+            cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
+        cmd += ["--threads", str(threads), "--quiet"]
+        stamp = {"run": k, "dx": dx, "sets": [list(s) for s in p.sets], "t_end": t_end, "case": case,
+                 "threads": threads, "command": cmd}
+        jobs.append(Job(p, dx, d, cmd, stamp))
+
+    signal.signal(signal.SIGTERM, on_sigterm)
+    failed = []
+    for job in jobs:
+        if args.reuse:
+            ok, why = reusable(job, t_end)
+            if ok:
+                job.source = "reused"
+                print(f"V{job.paper.run}: reused {show(job.outdir)}/ ({why})")
+                continue
+            if os.path.isdir(job.outdir):
+                print(f"V{job.paper.run}: not reused ({why}): running it again")
+        rc = run_job(job, t_end, args.progress)
+        if rc != 0:
+            failed.append(job)
+            if rc == 2:
+                for j in jobs:
+                    if not j.source:
+                        j.source = "not run"
+                break
+
+    try:
+        results = [load_result(job) for job in jobs]
+    except mt.ToolError as e:
+        fail(str(e))
+    used_threads = sorted({r.threads for r in results if r.ok})
+    head = (f"Vajont (Padua 1968, test No. 48), mixsph versus Manenti et al. (2018) Tables 4-5: V1-V4 at dx = "
+            f"{args.dx:g} m (paper {PAPER_DX:g} m), t_end = {t_end:g} s, threads "
+            f"{','.join(str(t) for t in used_threads) or threads}; paper: SPHERA on 16 cores at 2.3 GHz")
+    print()
+    print(head)
+    print()
+    rows = rows_of(results)
+    print_table(rows)
+    print("run-up: highest water particle centre (>= 3 water neighbours within 2h) over the opposite slope, "
+          "x in [0.75, 1.81] m, every 0.005 s;")
+    print("        Z = 1211.8 z + 0.3 m a.m.s.l.; d_eta% = |Z - 863.0| / (863.0 - 700.0) * 100 "
+          "(= 100 |z - 0.712| / 0.1345), the paper's error (13).")
+    print("lost: particles that left the domain; mass drift: max |M(t) - M(0)| / M(0) of the fluid and granular "
+          "particles.")
+    print()
+    for r in results:
+        if r.ok:
+            p = r.paper
+            print(f"V{p.run}: max run-up {fmt(r.run_up, '.3f')} m at t = {fmt(r.t_run_up, '.3f')} s, "
+                  f"Z = {fmt(r.Z, '.1f')} m a.m.s.l., d_eta = {fmt(r.d_eta, '.1f')} % at dx = {r.dx:g} m "
+                  f"(paper V{p.run}: {p.run_up:.3f} m at {p.t_run_up:.2f} s, Z = {p.Z:.1f}, d_eta {p.d_eta:g} %; "
+                  f"experiment {EXP_RUN_UP} m); wall time {fmt(r.wall, '.0f')} s on {r.threads} thread(s)")
+    checks = ordering(results)
+    if checks:
+        print()
+        for what, holds, detail in checks:
+            print(f"ordering: {what}: {'holds' if holds else 'does NOT hold'} ({detail})")
+    print()
+    print("stability (plate starts at t = 0, stops at t = 0.8 s):")
+    for r in results:
+        if r.status in ("not run", "missing", "no summary"):
+            continue
+        print(f"  V{r.paper.run}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, mass drift "
+              f"{fmt(r.mass_drift, '.1e')}, wall-crossing corrections {fmt(r.wall_corr, '.0f')}, "
+              f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, landslide front max "
+              f"{fmt(r.front_max, '.3f')} m")
+
+    csv_path = os.path.join(out, "vajont_table.csv")
+    md_path = os.path.join(out, "vajont_table.md")
+    png_path = os.path.join(out, "vajont_profiles.png")
+    write_csv(csv_path, results)
+    write_md(md_path, results, [head], checks)
+    media = case_json.get("media", {})
+    granular = [k for k, m in enumerate(media.values()) if isinstance(m, dict) and m.get("type") == "granular"]
+    drew = plot(png_path, results, plot_runs, granular)
+    print()
+    print(f"table: {show(csv_path)}, {show(md_path)}")
+    print(f"plot:  {show(png_path)}" if drew else "plot:  none (no profiles of the plotted runs)")
+    if failed:
+        fail("mixsph failed for " + "; ".join(f"V{j.paper.run}: {j.message}" for j in failed), code=1)
+
+
+if __name__ == "__main__":
+    main()
