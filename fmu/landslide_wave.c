@@ -1024,13 +1024,16 @@ fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedSta
     SER_GET(p, lib_len);
     tmp.set.case_file[sizeof tmp.set.case_file - 1] = '\0';
     if (lib_len != size - ser_size(&tmp)) return reject(in, "fmi2DeSerializeFMUstate: truncated or padded state");
-    struct fmu_state *fs = calloc(1, sizeof *fs);
+    struct fmu_state *fs = *FMUstate; /* a state given back is re-used */
+    const int reuse = fs != NULL;
+    if (!fs) fs = calloc(1, sizeof *fs);
     void *lib = malloc(lib_len ? lib_len : 1);
     if (!fs || !lib) {
-        free(fs);
+        if (!reuse) free(fs);
         free(lib);
         return reject(in, "fmi2DeSerializeFMUstate: out of memory");
     }
+    if (reuse) free_lib(fs);
     *fs = tmp;
     memcpy(lib, p, lib_len);
     fs->lib = lib;
