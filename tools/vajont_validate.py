@@ -32,7 +32,9 @@ d_eta% = |Z - Z_exp| / (Z_exp - Z_still) * 100 with Z_exp = 863.0, Z_still = 700
 
 Printed: the paper's Tables 4-5 beside ours (elapsed time, max run-up, its time, Z, d_eta%), the
 steps, particles, lost particles, the mass balance (largest relative change of the total mass of
-fluid and granular particles), the wall-crossing corrections and whether the paper's ordering holds
+fluid and granular particles), the wall-crossing corrections, the largest density variation
+|rho / rho0 - 1| of the snapshots (rho0: the medium's reference density, the mixture density (5)
+for grains; the paper asks for <= 1 %) and whether the paper's ordering holds
 (lower phi, V2, raises the run-up; saturation, V4, lowers it). Written: OUT/vajont_table.csv,
 OUT/vajont_table.md and OUT/vajont_profiles.png (like the paper's Figs 7-10): per plotted run the
 water surface and the landslide surface at the time of the maximum run-up (the case's profiles
@@ -298,6 +300,9 @@ class Result:
     wall_corr: float = math.nan
     front_max: float = math.nan
     vmax_stop: float = math.nan       # max speed around the plate's stop [m/s]
+    drho: float = math.nan            # max |rho / rho0 - 1| of mobile particles over the snapshots
+    drho_t: float = math.nan          # its time [s]
+    drho99: float = math.nan          # max over the snapshots of the 99th percentile of |rho / rho0 - 1|
     profiles: dict = field(default_factory=dict)   # name -> mt.Profile at the max run-up
 
     @property
@@ -308,7 +313,55 @@ class Result:
 PROFILE_NAMES = ("water_surface", "landslide_surface_above", "landslide_surface_below")
 
 
-def load_result(job):
+def reference_densities(case_json, sets):
+    """rho0 [kg/m3] per medium index: fluids rho, granular media the mixture density (5)
+    (saturated n rho_f + (1 - n) rho_s, dry (1 - n) rho_s), "$parameters" resolved with the run's
+    overrides."""
+    params = dict(case_json.get("parameters", {}))
+    for key, val in sets:
+        if key.startswith("parameters."):
+            params[key.split(".", 1)[1]] = val
+
+    def val(v):
+        if isinstance(v, str) and v.startswith("$"):
+            return params.get(v[1:], math.nan)
+        return float(v) if isinstance(v, (int, float)) else math.nan
+
+    media = case_json.get("media", {})
+    rho = []
+    for m in media.values():
+        if m.get("type") == "granular":
+            n, rs = val(m.get("porosity")), val(m.get("rho"))
+            sat = val(m.get("saturated", False)) if not isinstance(m.get("saturated"), bool) else float(m["saturated"])
+            rf = val(media.get(m.get("pore_fluid"), {}).get("rho", math.nan)) if sat else 0.0
+            rho.append(n * rf + (1 - n) * rs)
+        else:
+            rho.append(val(m.get("rho")))
+    return np.array(rho)
+
+
+def density_variation(outdir, rho0):
+    """(max |rho / rho0 - 1| of the mobile particles over all snapshots, its time, the largest
+    99th percentile of |rho / rho0 - 1| over the snapshots)."""
+    best, t_best, p99 = math.nan, math.nan, math.nan
+    if rho0.size == 0 or not np.all(np.isfinite(rho0)):
+        return best, t_best, p99
+    for t, path in mt.list_snapshots(outdir):
+        _, snap = mt.read_snapshot(path)
+        live = snap["state"] <= mt.STATE_FIXED
+        med = snap["medium"][live].astype(int)
+        if med.size == 0 or med.max() >= rho0.size:
+            continue
+        dev = np.abs(snap["rho"][live] / rho0[med] - 1.0)
+        d = float(np.max(dev))
+        if not math.isfinite(best) or d > best:
+            best, t_best = d, t
+        q = float(np.percentile(dev, 99))
+        p99 = q if not math.isfinite(p99) else max(p99, q)
+    return best, t_best, p99
+
+
+def load_result(job, rho0=None):
     r = Result(job.paper, job.dx, job.outdir, job.source)
     if job.source == "not run":
         r.status = "not run"
@@ -345,6 +398,8 @@ def load_result(job):
             sel = (mon["t"] >= PLATE_STOP - 0.1) & (mon["t"] <= PLATE_STOP + 0.1)
             if sel.any():
                 r.vmax_stop = float(np.nanmax(v[sel]))
+    if rho0 is not None:
+        r.drho, r.drho_t, r.drho99 = density_variation(job.outdir, rho0)
     for name in PROFILE_NAMES:
         path = os.path.join(job.outdir, f"profile_{name}_atmax.csv")
         if os.path.isfile(path):
@@ -410,7 +465,7 @@ def write_csv(path, results):
               "wall_time_s", "particle_steps_per_s", "paper_elapsed_s", "run_up_m", "paper_run_up_m", "t_run_up_s",
               "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
               "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
-              "outdir"]
+              "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "outdir"]
 
     def v(x):
         if isinstance(x, float):
@@ -425,7 +480,8 @@ def write_csv(path, results):
             w.writerow([v(x) for x in (
                 f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
                 r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
-                r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.outdir)])
+                r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.drho,
+                r.drho_t, r.drho99, r.outdir)])
 
 
 def write_md(path, results, header_lines, checks):
@@ -654,7 +710,7 @@ def main():
                 break
 
     try:
-        results = [load_result(job) for job in jobs]
+        results = [load_result(job, reference_densities(case_json, job.paper.sets)) for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     used_threads = sorted({r.threads for r in results if r.ok})
@@ -692,7 +748,9 @@ def main():
             continue
         print(f"  V{r.paper.run}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, mass drift "
               f"{fmt(r.mass_drift, '.1e')}, wall-crossing corrections {fmt(r.wall_corr, '.0f')}, "
-              f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, landslide front max "
+              f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, max |rho/rho0 - 1| over the "
+              f"snapshots {fmt(100 * r.drho, '.2f')} % (t = {fmt(r.drho_t, '.1f')} s; 99th percentile <= "
+              f"{fmt(100 * r.drho99, '.2f')} %), landslide front max "
               f"{fmt(r.front_max, '.3f')} m")
 
     csv_path = os.path.join(out, "vajont_table.csv")
