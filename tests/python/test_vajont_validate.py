@@ -1,0 +1,96 @@
+"""tools/vajont_validate.py without running mixsph: the error (13), the reference densities of the
+runs, and the analysis of a run folder written by hand (summary.json, monitors.csv, profiles,
+snapshots in the formats of cli/main.c and lib/src/monitors.c)."""
+
+import json
+import math
+import os
+import sys
+
+import numpy as np
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import vajont_validate as vv  # noqa: E402
+
+
+def case_json():
+    with open(os.path.join(ROOT, "cases", "vajont_padua.json")) as f:
+        return json.load(f)
+
+
+def test_d_eta_matches_full_scale_map():
+    # the paper's Table 5: Z = 1211.8 z + 0.3, d_eta = |Z - 863| / 163 * 100 (within 0.1 %)
+    for p in vv.PAPER.values():
+        Z = 1211.8 * p.run_up + 0.3
+        assert abs(Z - p.Z) < 0.2
+        assert abs(vv.d_eta(p.run_up) - 100 * abs(Z - 863.0) / 163.0) < 0.1
+    assert math.isnan(vv.d_eta(math.nan))
+
+
+def test_reference_densities():
+    c = case_json()
+    dry = vv.reference_densities(c, vv.PAPER[1].sets)      # water, slide, slide_wet (dry in V1)
+    assert np.allclose(dry, [1000.0, 0.65 * 2650.0, 0.65 * 2650.0])
+    wet = vv.reference_densities(c, vv.PAPER[4].sets)      # V4: the part below the level saturated
+    assert np.allclose(wet, [1000.0, 0.65 * 2650.0, 0.35 * 1000.0 + 0.65 * 2650.0])
+
+
+def test_runs_and_ratios():
+    assert vv.parse_runs("all", "--runs") == [1, 2, 3, 4, 5, 6]
+    assert vv.parse_runs("V4,1, 2", "--runs") == [1, 2, 4]
+    with pytest.raises(SystemExit):
+        vv.parse_runs("7", "--runs")
+    assert vv.PAPER[5].dx_ratio * 0.005 == pytest.approx(6.25e-3)
+    assert vv.PAPER[6].dx_ratio * 0.005 == pytest.approx(7.5e-3)
+
+
+def write_run(d):
+    os.makedirs(d)
+    outputs = {
+        "lost_particles": {"final": 0, "max": 0, "t_max": 0, "min": 0, "t_min": 0},
+        "wall_corrections": {"final": 5, "max": 5, "t_max": 1.0, "min": 0, "t_min": 0},
+        "run_up": {"final": 0.65, "max": 0.72, "t_max": 1.2, "min": 0.45, "t_min": 0},
+        "run_up_Z": {"final": 788.0, "max": 872.8, "t_max": 1.2, "min": 545.6, "t_min": 0},
+        "run_up_d_eta": {"final": 5.9, "max": 190, "t_max": 0, "min": 5.9, "t_min": 1.2},
+        "landslide_front": {"final": 0.9, "max": 0.9, "t_max": 1.6, "min": 0.65, "t_min": 0},
+    }
+    summ = {"case": "vajont_padua", "status": "ok", "particles": 3, "wall_particles": 1, "steps": 100,
+            "threads": 1, "simulated_time_s": 1.6, "wall_time_s": 12.5, "particle_steps_per_s": 24.0,
+            "outputs": outputs}
+    with open(os.path.join(d, "summary.json"), "w") as f:
+        json.dump(summ, f)
+    with open(os.path.join(d, "monitors.csv"), "w") as f:
+        f.write("t,step,kinetic_energy,mass,max_speed,run_up\n0,0,0,10.0,0,0.45\n0.8,50,1,10.0,1.2,0.6\n"
+                "1.6,100,0.1,10.0,0.3,0.65\n")
+    for name, z in (("water_surface", 0.7), ("landslide_surface_above", 0.5), ("landslide_surface_below", 0.6)):
+        with open(os.path.join(d, f"profile_{name}_atmax.csv"), "w") as f:
+            f.write(f"# profile {name} of x at t = 1.2 s (requested 1.2 s): top of the medium per x bin, "
+                    "at the maximum of run_up so far\nx,z_top\n0.5,nan\n0.7," + str(z) + "\n")
+    with open(os.path.join(d, "snap_0000.csv"), "w") as f:
+        f.write("# t = 0.8 s\nid,x,z,vx,vz,rho,p,mu,medium,state\n"
+                "0,0.8,0.5,0.1,0,1010,0,0.001,0,0\n1,0.5,0.4,0,0,1722.5,0,5000,1,1\n"
+                "2,0.6,0.3,0,0,2072.5,0,5000,2,0\n3,0,0,0,0,1000,0,0,0,2\n")
+
+
+def test_load_result_and_outputs(tmp_path):
+    d = str(tmp_path / "V4_dx0.02")
+    write_run(d)
+    job = vv.Job(vv.PAPER[4], 0.02, d, [], {}, source="reused")
+    r = vv.load_result(job, vv.reference_densities(case_json(), vv.PAPER[4].sets))
+    assert r.ok and r.particles == 3 and r.steps == 100
+    assert r.run_up == 0.72 and r.t_run_up == 1.2 and r.Z == 872.8 and r.d_eta == 5.9
+    assert r.lost == 0 and r.mass_drift == 0.0 and r.vmax_stop == 1.2
+    assert r.drho == pytest.approx(0.01) and r.drho_t == 0.8        # the water particle at 1010
+    top = vv.landslide_top(r)
+    assert np.isnan(top[1][0]) and top[1][1] == 0.6
+    rows = vv.rows_of([r])
+    assert rows[0][0] == "V4" and rows[0][8] == "0.720" and rows[-1][0] == "exp."
+    csv_path, md_path, png_path = (str(tmp_path / n) for n in ("t.csv", "t.md", "p.png"))
+    vv.write_csv(csv_path, [r])
+    vv.write_md(md_path, [r], ["head"], vv.ordering([r]))
+    assert vv.plot(png_path, [r], [4], [1, 2])
+    assert os.path.getsize(png_path) > 1000
+    with open(csv_path) as f:
+        assert f.readline().startswith("run,change,dx_m")
