@@ -82,13 +82,13 @@ class Logger:
         return [m for s, c, m in self.messages if s >= 3]
 
 
-def instance(name="lw", logger=None, logging_on=False):
+def instance(name="lw", logger=None, logging_on=False, unzipdir=None):
     """An instantiated FMU2Slave of the unpacked FMU (with a logger if given)."""
     from fmpy.fmi2 import FMU2Slave, fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, \
         fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE
     from fmpy import calloc, free  # noqa: F401  (C allocation functions for the callbacks)
     md = model_description()
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipped(),
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir or unzipped(),
                     modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
     fmu._logger_ref = logger
     if logger is None:

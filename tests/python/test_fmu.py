@@ -90,6 +90,19 @@ def test_reservoir_level_sets_the_still_water():
         assert level - H.COARSE["dx"] <= z <= level, levels
 
 
+def test_resource_location_with_escaped_characters(tmp_path):
+    # fmpy passes the resources folder as a file:/// URI with %-escapes (here a space and a '%')
+    import shutil
+    d = tmp_path / "unpacked 100% here"
+    shutil.copytree(H.unzipped(), d)
+    log = H.Logger()
+    f = H.instance("escaped", logger=log, unzipdir=str(d))
+    H.start(f, H.COARSE)
+    f.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+    assert H.outputs(f)[-1] > 0 and not log.errors()  # steps taken, no error
+    f.freeInstance()
+
+
 def test_lower_friction_angle_raises_the_run_up(fmu_run_phi35):
     from fmpy import simulate_fmu
     res25 = simulate_fmu(H.fmu_path(), start_values={**RUN, "phi": 25.0}, stop_time=STOP, output_interval=0.02)
