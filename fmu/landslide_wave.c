@@ -930,15 +930,18 @@ fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
      * simulation yet) build the simulation from the state. */
     mixsph_status st = MIXSPH_ERR_ARG;
     if (in->sim) st = mixsph_sim_load_state(in->sim, fs->lib, fs->lib_len);
-    in->set = fs->set;
     if (st != MIXSPH_OK) {
         char err[FMU_MSG_LEN];
         mixsph_sim *sim = NULL;
         st = mixsph_sim_create_from_state(fs->lib, fs->lib_len, &sim, err, sizeof err);
-        if (st != MIXSPH_OK) return fail(in, "fmi2SetFMUstate: %s", err);
+        /* a state that cannot be loaded leaves the instance as it was */
+        if (st != MIXSPH_OK) return reject(in, "fmi2SetFMUstate: %s", err);
+        in->set = fs->set;
         if (adopt_sim(in, sim) != fmi2OK) return fmi2Error;
-    } else if (mixsph_sim_set_threads(in->sim, in->set.threads) != MIXSPH_OK) {
-        return fail(in, "fmi2SetFMUstate: threads: %s", mixsph_sim_last_error(in->sim));
+    } else {
+        in->set = fs->set;
+        if (mixsph_sim_set_threads(in->sim, in->set.threads) != MIXSPH_OK)
+            return fail(in, "fmi2SetFMUstate: threads: %s", mixsph_sim_last_error(in->sim));
     }
     in->start_time = fs->start_time;
     in->time = fs->time;

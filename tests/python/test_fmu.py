@@ -160,8 +160,12 @@ def test_state_save_continue_restore_continue_and_serialize():
     bad = bytearray(blob)
     bad[-100] ^= 0xFF
     st = other.deSerializeFMUstate(bytes(bad))
+    before = H.outputs(other)
     with pytest.raises(FMICallException):
         other.setFMUstate(st)
+    other.freeFMUstate(st)
+    assert H.outputs(other) == before  # a refused state leaves the instance as it was
+    other.doStep(currentCommunicationPoint=0.6, communicationStepSize=0.02)
     for f in (fmu, other):
         f.freeInstance()
 
