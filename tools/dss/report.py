@@ -23,6 +23,14 @@ META = {"error", "worker_pid", "unzip_count", "host", "run_id", "submitted_at", 
         "series"}
 
 
+def varied_params(df: pd.DataFrame) -> list[str]:
+    """Columns (other than outputs we know of) that take more than one value."""
+    skip = META | {"status", "wall_time_s", "cpu_time_s", "stop_time", "max_run_up", "max_run_up_Z",
+                   "time_of_max_run_up", "run_up", "landslide_front", "kinetic_energy",
+                   "fixed_particles", "dt", "lost_particles", "steps", ID}
+    return [c for c in df.columns if c not in skip and df[c].nunique(dropna=True) > 1]
+
+
 def pick_runup(df: pd.DataFrame, prefer: str | None = None) -> tuple[str, str]:
     """(column, label) of the run-up to report: full scale if the FMU gives it (finite)."""
     if prefer:
@@ -78,6 +86,7 @@ def make_report(df: pd.DataFrame, out_dir: str, crest: float | None = None, x: s
         t.auto_set_font_size(False)
         t.set_fontsize(7)
         t.scale(1, 1.1)
+        t.auto_set_column_width(list(range(len(pretty))))
     note = f"{len(df)} scenarios ({info['n_ok']} ok, {info['n_failed']} failed)"
     if len(df) > max_table_rows:
         note += f"; first {max_table_rows} shown, all in scenario_table.csv"
@@ -96,13 +105,22 @@ def make_report(df: pd.DataFrame, out_dir: str, crest: float | None = None, x: s
     if x in ok.columns:
         xv = pd.to_numeric(ok[x], errors="coerce").to_numpy(dtype=float)
         fig, ax = plt.subplots(figsize=(7, 4.5))
-        ax.scatter(xv, yv, s=14, alpha=0.6, label="scenarios")
+        # colour the points by the other parameter that varies most (the spread's main source)
+        others = [c for c in ok.columns if c not in META and c not in (ID, x, ycol, "status")
+                  and c in varied_params(ok)]
+        if others:
+            cname = max(others, key=lambda c: ok[c].nunique())
+            sc = ax.scatter(xv, yv, s=16, alpha=0.8, c=pd.to_numeric(ok[cname], errors="coerce"),
+                            cmap="viridis", label="scenarios", zorder=3)
+            fig.colorbar(sc, ax=ax, label=cname)
+        else:
+            ax.scatter(xv, yv, s=16, alpha=0.8, label="scenarios", zorder=3)
         levels = np.unique(xv[np.isfinite(xv)])
-        if len(levels) <= 12:
+        if len(levels) <= max(1, len(xv) // 2):   # a grid of levels: one group per level
             centres = levels
             groups = [yv[xv == lv] for lv in levels]
         else:   # sampled levels: quantile bins
-            nb = min(10, max(3, len(xv) // 8))
+            nb = min(10, max(2, len(xv) // 4))
             edges = np.unique(np.nanquantile(xv, np.linspace(0, 1, nb + 1)))
             idx = np.clip(np.searchsorted(edges, xv, side="right") - 1, 0, len(edges) - 2)
             centres = np.array([np.nanmean(xv[idx == i]) for i in range(len(edges) - 1)])
@@ -131,8 +149,10 @@ def make_report(df: pd.DataFrame, out_dir: str, crest: float | None = None, x: s
     v = np.sort(yv[np.isfinite(yv)])
     if v.size:
         fig, ax = plt.subplots(figsize=(7, 4.5))
-        pex = 1.0 - np.arange(v.size) / v.size     # P(Y >= v_i), empirical
-        ax.step(v, pex, where="post", label="P(run-up >= z)")
+        # empirical P(Y > z): 1 below the smallest value, (n-1-i)/n from v_i on, 0 from the largest
+        xs = np.concatenate([[v[0] - 0.02 * (v[-1] - v[0] + 1e-9)], v])
+        ps = np.concatenate([[1.0], (v.size - 1 - np.arange(v.size)) / v.size])
+        ax.step(xs, ps, where="post", label="P(run-up > z)")
         if crest is not None:
             pc, na, n = exceedance(v, crest)
             info["crest"] = crest
