@@ -52,11 +52,10 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, quiet:
                                dashboard_address=dash, silence_logs=logging.ERROR,
                                env={"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "passive"})
         client = Client(cluster)
+    global _TASK_MODULE
+    _TASK_MODULE = fmu_run
     if upload_code:
-        # workers without this repository: send our modules by value with the tasks
-        import cloudpickle
-        from . import fmu_run as _m
-        cloudpickle.register_pickle_by_value(_m)
+        _TASK_MODULE = upload_worker_module(client)
     try:
         if not quiet:
             info = client.scheduler_info()
@@ -70,6 +69,30 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, quiet:
         client.close()
         if cluster is not None:
             cluster.close()
+
+
+# The module whose run_scenario the tasks call: tools.dss.fmu_run (workers that have this
+# repository on their path), or its copy uploaded to the cluster (upload_worker_module).
+_TASK_MODULE = fmu_run
+WORKER_MODULE = "mixsph_dss_worker"
+
+
+def upload_worker_module(client):
+    """Send fmu_run.py to the scheduler and every worker (Client.upload_file) as the top-level
+    module mixsph_dss_worker, and use that module for the tasks: the workers then need only
+    fmpy (and distributed), not this repository."""
+    import importlib.util
+    import shutil
+    import tempfile
+    d = tempfile.mkdtemp(prefix="dss-upload-")
+    path = os.path.join(d, WORKER_MODULE + ".py")
+    shutil.copyfile(fmu_run.__file__, path)
+    client.upload_file(path)
+    spec = importlib.util.spec_from_file_location(WORKER_MODULE, path)
+    mod = importlib.util.module_from_spec(spec)
+    sys.modules[WORKER_MODULE] = mod
+    spec.loader.exec_module(mod)
+    return mod
 
 
 def n_workers(client) -> int:
@@ -122,8 +145,10 @@ class Progress:
             if force:
                 print(file=self.stream)
         elif force or frac - self.last_frac >= 0.1 or now - self.last_print >= 30:
-            print(self.line(running), file=self.stream, flush=True)
-            self.last_print, self.last_frac = now, frac
+            text = self.line(running)
+            if text != getattr(self, "last_text", None):
+                print(text, file=self.stream, flush=True)
+            self.last_print, self.last_frac, self.last_text = now, frac, text
 
 
 _SHIPPED: dict = {}
@@ -157,7 +182,7 @@ def run_scenarios(client, fmu_path: str, scenarios: list[dict], opts: dict, on_r
     submitted = utc_now()
     for sc in scenarios:
         params = {k: v for k, v in sc.items() if k != ID}
-        f = client.submit(fmu_run.run_scenario, fmu_future, params, opts,
+        f = client.submit(_TASK_MODULE.run_scenario, fmu_future, params, opts,
                           key=f"dss-{sc[ID]}-{uuid.uuid4().hex[:6]}", pure=False, retries=0)
         futures[f] = sc
     rows = []
