@@ -12,8 +12,8 @@ last snapshot is drawn. -o defaults to RUN/snapshot_<index>_<color>.png, or for 
 RUN/run_<color>.mp4 when ffmpeg is on the PATH and RUN/run_<color>.gif otherwise (the format
 follows the extension of -o: .gif with pillow, .mp4 with ffmpeg). With --color speed the colour
 scale is shared by all frames (0 to the largest |u| of the run, or --vmax).
-Only complete snapshots are read (the first n_snapshots of the file), so a run still going or
-killed mid-way can be plotted.
+Only complete snapshots are read (groups with their index attribute, written last), so a run
+still going or killed mid-way can be plotted.
 Exit codes: 0 ok, 2 bad arguments or no such file/snapshot.
 """
 import argparse
@@ -56,8 +56,10 @@ class Run:
         self.case = str(self.f.attrs.get("case_name", ""))
         self.media = [str(m) for m in meta.attrs["media"]]
         self.dx = float(meta.attrs["dx"])
-        n_complete = int(self.f.attrs["n_snapshots"])
-        self.groups = [self.f[f"snapshots/{k:06d}"] for k in range(n_complete)]
+        # complete snapshots: groups with their index attribute (written last), by index (a run
+        # restarted into a new folder starts at the checkpoint's index)
+        snaps = self.f["snapshots"]
+        self.groups = [snaps[name] for name in sorted(snaps) if "index" in snaps[name].attrs]
         self.times = np.array([g.attrs["time"] for g in self.groups])
         if not self.groups:
             raise SystemExit(f"plot_snapshot: {path}: no snapshot yet")

@@ -3,7 +3,9 @@
  * run.h5 (one file per run, in the output folder; HDF5 default file format, so that a file left
  * open by a killed run opens without repair):
  *   /                   attributes: format = "mixsph-run", format_version, mixsph_version,
- *                       case_name, created_utc, n_snapshots (complete snapshots), restarts
+ *                       case_name, created_utc, n_snapshots (complete snapshots), restarts,
+ *                       last_restart_time; first_snapshot (index of the first snapshot) when a
+ *                       restored run starts a new file
  *   /metadata           attributes: case_origin, overrides ("key=value" lines), dx, h, t_end,
  *                       snapshot_interval, monitor_interval, gravity, n_particles (fluid and
  *                       granular), n_wall_particles, media (names; medium index k of a fluid or
@@ -43,7 +45,9 @@
  *
  * HDF5 never prints: its automatic error printing is switched off for the duration of each call
  * into it (and restored after), and its innermost error message goes into the simulation's
- * message. The HDF5 library is process-wide; the file handles belong to the simulation. */
+ * message. The HDF5 library is process-wide; the file handles belong to the simulation.
+ * Debian's serial HDF5 is not thread-safe: simulations of one process may write outputs only
+ * from one thread at a time (stepping them in turn, as the CLI and the FMU do, is fine). */
 #include "output.h"
 
 #include <errno.h>
@@ -533,7 +537,19 @@ mixsph_status output_open(mixsph_sim *s, int resume)
     snprintf(o->xdmf, sizeof o->xdmf, "%s/%s", s->out_dir, XDMF_FILE);
     struct quiet q;
     quiet_on(&q);
-    mixsph_status st = resume && access(o->path, F_OK) == 0 ? run_continue(s, o) : run_create(s, o);
+    mixsph_status st;
+    if (resume && access(o->path, F_OK) == 0) {
+        st = run_continue(s, o);
+    } else {
+        st = run_create(s, o);
+        /* a restored run in a new folder: its snapshots start at the restored index */
+        if (st == MIXSPH_OK && resume &&
+            (attr_i64(o->file, "restarts", 1) || attr_f64(o->file, "last_restart_time", s->t) ||
+             attr_i64(o->file, "first_snapshot", s->snap_index))) {
+            H5_FAIL(s, "cannot write the metadata", o->path);
+            st = MIXSPH_ERR_IO;
+        }
+    }
     quiet_off(&q);
     if (st == MIXSPH_OK && xdmf_write(s, o) != 0)
         st = SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));

@@ -217,7 +217,15 @@ def same_run_files(a, b):
     assert (a / "run.xdmf").read_text() == (b / "run.xdmf").read_text()
 
 
-def test_restart_equals_uninterrupted(killed, tmp_path):
+@pytest.fixture(scope="module")
+def full(tmp_path_factory):
+    """The killed run's settings, uninterrupted."""
+    out = tmp_path_factory.mktemp("uninterrupted")
+    run(case_args(0.01, 0.2, out, "--set", "output.snapshot_interval=0.02"))
+    return out
+
+
+def test_restart_equals_uninterrupted(killed, full, tmp_path):
     # continue a copy of the killed run's folder from its checkpoint (the default folder: the
     # checkpoint's)
     cont = tmp_path / "continued"
@@ -229,11 +237,38 @@ def test_restart_equals_uninterrupted(killed, tmp_path):
     r = subprocess.run([mixsph(), "run", "--restart", str(cont / "checkpoint.h5"), "--threads", "1", "--quiet"],
                        env=ENV, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
-    full = tmp_path / "uninterrupted"
-    run(case_args(0.01, 0.2, full, "--set", "output.snapshot_interval=0.02"))
     same_run_files(full, cont)
     with h5py.File(cont / "run.h5", "r") as f:
         assert f.attrs["restarts"] == 1 and f.attrs["last_restart_time"] == t_ckpt
+
+
+def test_restart_into_new_folder(killed, full, tmp_path):
+    """--out to a fresh folder: new files holding the snapshots and monitor rows from the
+    checkpoint on, equal to the uninterrupted run's."""
+    new = tmp_path / "new"
+    r = subprocess.run([mixsph(), "run", "--restart", str(killed / "checkpoint.h5"), "--out", str(new), "--threads",
+                        "1", "--quiet"], env=ENV, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    with h5py.File(new / "run.h5", "r") as fn, h5py.File(full / "run.h5", "r") as ff:
+        first = int(fn.attrs["first_snapshot"])
+        assert fn.attrs["restarts"] == 1 and first >= 1
+        names = sorted(fn["snapshots"])
+        assert names == sorted(ff["snapshots"])[first:]
+        for name in names:
+            for field in FIELDS:
+                assert fn["snapshots"][name][field][()].tobytes() == ff["snapshots"][name][field][()].tobytes()
+    rows_new = (new / "monitors.csv").read_text().splitlines()
+    rows_full = (full / "monitors.csv").read_text().splitlines()
+    assert rows_new[0] == rows_full[0] and len(rows_new) > 1
+    assert rows_new[1:] == rows_full[len(rows_full) - (len(rows_new) - 1):]
+    # the XDMF lists them and the plot tool draws them
+    with TimeSeriesReader(str(new / "run.xdmf")) as reader:
+        assert reader.num_steps == len(names)
+    png = tmp_path / "first.png"
+    p = subprocess.run([PYTHON, str(ROOT / "tools" / "plot_snapshot.py"), str(new), "--index", "0", "-o", str(png)],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    assert png.stat().st_size > 5000
 
 
 def test_restart_rejects_case_arguments(killed):
