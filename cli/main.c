@@ -1,8 +1,9 @@
 /* mixsph - run a case file.
  *
  *   mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]
- *              [--checkpoint-every SECONDS]
+ *              [--checkpoint-every SECONDS] [--no-csv]
  *   mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]
+ *              [--no-csv]
  *
  * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
  * on stdout and summary.json in the output folder. Exit codes: 0 ok, 2 bad usage or input,
@@ -22,8 +23,9 @@ static void usage(FILE *f)
 {
     fprintf(f,
             "usage: mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]\n"
-            "                  [--checkpoint-every SECONDS]\n"
+            "                  [--checkpoint-every SECONDS] [--no-csv]\n"
             "       mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]\n"
+            "                  [--no-csv]\n"
             "  --set key=value   override a numeric case value, e.g. --set numerics.dx=0.01\n"
             "  --out DIR         output folder (default: out/<case name>)\n"
             "  --threads N       OpenMP threads (default: all cores)\n"
@@ -33,7 +35,8 @@ static void usage(FILE *f)
             "                    step, t_end/1000); it replaces the previous one atomically\n"
             "  --restart FILE    continue the run saved in checkpoint FILE (the case and overrides come from\n"
             "                    it); output folder: --out, default the checkpoint's folder, whose files\n"
-            "                    (monitors.csv, run.h5, snapshots) are continued from the checkpoint's time\n");
+            "                    (monitors.csv, run.h5, snapshots) are continued from the checkpoint's time\n"
+            "  --no-csv          particle snapshots only in run.h5 (no snap_NNNN.csv)\n");
 }
 
 static int exit_code(mixsph_status st)
@@ -153,7 +156,7 @@ static int cmd_run(int argc, char **argv)
     double ckpt_every = -1.0; /* wall seconds between checkpoints, < 0: none */
     mixsph_override sets[MAX_SETS];
     size_t n_sets = 0;
-    int threads = 0, quiet = 0;
+    int threads = 0, quiet = 0, no_csv = 0;
     char err[1024];
     for (int a = 0; a < argc; a++) {
         const char *arg = argv[a];
@@ -196,6 +199,8 @@ static int cmd_run(int argc, char **argv)
             }
         } else if (strcmp(arg, "--quiet") == 0) {
             quiet = 1;
+        } else if (strcmp(arg, "--no-csv") == 0) {
+            no_csv = 1;
         } else if (arg[0] == '-') {
             fprintf(stderr, "mixsph: unknown option '%s'\n", arg);
             usage(stderr);
@@ -239,6 +244,7 @@ static int cmd_run(int argc, char **argv)
     }
     char ckpt[1100];
     snprintf(ckpt, sizeof ckpt, "%s/checkpoint.h5", dir);
+    if (no_csv) mixsph_sim_set_csv_snapshots(s, 0);
     if ((st = mixsph_sim_set_threads(s, threads)) != MIXSPH_OK ||
         (st = restart ? mixsph_sim_resume_output_dir(s, dir) : mixsph_sim_set_output_dir(s, dir)) != MIXSPH_OK) {
         fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));

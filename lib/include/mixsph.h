@@ -173,6 +173,10 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
  *  and written again as the run continues. Without earlier files they are started anew. */
 mixsph_status mixsph_sim_resume_output_dir(mixsph_sim *s, const char *dir);
 
+/** Write the particle snapshots also as CSV files snap_NNNN.csv (on = 1, the default) or only
+ *  into run.h5 (on = 0; the CSV files cost 10-20 times as much to write). */
+mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on);
+
 /** Wall time this simulation has spent writing CSV snapshots, HDF5 snapshots (with the XDMF
  *  sidecar) and checkpoints [s] (any pointer may be NULL). */
 void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, double *checkpoint_s);

@@ -20,7 +20,8 @@ mixsph_status output_open(mixsph_sim *s, int resume);
  *  s->monitor_csv (a missing file is started anew). */
 mixsph_status output_resume_monitors(mixsph_sim *s);
 
-/** Take a snapshot now: snap_NNNN.csv (monitors_snapshot) and a group of run.h5, then flush the
+/** Take a snapshot now: snap_NNNN.csv (monitors_snapshot, unless s->csv_snapshots_off) and a
+ *  group of run.h5, then flush the
  *  file and rewrite the sidecar, so that a run killed later leaves every snapshot so far
  *  readable. Advances s->snap_index. */
 mixsph_status output_snapshot(mixsph_sim *s);

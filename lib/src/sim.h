@@ -75,6 +75,7 @@ struct mixsph_sim {
     FILE *monitor_csv;
     struct output *h5;            /* run.h5 and run.xdmf (output.c); NULL without an output folder */
     double out_seconds[3];        /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
+    int csv_snapshots_off;        /* no snap_NNNN.csv (run.h5 only) */
 
     char err[1024];
 };

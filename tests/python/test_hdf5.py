@@ -291,6 +291,17 @@ def test_unwritable_output_fails_before_the_run(tmp_path):
     assert not list(out.glob("snap_*.csv"))
 
 
+def test_no_csv_writes_run_file_only(ref, tmp_path):
+    out = tmp_path / "nocsv"
+    run(case_args(0.02, 0.2, out, "--no-csv"))
+    assert not list(out.glob("snap_*.csv"))
+    with h5py.File(ref / "run.h5", "r") as fa, h5py.File(out / "run.h5", "r") as fb:
+        assert sorted(fa["snapshots"]) == sorted(fb["snapshots"])
+        for name in fa["snapshots"]:
+            for field in FIELDS:
+                assert fa["snapshots"][name][field][()].tobytes() == fb["snapshots"][name][field][()].tobytes()
+
+
 def test_plot_snapshot_png_and_gif(ref, tmp_path):
     tool = ROOT / "tools" / "plot_snapshot.py"
     png = tmp_path / "snap.png"
