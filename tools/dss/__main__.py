@@ -66,8 +66,8 @@ def common_cluster_args(p):
     g.add_argument("--workers", type=int, metavar="N",
                    help="workers of the local cluster (default: the machine's cores)")
     g.add_argument("--upload-code", action="store_true",
-                   help="send this package's worker code with the tasks (workers that have fmpy "
-                        "but not this repository)")
+                   help="upload the worker module to the scheduler and the workers "
+                        "(Client.upload_file): workers need fmpy and distributed, not this repository")
 
 
 def common_run_args(p):
@@ -96,7 +96,8 @@ def build_parser():
 
     s = sub.add_parser("sweep", help="run a scenario sweep (resumable)")
     s.add_argument("out", help="output folder (results, scenario table, report)")
-    g = s.add_argument_group("scenarios (combine --set with one of grid, sampling or CSV)")
+    g = s.add_argument_group("scenarios (--grid and --dist together: the n samples at every grid "
+                             "point; --csv rows are added; --set fixes a parameter in all)")
     g.add_argument("--grid", action="append", default=[], metavar="NAME=SPEC",
                    help="a grid axis: NAME=v1,v2,... or NAME=lo:hi:n (repeatable; all combinations)")
     g.add_argument("--dist", action="append", default=[], metavar="NAME=SPEC",
@@ -193,17 +194,22 @@ def cmd_sweep(args):
 
     # the scenario table: new specification, merged with what OUT already has
     specs = []
+    grid_sc = samp_sc = None
     if args.grid:
         axes = {}
         for it in args.grid:
             k, v = S.split_assignment(it)
             axes[k] = S.grid_values(v)
-        specs.append(S.grid(axes, fixed))
+        grid_sc = S.grid(axes, fixed)
     if args.dist:
         if args.n < 1:
             raise UsageError("sampling needs -n N (number of scenarios)")
         dists = [S.Distribution(*S.split_assignment(it)) for it in args.dist]
-        specs.append(S.sample(dists, args.n, args.sample, args.seed, fixed))
+        samp_sc = S.sample(dists, args.n, args.sample, args.seed, fixed)
+    if grid_sc and samp_sc:       # every grid point with every sample
+        specs.append([{**g, **smp} for g in grid_sc for smp in samp_sc])
+    else:
+        specs += [x for x in (grid_sc, samp_sc) if x]
     if args.csv:
         specs.append(S.from_csv(args.csv, fixed))
     new = [s for spec in specs for s in spec]
