@@ -536,6 +536,11 @@ def draw_profiles(ax, r):
     w = r.profiles.get("water_surface")
     if w is not None:
         m = np.isfinite(w.z)
+        if ls is not None and ls[0].shape == w.x.shape:
+            # a bin whose highest water lies below the landslide surface holds only water trapped
+            # under or inside the landslide: not the free surface
+            with np.errstate(invalid="ignore"):
+                m &= ~(np.isfinite(ls[1]) & (w.z < ls[1]))
         ax.plot(w.x[m], w.z[m], ".-", color="tab:blue", ms=2, lw=1.2, label="water surface")
     t = next((p.t for p in r.profiles.values()), math.nan)
     ax.plot([], [], " ", label=f"max run-up {fmt(r.run_up, '.3f')} m (d_eta {fmt(r.d_eta, '.1f')} %)")
