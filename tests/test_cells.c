@@ -15,6 +15,7 @@
 
 #include "cells.h"
 #include "mixsph.h"
+#include "neighbours.h"
 #include "particles.h"
 
 /* splitmix64: a fixed, portable random sequence */
@@ -305,6 +306,92 @@ static void test_empty(void **state)
     cells_free(&C);
 }
 
+/* Is j in [r[0], r[1]) or [r[2], r[3]) ... (n_ranges ranges)? */
+static int in_ranges(const uint32_t *r, int n_ranges, size_t j)
+{
+    int hits = 0;
+    for (int k = 0; k < n_ranges; k++) hits += j >= r[2 * k] && j < r[2 * k + 1];
+    return hits;
+}
+
+/* Neighbour ranges (neighbours.c) on narrow columns: after every particle has moved by less
+ * than skin/2 since the build (random directions, fixed seed), each pair closer than 2h is met
+ * exactly once by the half-stencil ranges (in i's ranges or in j's, never both: the symmetric
+ * pair loops count each pair once), every particle's gather ranges hold each neighbour closer
+ * than 2h exactly once, and a wall particle's list holds exactly its non-wall neighbours closer
+ * than 2h + skin at the build. Reference: brute force over all pairs. */
+static void test_neighbour_ranges(void **state)
+{
+    (void)state;
+    const double h = 0.013, skin = 0.3 * h, rc = 2.0 * h + skin;
+    for (int kx = 1; kx <= 8; kx *= 2) {
+        struct cells C;
+        struct particles P;
+        memset(&P, 0, sizeof P);
+        assert_int_equal(cells_init_columns(&C, 0.0, 0.5, 0.0, 0.3, rc, kx), 0);
+        assert_true(C.width * kx == C.size);
+        assert_int_equal(particles_alloc(&P, 3000), 0);
+        uint64_t seed = 99u + (uint64_t)kx;
+        for (int i = 0; i < 2500; i++) {
+            const uint8_t st = i % 7 == 0 ? MIXSPH_STATE_WALL : MIXSPH_STATE_MOBILE;
+            particles_push(&P, rng_uniform(&seed, 0.01, 0.49), rng_uniform(&seed, 0.01, 0.29), 1000.0, 1.0, 0, st);
+        }
+        /* particles on column and row borders */
+        for (int k = 0; k < 40; k++)
+            particles_push(&P, C.x0 + (k % 10 + 1) * C.width, C.z0 + (k % 5 + 1) * C.size, 1000.0, 1.0, 0,
+                           MIXSPH_STATE_MOBILE);
+        assert_int_equal(cells_build(&C, &P), 0);
+        const size_t n = C.start[C.ncell];
+        struct neighbours NB;
+        struct gather G;
+        memset(&NB, 0, sizeof NB);
+        memset(&G, 0, sizeof G);
+        NB.skin = skin;
+        assert_int_equal(neighbours_build(&NB, &C, &P, n, rc, 2), 0);
+        assert_int_equal(neighbours_gather_reserve(&G, P.cap), 0);
+        memset(G.mode, NEIGHBOURS_GATHER_ALL, n);
+        assert_int_equal(neighbours_gather_build(&G, &NB, &C, P.state, n, rc, 2), 0);
+        /* wall lists: exactly the non-wall particles closer than rc at the build */
+        for (size_t i = 0; i < n; i++) {
+            if (P.state[i] != MIXSPH_STATE_WALL) continue;
+            size_t expect = 0;
+            for (size_t j = 0; j < n; j++) {
+                const double rx = P.x[i] - P.x[j], rz = P.z[i] - P.z[j];
+                expect += P.state[j] != MIXSPH_STATE_WALL && rx * rx + rz * rz < rc * rc;
+            }
+            assert_int_equal(G.start[i + 1] - G.start[i], expect);
+            for (size_t k = G.start[i]; k < G.start[i + 1]; k++) assert_int_not_equal(P.state[G.list[k]], MIXSPH_STATE_WALL);
+        }
+        /* move every particle by less than skin / 2 */
+        for (size_t i = 0; i < n; i++) {
+            const double a = rng_uniform(&seed, 0.0, 6.283185307179586), d = rng_uniform(&seed, 0.0, 0.4999 * skin);
+            P.x[i] += d * cos(a);
+            P.z[i] += d * sin(a);
+        }
+        int outside = 1;
+        const double shift2 = neighbours_max_shift2(&NB, &C, &P, n, &outside, 2);
+        assert_true(4.0 * shift2 < skin * skin);
+        assert_int_equal(outside, 0);
+        size_t pairs = 0;
+        for (size_t i = 0; i < n; i++)
+            for (size_t j = 0; j < n; j++) {
+                if (j == i) continue;
+                const double rx = P.x[i] - P.x[j], rz = P.z[i] - P.z[j];
+                if (rx * rx + rz * rz >= 4.0 * h * h) continue;
+                assert_int_equal(in_ranges(G.rng + 6 * i, 3, j), 1);
+                if (j < i) continue;
+                pairs++;
+                assert_int_equal(in_ranges(NB.rng + 4 * i, 2, j) + in_ranges(NB.rng + 4 * j, 2, i), 1);
+            }
+        print_message("kx = %d: %zu pairs within 2h, each met once\n", kx, pairs);
+        assert_true(pairs > 10000);
+        neighbours_free(&NB);
+        neighbours_gather_free(&G);
+        particles_free(&P);
+        cells_free(&C);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -312,6 +399,7 @@ int main(void)
         cmocka_unit_test(test_rounded_grid),
         cmocka_unit_test(test_degenerate_grids),
         cmocka_unit_test(test_empty),
+        cmocka_unit_test(test_neighbour_ranges),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -74,7 +74,7 @@ static int setup(void **state)
         P->inv_m[i] = 1.0 / P->m[i];
         P->mu[i] = uniform(0.0, 0.1);
     }
-    if (cells_build(&s->C, P) != 0) {
+    if (integrate_rebuild(s) != MIXSPH_OK) { /* cells and neighbour ranges of the moved particles */
         mixsph_sim_destroy(s);
         return -1;
     }

@@ -17,22 +17,24 @@
  *
  * Symmetric evaluation: every pair is computed once, as a force f_ij = m_i a_ij = -m_j a_ji,
  * added to i and subtracted from j, so momentum is conserved to round-off by construction.
- * Particles are sorted by cell (cells.c); particle i of cell (ix, iz) meets the particles after
- * it in its own cell and cell ix+1 (one contiguous range), and cells ix-1..ix+1 of row iz+1
- * (another), so each pair is met once and the inner loops run over contiguous memory; they are
+ * Particles are sorted by cell (cells.c); particle i meets the two contiguous ranges of its half
+ * stencil kept by neighbours.c (the particles after it in its own row up to kx columns ahead,
+ * and kx columns either side in the row above, trimmed to the candidates within 2h + skin at
+ * the last build), so each pair is met once and the inner loops run over contiguous memory; they are
  * branch-free (the kernel factor is 0 beyond 2h; wall and artificial-viscosity terms are
  * selected arithmetically) and vectorised with `omp simd`. The loops are compiled for AVX-512,
  * AVX2 and baseline x86-64 and the widest is picked at run time (target_clones).
  *
- * Threads: the grid is cut into bands of two cell rows; a band writes its own rows and the row
- * above, so even bands never touch each other, nor odd bands: even bands run in parallel, then
+ * Threads: the grid is cut into bands of two cell rows (index ranges fixed at the last build); a
+ * band writes its own rows and the row above, so even bands never touch each other, nor odd bands: even bands run in parallel, then
  * odd bands. The bands do not depend on the thread count and each band is walked in memory
  * order, so every particle receives its contributions in the same order whatever the number of
  * threads: results are bit-identical for any thread count.
  *
  * Two passes per step: continuity (with the newest velocities) before the EOS, momentum after;
  * see integrate.c for why. With granular media the velocity gradient of each grain (for its
- * strain rate) is gathered right after the continuity pass, over the grains only. */
+ * strain rate) is gathered right after the continuity pass, over its gather ranges (all its
+ * neighbours, three contiguous ranges). */
 #include <math.h>
 #include <string.h>
 
@@ -231,43 +233,29 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     *azi += tz;
 }
 
-/* The two candidate ranges of particle i in cell (ix, iz): after i in its cell and cell ix+1;
- * cells ix-1..ix+1 of row iz+1. */
-FORCES_INLINE void half_ranges(const struct cells *C, size_t i, struct range *a, struct range *b)
-{
-    const size_t c = C->cell[i];
-    const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
-    a->begin = i + 1;
-    a->end = C->start[c + (ix + 1 < C->nx ? 2 : 1)];
-    *b = cells_row(C, ix, iz, 1);
-}
-
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
-FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                    size_t b0, size_t b1, const int wendland)
 {
     for (size_t i = b0; i < b1; i++) {
-        struct range ra, rb;
-        half_ranges(C, i, &ra, &rb);
         double di = 0.0, ni = 0.0;
-        continuity_range(X, P, i, ra.begin, ra.end, &di, &ni, wendland);
-        continuity_range(X, P, i, rb.begin, rb.end, &di, &ni, wendland);
+        const uint32_t *r = NB->rng + 4 * i;
+        continuity_range(X, P, i, r[0], r[1], &di, &ni, wendland);
+        continuity_range(X, P, i, r[2], r[3], &di, &ni, wendland);
         P->drho[i] += di;
         P->ax[i] += ni;
     }
 }
 
 FORCES_CLONES
-static void gradient_particle(const struct pair_ctx *X, const struct cells *C, const struct particles *restrict P,
+static void gradient_particle(const struct pair_ctx *X, const struct gather *G, const struct particles *restrict P,
                               struct kinematics *restrict K, size_t i)
 {
     double acc[7] = {0};
-    int ix, iz;
-    cells_coords(C, P->x[i], P->z[i], &ix, &iz);
-    for (int row = -1; row <= 1; row++) {
-        const struct range rg = cells_row(C, ix, iz, row);
-        if (X->wendland) gradient_range(X, P, i, rg.begin, rg.end, acc, 1);
-        else gradient_range(X, P, i, rg.begin, rg.end, acc, 0);
+    const uint32_t *r = G->rng + 6 * i;
+    for (int row = 0; row < 3; row++) {
+        if (X->wendland) gradient_range(X, P, i, r[2 * row], r[2 * row + 1], acc, 1);
+        else gradient_range(X, P, i, r[2 * row], r[2 * row + 1], acc, 0);
     }
     K->gux[i] = acc[0];
     K->guz[i] = acc[1];
@@ -278,40 +266,36 @@ static void gradient_particle(const struct pair_ctx *X, const struct cells *C, c
     K->lzz[i] = acc[6];
 }
 
-FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
+FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                  size_t b0, size_t b1, const int wendland)
 {
     for (size_t i = b0; i < b1; i++) {
-        struct range ra, rb;
-        half_ranges(C, i, &ra, &rb);
         double sx = 0.0, sz = 0.0;
-        momentum_range(X, P, i, ra.begin, ra.end, &sx, &sz, wendland);
-        momentum_range(X, P, i, rb.begin, rb.end, &sx, &sz, wendland);
+        const uint32_t *r = NB->rng + 4 * i;
+        momentum_range(X, P, i, r[0], r[1], &sx, &sz, wendland);
+        momentum_range(X, P, i, r[2], r[3], &sx, &sz, wendland);
         P->ax[i] += sx * P->inv_m[i];
         P->az[i] += sz * P->inv_m[i];
     }
 }
 
 FORCES_CLONES
-static void continuity_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
-                            struct kinematics *restrict K, size_t b0, size_t b1)
+static void continuity_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
+                            size_t b0, size_t b1)
 {
-    (void)K;
-    if (X->wendland) continuity_walk(X, C, P, b0, b1, 1);
-    else continuity_walk(X, C, P, b0, b1, 0);
+    if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1);
+    else continuity_walk(X, NB, P, b0, b1, 0);
 }
 
 FORCES_CLONES
-static void momentum_band(const struct pair_ctx *X, const struct cells *C, struct particles *restrict P,
-                          struct kinematics *restrict K, size_t b0, size_t b1)
+static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
+                          size_t b0, size_t b1)
 {
-    (void)K;
-    if (X->wendland) momentum_walk(X, C, P, b0, b1, 1);
-    else momentum_walk(X, C, P, b0, b1, 0);
+    if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1);
+    else momentum_walk(X, NB, P, b0, b1, 0);
 }
 
-typedef void (*band_fn)(const struct pair_ctx *, const struct cells *, struct particles *restrict,
-                        struct kinematics *restrict, size_t, size_t);
+typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, struct particles *restrict, size_t, size_t);
 
 /* Run `fn` over all bands of FORCES_BAND_ROWS cell rows: even bands in parallel, then odd. */
 static void for_bands(mixsph_sim *s, band_fn fn, const struct pair_ctx *X)
@@ -325,7 +309,7 @@ static void for_bands(mixsph_sim *s, band_fn fn, const struct pair_ctx *X)
         for (long b = phase; b < nb; b += 2) {
             const long r0 = b * FORCES_BAND_ROWS;
             const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;
-            fn(X, C, P, &s->kin, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
+            fn(X, &s->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
         }
     }
 }
@@ -348,7 +332,7 @@ int forces_continuity(mixsph_sim *s)
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
         for (size_t i = 0; i < n; i++)
             if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
-                gradient_particle(&X, &s->C, P, K, i);
+                gradient_particle(&X, &s->G, P, K, i);
     }
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))

@@ -10,8 +10,11 @@
  * v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still gets
  * forces and the kicks, is not drifted and does not limit dt (MODEL.md section 6).
  * Evaluating both rates in one pass from the same old state would be explicit Euler for the
- * acoustic modes, which grow without bound (found the hard way: the hydrostatic tank blew up). */
+ * acoustic modes, which grow without bound (found the hard way: the hydrostatic tank blew up).
+ * After the drift the particles are re-sorted and the neighbour ranges rebuilt only when one of
+ * them has moved skin/2 since the last build or left the grid (neighbours.h). */
 #include <math.h>
+#include <stdlib.h>
 
 #include "eos.h"
 #include "sim.h"
@@ -63,6 +66,55 @@ void integrate_eos(mixsph_sim *s)
     }
 }
 
+/* Sort by cell (marking particles that left the domain lost) and rebuild the neighbour lists. */
+mixsph_status integrate_rebuild(mixsph_sim *s)
+{
+    const long lost = cells_build(&s->C, &s->P);
+    if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
+    s->n_lost += lost;
+    if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
+    return integrate_gather(s);
+}
+
+/* Gather lists from the current pair lists' build: grains gather over all their neighbours (the
+ * velocity gradient), wall particles over the non-wall ones (their pressure). */
+mixsph_status integrate_gather(mixsph_sim *s)
+{
+    const struct particles *P = &s->P;
+    const size_t n = s->C.start[s->C.ncell];
+    if (neighbours_gather_reserve(&s->G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
+    for (size_t i = 0; i < n; i++) {
+        uint8_t mode = NEIGHBOURS_GATHER_NONE;
+        if (P->state[i] == MIXSPH_STATE_WALL || s->cfg.media[P->medium[i]].kind == MEDIUM_GRANULAR)
+            mode = NEIGHBOURS_GATHER_ALL;
+        s->G.mode[i] = mode;
+    }
+    if (neighbours_gather_build(&s->G, &s->NB, &s->C, P->state, n, 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
+    /* Particles that may reach a wall before the next build: until then every particle and
+     * every wall moves less than skin/2 from its build position, so from any time in between
+     * the remaining relative motion is below 2 skin. The others skip the wall-crossing test
+     * (which could not fire for them: skipping it changes no result). */
+    uint8_t *near = realloc(s->near_wall, P->cap ? P->cap : 1);
+    if (!near) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    s->near_wall = near;
+    const double reach = 2.0 * s->NB.skin + 2.0 * s->dx;
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < n; i++) {
+        int close = 0;
+        if (P->state[i] != MIXSPH_STATE_WALL)
+            for (size_t w = 0; w < s->cfg.n_walls && !close; w++) {
+                double d;
+                int at_end;
+                walls_signed_distance(s, w, P->x[i], P->z[i], &d, &at_end);
+                close = !(fabs(d) > reach); /* NaN counts as close */
+            }
+        near[i] = (uint8_t)close;
+    }
+    return MIXSPH_OK;
+}
+
 mixsph_status integrate_step(mixsph_sim *s)
 {
     struct particles *P = &s->P;
@@ -86,7 +138,7 @@ mixsph_status integrate_step(mixsph_sim *s)
         if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
             const double x0 = P->x[i], z0 = P->z[i];
             double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
-            walls_clip(s, ox_old, oz_old, x0, z0, &x1, &z1, &vx, &vz, &clips);
+            if (s->near_wall[i]) walls_clip(s, ox_old, oz_old, x0, z0, &x1, &z1, &vx, &vz, &clips);
             P->x[i] = x1;
             P->z[i] = z1;
         }
@@ -96,9 +148,14 @@ mixsph_status integrate_step(mixsph_sim *s)
     s->n_clipped += clips;
     s->t += dt;
     s->step++;
-    const long lost = cells_build(&s->C, P);
-    if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
-    s->n_lost += lost;
+    /* the lists hold while no particle has moved skin/2 since their build; a particle that left
+     * the grid is marked lost by the rebuild at once */
+    int outside = 0;
+    const double shift2 = neighbours_max_shift2(&s->NB, &s->C, P, s->C.start[s->C.ncell], &outside, SIM_THREADS(s));
+    if (outside || 4.0 * shift2 >= s->NB.skin * s->NB.skin) {
+        const mixsph_status st = integrate_rebuild(s);
+        if (st != MIXSPH_OK) return st;
+    }
     int bad_rho = forces_continuity(s);
 #pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {

@@ -141,19 +141,15 @@ void mixture_update(mixsph_sim *s)
         if (P->state[i] != MIXSPH_STATE_FIXED) continue;
         const double xi = P->x[i], zi = P->z[i];
         double sw = 0.0, sp = 0.0;
-        int ix, iz;
-        cells_coords(C, xi, zi, &ix, &iz);
-        for (int row = -1; row <= 1; row++) {
-            const struct range rg = cells_row(C, ix, iz, row);
-            for (size_t j = rg.begin; j < rg.end; j++) {
-                if (P->state[j] != MIXSPH_STATE_MOBILE || s->cfg.media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
-                const double rx = xi - P->x[j], rz = zi - P->z[j];
-                const double r2 = rx * rx + rz * rz;
-                if (r2 >= KW->r2max) continue;
-                const double w = kernel_w(KW, sqrt(r2));
-                sw += w;
-                sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
-            }
+        for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
+            for (size_t j = s->G.rng[6 * i + k]; j < s->G.rng[6 * i + k + 1]; j++) {
+            if (P->state[j] != MIXSPH_STATE_MOBILE || s->cfg.media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
+            const double rx = xi - P->x[j], rz = zi - P->z[j];
+            const double r2 = rx * rx + rz * rz;
+            if (r2 >= KW->r2max) continue;
+            const double w = kernel_w(KW, sqrt(r2));
+            sw += w;
+            sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
         }
         if (sw > 0.0) P->p[i] = sp / sw;
     }

@@ -1,5 +1,6 @@
 /* particles.h - struct-of-arrays particle storage (fluid, granular and wall particles in one
- * set, told apart by `state`), growth and permutation (the cell sort reorders every step). */
+ * set, told apart by `state`), growth and permutation (the cell sort reorders them at each
+ * rebuild of the neighbour ranges). */
 #ifndef MIXSPH_PARTICLES_H
 #define MIXSPH_PARTICLES_H
 #include <stddef.h>

@@ -190,7 +190,9 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (!(s->P.x[i] >= dom[0] && s->P.x[i] < dom[1] && s->P.z[i] >= dom[2] && s->P.z[i] < dom[3]))
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
                             s->P.x[i], s->P.z[i]);
-    if (cells_init(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h) != 0)
+    s->NB.skin = NEIGHBOURS_SKIN_OVER_H * s->h;
+    if (cells_init_columns(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h + s->NB.skin,
+                           SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->domain[0], s->domain[1], s->domain[2], s->domain[3]);
     if (cells_build(&s->C, &s->P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
@@ -199,6 +201,9 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (s->P.state[i] == MIXSPH_STATE_LOST)
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
                             s->P.x[i], s->P.z[i]);
+    if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
+    if ((st = integrate_gather(s)) != MIXSPH_OK) return st;
     if (forces_continuity(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     integrate_eos(s);
     if (s->has_granular) mixture_update(s);
@@ -278,6 +283,9 @@ void mixsph_sim_destroy(mixsph_sim *s)
     if (s->has_granular) mixture_free(s);
     particles_free(&s->P);
     cells_free(&s->C);
+    neighbours_free(&s->NB);
+    neighbours_gather_free(&s->G);
+    free(s->near_wall);
     case_free(&s->cfg);
     for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
     free(s->ov_key);

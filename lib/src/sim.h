@@ -9,6 +9,7 @@
 #include "cells.h"
 #include "kernel.h"
 #include "mixsph.h"
+#include "neighbours.h"
 #include "particles.h"
 
 #ifdef _OPENMP
@@ -16,6 +17,11 @@
 #define SIM_THREADS(s) ((s)->n_threads > 0 ? (s)->n_threads : omp_get_max_threads())
 #else
 #define SIM_THREADS(s) 1
+#endif
+
+/* Cell columns per neighbour-search radius (cells.c, neighbours.c). */
+#ifndef SIM_CELL_COLUMNS
+#define SIM_CELL_COLUMNS 4
 #endif
 
 #define SIM_MAX_OUTPUTS (8 + CASE_MAX_MONITORS)
@@ -49,6 +55,9 @@ struct mixsph_sim {
     double domain[4];             /* x_min, x_max, z_min, z_max [m] */
     struct particles P;
     struct cells C;
+    struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
+    struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
+    uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
     int has_granular;             /* any granular medium: strain rates and regimes every step */
@@ -102,6 +111,8 @@ void mixture_free(mixsph_sim *s);
 void mixture_update(mixsph_sim *s);
 
 /* integrate.c */
+mixsph_status integrate_rebuild(mixsph_sim *s);
+mixsph_status integrate_gather(mixsph_sim *s);
 double integrate_time_step(const mixsph_sim *s);
 mixsph_status integrate_step(mixsph_sim *s);
 void integrate_eos(mixsph_sim *s);

@@ -167,6 +167,10 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
     put(w, P->state, P->n);
     put(w, P->nneigh, P->n * sizeof(uint16_t));
     put(w, P->id, P->n * sizeof(uint32_t));
+    /* the neighbour lists' build positions: the lists (and the pair order) are rebuilt from them */
+    put(w, s->NB.x0, P->n * sizeof(double));
+    put(w, s->NB.z0, P->n * sizeof(double));
+    put_u64(w, s->NB.builds);
 }
 
 mixsph_status mixsph_sim_save_state(const mixsph_sim *s, void **buf, size_t *len)
@@ -270,6 +274,15 @@ int state_same_case(const mixsph_sim *s, const char *text, const char *const *ke
     return 1;
 }
 
+/* Cells and neighbour lists from the build positions (the particles are in their build order). */
+static mixsph_status state_relist(mixsph_sim *s)
+{
+    if (cells_index(&s->C, &s->P, s->NB.x0, s->NB.z0) != 0 ||
+        neighbours_relist(&s->NB, &s->C, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particles not in cell order (or out of memory)");
+    return integrate_gather(s);
+}
+
 /* Read the dynamic part into s (same case, checked by the caller). On a malformed stream s may
  * be partly overwritten: the caller restores from its own copy. */
 static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
@@ -311,10 +324,11 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
     get(r, P->state, P->n);
     get(r, P->nneigh, P->n * sizeof(uint16_t));
     get(r, P->id, P->n * sizeof(uint32_t));
+    get(r, s->NB.x0, P->n * sizeof(double));
+    get(r, s->NB.z0, P->n * sizeof(double));
+    s->NB.builds = get_u64(r);
     if (r->bad || r->pos != r->len) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: malformed particle section");
-    /* the saved order is the cell order of the saved step: rebuilding the list keeps it */
-    if (cells_build(&s->C, P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
-    return MIXSPH_OK;
+    return state_relist(s);
 }
 
 mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
@@ -334,11 +348,17 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     if (st != MIXSPH_OK) return st;
     /* keep a copy so that a malformed payload leaves the simulation unchanged */
     mixsph_sim *keep = malloc(sizeof *keep);
+    const size_t nb = s->P.n * sizeof(double);
+    double *x0k = malloc(nb + 1), *z0k = malloc(nb + 1);
     struct particles Pk;
-    if (!keep || particles_copy(&Pk, &s->P) != 0) {
+    if (!keep || !x0k || !z0k || particles_copy(&Pk, &s->P) != 0) {
         free(keep);
+        free(x0k);
+        free(z0k);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     }
+    memcpy(x0k, s->NB.x0, nb);
+    memcpy(z0k, s->NB.z0, nb);
     memcpy(keep, s, sizeof *s);
     st = read_dynamic(&r, s);
     if (st != MIXSPH_OK) {
@@ -355,11 +375,15 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
         memcpy(s->P.state, Pk.state, n);
         memcpy(s->P.nneigh, Pk.nneigh, n * sizeof(uint16_t));
         memcpy(s->P.id, Pk.id, n * sizeof(uint32_t));
-        cells_build(&s->C, &s->P);
+        memcpy(s->NB.x0, x0k, nb);
+        memcpy(s->NB.z0, z0k, nb);
+        state_relist(s);
         memcpy(s->err, msg, sizeof msg);
     }
     particles_free(&Pk);
     free(keep);
+    free(x0k);
+    free(z0k);
     return st;
 }
 

@@ -150,13 +150,30 @@ void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old,
     }
 }
 
+/* W(q) without branches (0 for q >= 2), for the vectorised gather below. */
+static inline double walls_w(double q, double a_d, int wendland)
+{
+    if (wendland) {
+        double s = 1.0 - 0.5 * q;
+        s = s > 0.0 ? s : 0.0;
+        return a_d * s * s * s * s * (2.0 * q + 1.0);
+    }
+    double t = 2.0 - q;
+    t = t > 0.0 ? t : 0.0;
+    const double inner = 1.0 - 1.5 * q * q + 0.75 * q * q * q, outer = 0.25 * t * t * t;
+    return a_d * (q < 1.0 ? inner : outer);
+}
+
 /* Pressure and viscous velocity of wall particles from the surrounding fluid (Adami 2012). */
 void walls_pressure(mixsph_sim *s)
 {
     struct particles *P = &s->P;
     const struct cells *C = &s->C;
+    const struct gather *G = &s->G;
     const struct kernel *K = &s->K;
     const double g = s->cfg.g, vol = s->dx * s->dx, rho_default = s->cfg.media[0].rho0;
+    const double inv_h = 1.0 / K->h;
+    const int wendland = K->type == KERNEL_WENDLAND_C2;
     const size_t n = C->start[C->ncell];
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
@@ -166,22 +183,15 @@ void walls_pressure(mixsph_sim *s)
         const double gx = -ws->ax, gz = -g - ws->az;
         const double xi = P->x[i], zi = P->z[i];
         double sw = 0.0, sp = 0.0, svx = 0.0, svz = 0.0, srho = 0.0;
-        int ix, iz;
-        cells_coords(C, xi, zi, &ix, &iz);
-        for (int row = -1; row <= 1; row++) {
-            const struct range rg = cells_row(C, ix, iz, row);
-            for (size_t j = rg.begin; j < rg.end; j++) {
-                if (P->state[j] == MIXSPH_STATE_WALL) continue;
-                const double rx = xi - P->x[j], rz = zi - P->z[j];
-                const double r2 = rx * rx + rz * rz;
-                if (r2 >= K->r2max) continue;
-                const double wgt = kernel_w(K, sqrt(r2));
-                sw += wgt;
-                sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
-                svx += P->vx[j] * wgt;
-                srho += P->rho[j] * wgt;
-                svz += P->vz[j] * wgt;
-            }
+        for (size_t k = G->start[i]; k < G->start[i + 1]; k++) { /* the non-wall neighbours */
+            const size_t j = G->list[k];
+            const double rx = xi - P->x[j], rz = zi - P->z[j];
+            const double wgt = walls_w(sqrt(rx * rx + rz * rz) * inv_h, K->a_d, wendland);
+            sw += wgt;
+            sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
+            svx += P->vx[j] * wgt;
+            srho += P->rho[j] * wgt;
+            svz += P->vz[j] * wgt;
         }
         const int noslip = s->cfg.walls[P->medium[i]].slip == WALL_NO_SLIP;
         if (sw > 0.0) {

@@ -1,0 +1,171 @@
+/* neighbours.c - see neighbours.h. */
+#include "neighbours.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "mixsph.h"
+
+void neighbours_free(struct neighbours *NB)
+{
+    free(NB->x0);
+    free(NB->z0);
+    free(NB->rng);
+    const double skin = NB->skin;
+    memset(NB, 0, sizeof *NB);
+    NB->skin = skin;
+}
+
+static int grow(void **p, size_t n, size_t elem)
+{
+    void *q = realloc(*p, n * elem);
+    if (!q) return -1;
+    *p = q;
+    return 0;
+}
+
+int neighbours_reserve(struct neighbours *NB, size_t cap)
+{
+    if (cap + 1 <= NB->cap_n) return 0;
+    cap++;
+    if (grow((void **)&NB->x0, cap, sizeof(double)) || grow((void **)&NB->z0, cap, sizeof(double)) ||
+        grow((void **)&NB->rng, 4 * cap, sizeof(uint32_t)))
+        return -1;
+    NB->cap_n = cap;
+    return 0;
+}
+
+int neighbours_build(struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n, double rc,
+                     int n_threads)
+{
+    if (neighbours_reserve(NB, P->cap) != 0) return -1;
+    memcpy(NB->x0, P->x, P->n * sizeof(double));
+    memcpy(NB->z0, P->z, P->n * sizeof(double));
+    return neighbours_relist(NB, C, n, rc, n_threads);
+}
+
+/* [b, e) trimmed to its first and last particle closer than rc to (xi, zi) (empty if none). */
+static inline void trim(const double *x, const double *z, double xi, double zi, double rc2, size_t *b, size_t *e)
+{
+    size_t lo = *b, hi = *e;
+    while (lo < hi && (xi - x[lo]) * (xi - x[lo]) + (zi - z[lo]) * (zi - z[lo]) >= rc2) lo++;
+    while (hi > lo && (xi - x[hi - 1]) * (xi - x[hi - 1]) + (zi - z[hi - 1]) * (zi - z[hi - 1]) >= rc2) hi--;
+    *b = lo;
+    *e = hi;
+}
+
+int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads)
+{
+    const double rc2 = rc * rc;
+    const double *x = NB->x0, *z = NB->z0;
+#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
+    for (size_t i = 0; i < n; i++) {
+        const size_t c = C->cell[i];
+        const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
+        const int last = ix + C->kx < C->nx ? ix + C->kx : C->nx - 1;
+        size_t b1 = i + 1, e1 = C->start[(size_t)iz * (size_t)C->nx + (size_t)last + 1];
+        trim(x, z, x[i], z[i], rc2, &b1, &e1);
+        const struct range up = cells_row(C, ix, iz, 1);
+        size_t b2 = up.begin, e2 = up.end;
+        trim(x, z, x[i], z[i], rc2, &b2, &e2);
+        NB->rng[4 * i] = (uint32_t)b1;
+        NB->rng[4 * i + 1] = (uint32_t)e1;
+        NB->rng[4 * i + 2] = (uint32_t)b2;
+        NB->rng[4 * i + 3] = (uint32_t)e2;
+    }
+    NB->builds++;
+    return 0;
+}
+
+double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
+                             int *outside, int n_threads)
+{
+    double m = 0.0;
+    int out = 0;
+    const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
+#pragma omp parallel for schedule(static) reduction(max : m) reduction(| : out) num_threads(n_threads > 0 ? n_threads : 1)
+    for (size_t i = 0; i < n; i++) {
+        const double dx = P->x[i] - NB->x0[i], dz = P->z[i] - NB->z0[i];
+        const double d2 = dx * dx + dz * dz;
+        m = d2 > m ? d2 : m;
+        out |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
+    }
+    *outside = out;
+    return m;
+}
+
+void neighbours_gather_free(struct gather *G)
+{
+    free(G->rng);
+    free(G->mode);
+    free(G->start);
+    free(G->list);
+    memset(G, 0, sizeof *G);
+}
+
+int neighbours_gather_reserve(struct gather *G, size_t cap)
+{
+    if (cap + 1 <= G->cap_n) return 0;
+    cap++;
+    if (grow((void **)&G->rng, 6 * cap, sizeof(uint32_t)) || grow((void **)&G->mode, cap, 1) ||
+        grow((void **)&G->start, cap + 1, sizeof(size_t)))
+        return -1;
+    G->cap_n = cap;
+    return 0;
+}
+
+/* Non-wall neighbours of wall particle i within rc over its ranges: counted or written. */
+static inline size_t wall_scan(const struct gather *G, const double *x, const double *z, const uint8_t *state, size_t i,
+                               double rc2, uint32_t *out)
+{
+    size_t k = 0;
+    for (int q = 0; q < 6; q += 2)
+        for (size_t j = G->rng[6 * i + q]; j < G->rng[6 * i + q + 1]; j++) {
+            if (state[j] == MIXSPH_STATE_WALL) continue;
+            const double rx = x[i] - x[j], rz = z[i] - z[j];
+            if (rx * rx + rz * rz < rc2) {
+                if (out) out[k] = (uint32_t)j;
+                k++;
+            }
+        }
+    return k;
+}
+
+int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const struct cells *C, const uint8_t *state,
+                            size_t n, double rc, int n_threads)
+{
+    const double rc2 = rc * rc;
+    const double *x = NB->x0, *z = NB->z0;
+#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
+    for (size_t i = 0; i < n; i++) {
+        uint32_t *r = G->rng + 6 * i;
+        if (G->mode[i] == NEIGHBOURS_GATHER_NONE) {
+            memset(r, 0, 6 * sizeof *r);
+            continue;
+        }
+        const size_t c = C->cell[i];
+        const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
+        for (int row = -1; row <= 1; row++) {
+            const struct range g = cells_row(C, ix, iz, row);
+            size_t b = g.begin, e = g.end;
+            trim(x, z, x[i], z[i], rc2, &b, &e);
+            r[2 * (row + 1)] = (uint32_t)b;
+            r[2 * (row + 1) + 1] = (uint32_t)e;
+        }
+    }
+    size_t *cnt = G->start + 1;
+#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
+    for (size_t i = 0; i < n; i++) cnt[i] = state[i] == MIXSPH_STATE_WALL ? wall_scan(G, x, z, state, i, rc2, NULL) : 0;
+    G->start[0] = 0;
+    for (size_t i = 0; i < n; i++) G->start[i + 1] += G->start[i];
+    const size_t total = G->start[n];
+    if (total + NEIGHBOURS_PAD > G->cap_list) {
+        const size_t cap = total + total / 4 + NEIGHBOURS_PAD + 64;
+        if (grow((void **)&G->list, cap, sizeof(uint32_t))) return -1;
+        G->cap_list = cap;
+    }
+#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
+    for (size_t i = 0; i < n; i++)
+        if (state[i] == MIXSPH_STATE_WALL) wall_scan(G, x, z, state, i, rc2, G->list + G->start[i]);
+    return 0;
+}

@@ -1,0 +1,86 @@
+/* neighbours.h - Verlet neighbour ranges with a skin over the cell list (cells.c).
+ *
+ * The cells are rows of height 2h + skin cut into kx narrow columns per row height, and the
+ * particles are sorted by (row, column). For each particle i the pair loops (forces.c) walk two
+ * contiguous ranges of candidates j, its half stencil: the particles after i in its own row up
+ * to column ix + kx, and the particles of columns ix-kx..ix+kx of the row above, both trimmed at
+ * the build to the first and last candidates closer than 2h + skin. Contiguous ranges keep the
+ * inner loops on unit-stride loads (this CPU gathers slowly) while the narrow columns and the
+ * trimming cut the candidates beyond 2h from about 70% (square cells of side 2h) to about half.
+ * The ranges stay valid while no particle has moved more than skin/2 since the build (no pair
+ * can have come closer than 2h unseen), so the sort and the build run once every many steps:
+ * in this model the time step is set by the viscosity of the grains or by the sound speed, and a
+ * particle moves a small fraction of h per step. Between builds particles keep their memory
+ * order and the cells keep describing the build positions; bands of cell rows are fixed index
+ * ranges, so the threads' write sets stay disjoint (forces.c). */
+#ifndef MIXSPH_NEIGHBOURS_H
+#define MIXSPH_NEIGHBOURS_H
+#include <stddef.h>
+#include <stdint.h>
+
+#include "cells.h"
+#include "particles.h"
+
+/* Skin as a fraction of h: a larger skin means fewer builds but more candidates per pair loop
+ * ((2h + skin)^2 / (2h)^2 of them are beyond 2h). */
+#ifndef NEIGHBOURS_SKIN_OVER_H
+#define NEIGHBOURS_SKIN_OVER_H 0.3
+#endif
+
+/* Entries past the end of a gather list that a chunked loop may read (see forces.c). */
+#define NEIGHBOURS_PAD 16
+
+struct neighbours {
+    double skin;        /* [m] */
+    double *x0, *z0;    /* positions at the last build [m] */
+    uint32_t *rng;      /* per particle i, 4 entries: own row [rng[4i], rng[4i+1]), row above [rng[4i+2], rng[4i+3]) */
+    size_t cap_n;
+    uint64_t builds;    /* number of builds (diagnostic) */
+};
+
+/* Gather ranges: for chosen particles, their whole neighbourhood as three contiguous ranges
+ * (rows iz-1, iz, iz+1, columns ix-kx..ix+kx, trimmed at the build to the candidates closer
+ * than rc; i itself included), for loops that gather over one particle's neighbours (the
+ * velocity gradient of grains, the pressure of wall particles). Built with the pair ranges,
+ * from the same build positions. */
+enum { NEIGHBOURS_GATHER_NONE = 0, NEIGHBOURS_GATHER_ALL = 1 };
+
+struct gather {
+    uint32_t *rng;      /* per particle i, 6 entries: [rng[6i+2r], rng[6i+2r+1]) for rows r = 0, 1, 2 */
+    uint8_t *mode;      /* per particle: NEIGHBOURS_GATHER_* (set by the caller before a build) */
+    size_t cap_n;
+    /* wall particles: their non-wall neighbours as a compact list (few of a wall's neighbours
+     * are fluid, so a list beats the ranges): list[start[i] .. start[i+1]) */
+    size_t *start;
+    uint32_t *list;
+    size_t cap_list;
+};
+
+void neighbours_free(struct neighbours *NB);
+void neighbours_gather_free(struct gather *G);
+/** Make room for cap particles in G. Returns -1 on allocation failure. */
+int neighbours_gather_reserve(struct gather *G, size_t cap);
+/** Build G for the first n particles (those with a mode) from the build positions of NB; the
+ *  lists of the particles whose state is MIXSPH_STATE_WALL. Returns -1 on allocation failure. */
+int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const struct cells *C, const uint8_t *state,
+                            size_t n, double rc, int n_threads);
+
+/** Build the ranges of the first n particles (the cell list's active ones, sorted by cell) with
+ *  a cut-off radius rc (2h + skin) from their current positions, which become the build
+ *  positions. Returns -1 on allocation failure. */
+int neighbours_build(struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n, double rc,
+                     int n_threads);
+
+/** Rebuild the ranges from the build positions already in x0, z0 (a restored state). */
+int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads);
+
+/** Make room for cap particles' build positions. Returns -1 on allocation failure. */
+int neighbours_reserve(struct neighbours *NB, size_t cap);
+
+/** Largest squared displacement of the first n particles since the last build, and whether
+ *  one of them is outside the grid [x0, x0 + nx size) x [z0, z0 + nz size) (then the caller
+ *  rebuilds at once, which marks it lost). */
+double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
+                             int *outside, int n_threads);
+
+#endif
