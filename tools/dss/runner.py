@@ -45,11 +45,11 @@ def dask_client(scheduler: str | None = None, workers: int | None = None, quiet:
         n = workers or os.cpu_count() or 1
         try:
             import bokeh  # noqa: F401  (the dashboard needs it)
-            dash = ":0"
+            dash = True
         except ImportError:
-            dash = None
+            dash = False
         cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                               dashboard_address=dash, silence_logs=logging.ERROR,
+                               dashboard_address=":0", silence_logs=logging.ERROR,
                                env={"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "passive"})
         client = Client(cluster)
     global _TASK_MODULE
