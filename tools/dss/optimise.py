@@ -198,11 +198,15 @@ def optimise(client, fmu_path: str, out_dir: str, output: str, error: float, fix
                 bad = (m0, row, e)
                 break
             steps = row.get("steps", math.nan)
-            good.append((m0, row, e))
-            if math.isfinite(last_steps) and math.isfinite(steps) and steps >= 0.98 * last_steps:
-                stop_reason = (f"steps no longer fall below mu0 = {m0:g} (time step bound by the "
-                               f"acoustic CFL)")
+            if good and math.isfinite(last_steps) and math.isfinite(steps) \
+                    and steps >= 0.98 * last_steps:
+                # no cheaper than the rung above: the time step is the acoustic one; a lower
+                # mu0 would only add error, so mu0_min stays the rung above
+                runs.append(_row2(row, m0, mu_thr_min, ev, e, "no further saving"))
+                stop_reason = (f"steps no longer fall below mu0 = {good[-1][0]:g} (the time "
+                               f"step is bound by the acoustic CFL there)")
                 break
+            good.append((m0, row, e))
             last_steps = steps
     # refinement between the last good and the first bad mu0 (geometric)
     if bad is not None and refine > 0:
