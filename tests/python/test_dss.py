@@ -247,3 +247,28 @@ def test_scenario_with_invalid_parameters_is_recorded_as_failed(tmp_path):
     bad_case = df[df["case_file"] == "no_such_case.json"].iloc[0]
     assert bad_case["status"] == "failed" and bad_case["error"]
     assert "1 ok, 2 failed" in p.stdout
+
+
+def test_optimise_stops_lowering_mu0_where_the_steps_stop_falling(monkeypatch, tmp_path):
+    """Below an acoustic bound (here mu = 2.5 kPa s) the step count no longer falls: mu0_min is the
+    last rung that still saved steps, even though lower mu0 would be within the error."""
+    def fake_run(client, fmu_path, scen, opts, on_result=None, progress=None, run_id=None):
+        rows = []
+        for s in scen:
+            thr, mu0 = s["mu_thr"], s["mu0"]
+            m = max(min(thr, mu0), 2500.0)
+            y = 1.0 - 1e3 / thr
+            row = {**s, "status": "ok", "error": "", "max_run_up": y, "steps": 10 * m,
+                   "wall_time_s": m / 1e3, "cpu_time_s": m / 1e3, "finished_at": "0"}
+            on_result(row)
+            rows.append(row)
+        return rows
+
+    monkeypatch.setattr(O.runner, "run_scenarios", fake_run)
+    monkeypatch.setattr(O.runner, "n_workers", lambda c: 1)
+    res = O.optimise(None, "x.fmu", str(tmp_path), "max_run_up", 5.0, {}, {"stop_time": 1.0},
+                     mu_thr_start=10e3, progress=False)
+    assert res["mu_thr_min"] == 20e3
+    assert res["mu0_min"] == 2500.0
+    assert "steps no longer fall" in res["stop_reason"]
+    assert res["steps_saved_pct"] == pytest.approx(100 * (1 - 2500 / 20e3))
