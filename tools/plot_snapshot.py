@@ -131,7 +131,7 @@ class Drawer:
                                       label="fixed grains"))
             if not args.no_walls:
                 handles.append(Line2D([], [], marker="s", ls="", color=WALL_COLOUR, label="walls"))
-            self.ax.legend(handles=handles, loc="upper right", fontsize=8, markerscale=1.5)
+            self.ax.legend(handles=handles, loc="best", fontsize=8, markerscale=1.5)
         self.title = self.ax.set_title(" ")
         self.fig.tight_layout()
         # marker area so that particles of spacing dx about tile the plane (once the layout and
