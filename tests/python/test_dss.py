@@ -272,3 +272,60 @@ def test_optimise_stops_lowering_mu0_where_the_steps_stop_falling(monkeypatch, t
     assert res["mu0_min"] == 2500.0
     assert "steps no longer fall" in res["stop_reason"]
     assert res["steps_saved_pct"] == pytest.approx(100 * (1 - 2500 / 20e3))
+
+
+def _ancestors(pid):
+    out = []
+    while pid > 1:
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                pid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except OSError:
+            break
+        out.append(pid)
+    return out
+
+
+def test_sweep_on_an_existing_cluster_without_the_repository(tmp_path):
+    """--scheduler: the scenarios run on the workers of a separately started cluster (a scheduler
+    and a worker started in a folder where tools/ is not importable; --upload-code)."""
+    dask = pathlib.Path(sys.executable).parent / "dask"
+    env = {k: v for k, v in ENV.items() if k != "PYTHONPATH"}
+    sched_file = tmp_path / "scheduler.json"
+    cwd = tmp_path / "elsewhere"
+    cwd.mkdir()
+    procs = []
+    try:
+        procs.append(subprocess.Popen(
+            [str(dask), "scheduler", "--host", "127.0.0.1", "--port", "0",
+             "--dashboard-address", ":0", "--scheduler-file", str(sched_file)],
+            cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            start_new_session=True))
+        t0 = time.monotonic()
+        while not sched_file.exists():
+            assert time.monotonic() - t0 < 120, "the scheduler did not start"
+            time.sleep(0.2)
+        procs.append(subprocess.Popen(
+            [str(dask), "worker", "--scheduler-file", str(sched_file), "--nthreads", "1",
+             "--nworkers", "1"],
+            cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+            start_new_session=True))
+        out = tmp_path / "sweep"
+        dss("sweep", out, "--fmu", fmu_path(), "--grid", "phi=30,35", *COARSE, "--stop-time", 0.2,
+            "--scheduler", sched_file, "--upload-code", "--no-report", "--quiet")
+        df = ResultStore(str(out)).latest()
+        assert len(df) == 2 and (df["status"] == "ok").all(), df.get("error")
+        worker = procs[1].pid
+        for pid in df["worker_pid"]:
+            assert worker in _ancestors(int(pid)) or int(pid) == worker
+    finally:
+        for p in reversed(procs):
+            try:
+                os.killpg(p.pid, signal.SIGTERM)
+            except ProcessLookupError:
+                pass
+        for p in procs:
+            try:
+                p.wait(timeout=30)
+            except subprocess.TimeoutExpired:
+                os.killpg(p.pid, signal.SIGKILL)
