@@ -246,6 +246,13 @@ def run_scenario(fmu: dict, params: dict, opts: dict) -> dict:
                 raise TimeoutError(f"timeout: {timeout:g} s wall reached at t = {t:g} s of {stop:g}")
         for n in out_names:
             res[n] = _get(inst, var[n])
+        # the values of every parameter the run used (those the scenario did not set too)
+        for v in md.modelVariables:
+            if v.causality == "parameter" and v.name not in params:
+                try:
+                    res[v.name] = _get(inst, v)
+                except Exception:
+                    pass
         if series_names:
             res["series"] = {"time": times, **series}
         inst.terminate()

@@ -66,16 +66,15 @@ def make_report(df: pd.DataFrame, out_dir: str, crest: float | None = None, x: s
     info["n_ok"], info["n_failed"] = len(ok), len(df) - len(ok)
 
     # ---- the scenario table ----------------------------------------------------------------
-    cols = [c for c in df.columns if c not in META]
+    cols = [c for c in df.columns if c not in META or c == "error"]
     table = df[cols].copy()
     csv_path = os.path.join(out_dir, "scenario_table.csv")
     table.to_csv(csv_path, index=False)
     info["files"].append(csv_path)
-    shown = [c for c in [ID] + [c for c in cols if c != ID] if c not in ("stop_time", "series")]
-    pretty = [c for c in shown if c in ("scenario_id", "status", "wall_time_s", "max_run_up",
-                                        "time_of_max_run_up", "max_run_up_Z")
-              or (c not in ("run_up", "landslide_front", "kinetic_energy", "fixed_particles", "dt",
-                            "lost_particles", "steps") and c in df.columns)]
+    # the PNG: the parameters that vary between scenarios, the run-up results and the status
+    outs = [c for c in ("max_run_up", "time_of_max_run_up", "max_run_up_Z", "wall_time_s", "status")
+            if c in df.columns]
+    pretty = [ID] + [c for c in varied_params(df) if c not in outs] + outs
     sub = table[pretty].head(max_table_rows)
     cells = [[_fmt(v) for v in r] for r in sub.itertuples(index=False)]
     fig_h = 0.6 + 0.25 * (len(cells) + 1)
