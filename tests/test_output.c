@@ -342,6 +342,51 @@ static void test_resume_refuses_other_run(void **state)
     remove_tree(dir);
 }
 
+/* A simulation sent back by mixsph_sim_load_state rewrites its snapshots (same indices) without
+ * error, and run.h5 then holds those of the new trajectory. */
+static void test_load_state_rewrites_snapshots(void **state)
+{
+    (void)state;
+    char dir[512], path[600];
+    temp_dir(dir, sizeof dir);
+    mixsph_sim *s = make(0.02);
+    assert_int_equal(mixsph_sim_set_output_dir(s, dir), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.03), MIXSPH_OK); /* snapshot 0 */
+    void *buf = NULL;
+    size_t len = 0;
+    assert_int_equal(mixsph_sim_save_state(s, &buf, &len), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.10), MIXSPH_OK); /* snapshots 1, 2 */
+    assert_int_equal(mixsph_sim_load_state(s, buf, len), MIXSPH_OK);
+    mixsph_state_free(buf);
+    assert_int_equal(mixsph_sim_advance_to(s, 0.05), MIXSPH_OK); /* snapshot 1 again */
+    mixsph_particles_view v;
+    mixsph_sim_particles_view(s, &v);
+    const size_t n = v.n;
+    snprintf(path, sizeof path, "%s/run.h5", dir);
+    const hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+#if H5_VERSION_GE(1, 10, 7)
+    H5Pset_file_locking(fapl, 0, 1);
+#endif
+    const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    H5Pclose(fapl);
+    assert_true(f >= 0);
+    assert_int_equal(read_attr_ll(f, "n_snapshots"), 2);
+    const hid_t g = H5Gopen2(f, "/snapshots/000001", H5P_DEFAULT);
+    double *pos = read_dataset(g, "position", n, 2, H5T_FLOAT, 8, "m");
+    for (size_t i = 0; i < n; i++) assert_memory_equal(&pos[2 * v.id[i]], &v.x[i], sizeof(double));
+    free(pos);
+    H5Gclose(g);
+    H5Fclose(f);
+    size_t xl;
+    snprintf(path, sizeof path, "%s/run.xdmf", dir);
+    char *x = read_text(path, &xl);
+    assert_non_null(strstr(x, "/snapshots/000001/"));
+    assert_null(strstr(x, "/snapshots/000002/"));
+    free(x);
+    mixsph_sim_destroy(s);
+    remove_tree(dir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -349,6 +394,7 @@ int main(void)
         cmocka_unit_test(test_unwritable_output),
         cmocka_unit_test(test_restart_equals_uninterrupted),
         cmocka_unit_test(test_resume_refuses_other_run),
+        cmocka_unit_test(test_load_state_rewrites_snapshots),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -27,6 +27,8 @@
  *     every dataset has the attributes units and description.
  *   /xdmf/vertices_N    0..N-1, the XDMF Polyvertex topology of N particles
  *
+ * A simulation sent back in time by mixsph_sim_load_state writes its snapshots again: each
+ * replaces the group of the same index, and the sidecar lists the snapshots up to the newest.
  * A snapshot is written, then the file is flushed (H5Fflush) and n_snapshots updated, and then
  * run.xdmf is rewritten (to a temporary name, then renamed over the old one) listing the
  * snapshots so far: a run killed at any point leaves run.h5 with every flushed snapshot
@@ -618,6 +620,9 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
     for (size_t i = 0; i < P->n && by_id; i++) by_id = P->id[i] < P->n;
     char name[64];
     snprintf(name, sizeof name, "/snapshots/%06ld", index);
+    /* a snapshot of this index from before a mixsph_sim_load_state that went back in time */
+    if (H5Lexists(o->file, name, H5P_DEFAULT) > 0 && H5Ldelete(o->file, name, H5P_DEFAULT) < 0) return -1;
+    while (o->n_snaps > 0 && o->snaps[o->n_snaps - 1].index >= index) o->n_snaps--;
     const hid_t g = H5Gcreate2(o->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (g < 0) return -1;
     /* the attribute index is written last: a group without it is incomplete */
