@@ -174,7 +174,8 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
 }
 
 /* Momentum between i and candidates [b, e): the pair force f_ij (per unit depth) is added to
- * a_i as f/m_i and subtracted from a_j as f/m_j. */
+ * i and subtracted from j (ax, az hold forces during the pass; forces_compute divides by the
+ * masses after it). */
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b, size_t e,
                                   double *axi, double *azi, const int wendland)
 {
@@ -184,8 +185,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double walli = ti < 0.0 ? 1.0 : 0.0;
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
     const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
-    const double *restrict m = P->m, *restrict irho = P->inv_rho, *restrict mu = P->mu, *restrict tag = P->tag;
-    const double *restrict avc = P->avc, *restrict im = P->inv_m;
+    const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
+    const double *restrict avc = P->avc;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
     for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
@@ -198,8 +199,14 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double rx = xi - x[j], rz = zi - z[j];
             const double r2 = rx * rx + rz * rz;
             const double F = pair_f(&Xl, r2, wendland) * in;
-            const double inv_r2e = 1.0 / (r2 + Xl.eta2);
             const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
+            /* one division for 1 / (r^2 + eta^2) and 1 / (mu_i + mu_j) (a wall takes the
+             * viscosity of the particle it meets; mu_i + mu_j > 0 but for wall-wall pairs,
+             * which vanish; the 1e-30 keeps them finite) */
+            const double muj = mu[j] + wallj * mui, mu_i = mui + walli * mu[j];
+            const double r2e = r2 + Xl.eta2, mus = mu_i + muj + 1e-30;
+            const double inv_d = 1.0 / (r2e * mus);
+            const double inv_r2e = inv_d * mus;
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
             /* pressure */
             double fr = -vv * (pi + p[j]);
@@ -208,18 +215,17 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             vdotr = vdotr < 0.0 ? vdotr : 0.0;
             const double same = (tag[j] == ti ? 1.0 : 0.0) + walli + wallj > 0.0 ? 1.0 : 0.0;
             const double avc_ij = avci > avc[j] ? avci : avc[j];
-            fr += same * (1.0 - walli * wallj) * avc_ij * mi * m[j] * vdotr * inv_r2e * 0.5 * (irhoi + irho[j]);
-            /* laminar viscosity, pairwise harmonic mean (a wall takes the viscosity of the
-             * particle it meets): mu_i + mu_j of Morris is replaced by 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j) */
-            const double muj = mu[j] + wallj * mui, mu_i = mui + walli * mu[j];
-            const double musum = 4.0 * mu_i * muj / (mu_i + muj + 1e-300);
-            const double fv = vv * musum * r2 * inv_r2e;
+            /* m_i m_j (1/rho_i + 1/rho_j) / 2 = m_i (m_j / rho_i + V_j) / 2 */
+            fr += same * (1.0 - walli * wallj) * avc_ij * mi * (m[j] * irhoi + vol[j]) * vdotr * inv_r2e * 0.5;
+            /* laminar viscosity, pairwise harmonic mean: mu_i + mu_j of Morris is replaced by
+             * 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j); times r^2 / (r^2 + eta^2) */
+            const double fv = vv * 4.0 * mu_i * muj * r2 * inv_d;
             const double fx = F * (fr * rx + fv * (uvxi - uvx[j]));
             const double fz = F * (fr * rz + fv * (uvzi - uvz[j]));
             sx[k] += fx;
             sz[k] += fz;
-            ajx[k] = -fx * im[j];
-            ajz[k] = -fz * im[j];
+            ajx[k] = -fx; /* forces: divided by the masses once, after the pass */
+            ajz[k] = -fz;
         }
         chunk_add(P->ax, jb, n, ajx);
         chunk_add(P->az, jb, n, ajz);
@@ -274,8 +280,8 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
         const uint32_t *r = NB->rng + 4 * i;
         momentum_range(X, P, i, r[0], r[1], &sx, &sz, wendland);
         momentum_range(X, P, i, r[2], r[3], &sx, &sz, wendland);
-        P->ax[i] += sx * P->inv_m[i];
-        P->az[i] += sz * P->inv_m[i];
+        P->ax[i] += sx;
+        P->az[i] += sz;
     }
 }
 
@@ -360,7 +366,8 @@ int forces_compute(mixsph_sim *s)
     int bad = 0;
 #pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
-        P->az[i] -= g;
+        P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
+        P->az[i] = P->az[i] * P->inv_m[i] - g;
         bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
     }
     return bad;
