@@ -220,7 +220,7 @@ static void test_unwritable_output(void **state)
     /* a file that is not a checkpoint */
     mixsph_sim *r = NULL;
     char err[512];
-    assert_int_equal(mixsph_sim_create_from_checkpoint(DAMBREAK, &r, err, sizeof err), MIXSPH_ERR_IO);
+    assert_int_equal(mixsph_sim_create_from_checkpoint(DAMBREAK, &r, err, sizeof err), MIXSPH_ERR_ARG);
     assert_null(r);
     assert_non_null(strstr(err, "dambreak_water.json"));
     mixsph_sim_destroy(s);

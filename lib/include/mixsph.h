@@ -163,7 +163,8 @@ mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_s
  *  `path`, so a crash leaves either the previous checkpoint or the new one, never half of one. */
 mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path);
 
-/** Create a simulation from a checkpoint file (restart). */
+/** Create a simulation from a checkpoint file (restart). A missing file or one that is not a
+ *  mixsph checkpoint is MIXSPH_ERR_ARG, a failed read MIXSPH_ERR_IO. */
 mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len);
 
 /** As mixsph_sim_set_output_dir for a simulation restored from a checkpoint, continuing the

@@ -314,11 +314,9 @@ static mixsph_status run_create(mixsph_sim *s, struct output *o)
 {
     const hid_t fapl = fapl_nolock();
     o->file = H5Fcreate(o->path, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    if (o->file < 0) H5_FAIL(s, "cannot create the HDF5 run file", o->path); /* before any other call */
     if (fapl >= 0) H5Pclose(fapl);
-    if (o->file < 0) {
-        H5_FAIL(s, "cannot create the HDF5 run file", o->path);
-        return MIXSPH_ERR_IO;
-    }
+    if (o->file < 0) return MIXSPH_ERR_IO;
     char created[64];
     utc_now(created, sizeof created);
     char *ov = overrides_text(s);
@@ -404,11 +402,9 @@ static mixsph_status run_continue(mixsph_sim *s, struct output *o)
 {
     const hid_t fapl = fapl_nolock();
     o->file = H5Fopen(o->path, H5F_ACC_RDWR, fapl);
+    if (o->file < 0) H5_FAIL(s, "cannot open the run file to continue it (give another output folder)", o->path);
     if (fapl >= 0) H5Pclose(fapl);
-    if (o->file < 0) {
-        H5_FAIL(s, "cannot open the run file to continue it (give another output folder)", o->path);
-        return MIXSPH_ERR_IO;
-    }
+    if (o->file < 0) return MIXSPH_ERR_IO;
     const hid_t g = H5Gopen2(o->file, "metadata", H5P_DEFAULT);
     char *text = g < 0 ? NULL : dset_read_string(g, "case_json");
     char *ov = g < 0 ? NULL : attr_read_str(g, "overrides");
@@ -721,6 +717,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     quiet_on(&q);
     const hid_t fapl = fapl_nolock();
     const hid_t f = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    if (f < 0) H5_FAIL(s, "cannot create the checkpoint", tmp);
     if (fapl >= 0) H5Pclose(fapl);
     char created[64];
     utc_now(created, sizeof created);
@@ -733,7 +730,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
               dset_write(f, "state", H5T_STD_U8LE, H5T_NATIVE_UINT8, len, 0, buf, "1",
                          "mixsph_sim_save_state buffer (versioned, checksummed; same build and machine type)");
     if (f >= 0) bad |= H5Fclose(f) < 0;
-    if (bad) H5_FAIL(s, f < 0 ? "cannot create the checkpoint" : "cannot write the checkpoint", tmp);
+    if (bad && f >= 0) H5_FAIL(s, "cannot write the checkpoint", tmp);
     quiet_off(&q);
     mixsph_state_free(buf);
     if (!bad) {
@@ -759,7 +756,7 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
     if (out) *out = NULL;
     if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
     if (access(path, R_OK) != 0)
-        return status_set(err, err_len, MIXSPH_ERR_IO, "checkpoint %s: cannot read: %s", path, strerror(errno));
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "checkpoint %s: cannot read: %s", path, strerror(errno));
     struct quiet q;
     quiet_on(&q);
     struct cause c;
@@ -768,9 +765,10 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
     size_t len = 0;
     const hid_t fapl = fapl_nolock();
     const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
+    if (f < 0) h5_cause(&c); /* before any other call clears it */
     if (fapl >= 0) H5Pclose(fapl);
     if (f < 0) {
-        st = status_set(err, err_len, MIXSPH_ERR_IO, "checkpoint %s: not a readable HDF5 file (HDF5: %s)", path, h5_cause(&c));
+        st = status_set(err, err_len, MIXSPH_ERR_ARG, "checkpoint %s: not an HDF5 file (HDF5: %s)", path, c.text);
     } else {
         const hid_t d = H5Dopen2(f, "state", H5P_DEFAULT);
         const hid_t sp = d < 0 ? -1 : H5Dget_space(d);
