@@ -6,9 +6,11 @@
  *              [--no-csv]
  *
  * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
- * on stdout and summary.json in the output folder. Exit codes: 0 ok, 2 bad usage or input,
+ * on stdout and summary.json in the output folder. SIGINT or SIGTERM (Ctrl-C) stops the run at the
+ * next progress step with a checkpoint (a second one kills at once). Exit codes: 0 ok, 2 bad usage or input,
  * 3 unstable run, 4 out of memory or output failure. */
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +40,11 @@ static void usage(FILE *f)
             "                    (monitors.csv, run.h5, snapshots) are continued from the checkpoint's time\n"
             "  --no-csv          particle snapshots only in run.h5 (no snap_NNNN.csv)\n");
 }
+
+/* The signal that asked the run to stop (SIGINT, SIGTERM), 0 if none. */
+static volatile sig_atomic_t stop_signal = 0;
+
+static void on_stop_signal(int sig) { stop_signal = sig; }
 
 static int exit_code(mixsph_status st)
 {
@@ -262,7 +269,14 @@ static int cmd_run(int argc, char **argv)
     double last_print = 0.0, last_ckpt = t0;
     unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
-    for (int c = 1; c <= chunks && st == MIXSPH_OK; c++) {
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND; /* a second signal has its default effect */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+    for (int c = 1; c <= chunks && st == MIXSPH_OK && !stop_signal; c++) {
         st = mixsph_sim_advance_to(s, t_end * c / chunks);
         if (st == MIXSPH_OK && ckpt_every >= 0.0 && c < chunks && mixsph_sim_steps(s) > ckpt_step &&
             now() - last_ckpt >= ckpt_every) {
@@ -282,14 +296,22 @@ static int cmd_run(int argc, char **argv)
     }
     if (tty) fprintf(stderr, "\n");
     const double wall = now() - t0;
+    const int stopped = stop_signal && st == MIXSPH_OK && mixsph_sim_time(s) < t_end;
+    if (stopped) {
+        st = mixsph_sim_write_checkpoint(s, ckpt);
+        if (st == MIXSPH_OK)
+            fprintf(stderr, "mixsph: stopped by signal %d at t = %.6g s; continue with: mixsph run --restart %s\n",
+                    (int)stop_signal, mixsph_sim_time(s), ckpt);
+    }
     if (st != MIXSPH_OK) fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));
-    if (write_summary(dir, s, case_path, threads, wall, st == MIXSPH_OK ? "ok" : mixsph_status_string(st)) != 0) {
+    if (write_summary(dir, s, case_path, threads, wall,
+                      st != MIXSPH_OK ? mixsph_status_string(st) : stopped ? "stopped" : "ok") != 0) {
         fprintf(stderr, "mixsph: %s/summary.json: cannot write\n", dir);
         if (st == MIXSPH_OK) st = MIXSPH_ERR_IO;
     }
     const double psteps = (double)mixsph_sim_particles(s) * (double)mixsph_sim_steps(s);
     printf("%s: %s, %zu particles, %llu steps, %.2f s wall, %.3g particle-steps/s, t = %.4g s\n", mixsph_sim_name(s),
-           st == MIXSPH_OK ? "done" : "FAILED", mixsph_sim_particles(s), (unsigned long long)mixsph_sim_steps(s), wall,
+           st != MIXSPH_OK ? "FAILED" : stopped ? "STOPPED" : "done", mixsph_sim_particles(s), (unsigned long long)mixsph_sim_steps(s), wall,
            wall > 0 ? psteps / wall : 0.0, mixsph_sim_time(s));
     for (size_t k = 0; k < mixsph_sim_output_count(s); k++) {
         double mx, tmx, mn, tmn;
@@ -308,7 +330,7 @@ static int cmd_run(int argc, char **argv)
     }
     printf("  summary: %s/summary.json, monitors: %s/monitors.csv\n", dir, dir);
     mixsph_sim_destroy(s);
-    return exit_code(st);
+    return st == MIXSPH_OK && stopped ? 128 + (int)stop_signal : exit_code(st);
 }
 
 int main(int argc, char **argv)

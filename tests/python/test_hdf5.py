@@ -242,6 +242,26 @@ def test_restart_equals_uninterrupted(killed, full, tmp_path):
         assert f.attrs["restarts"] == 1 and f.attrs["last_restart_time"] == t_ckpt
 
 
+def test_sigterm_checkpoints_and_restart_equals_uninterrupted(full, tmp_path):
+    """SIGTERM (as Ctrl-C's SIGINT) stops the run at the next progress step with a checkpoint
+    (exit code 128 + 15); --restart then completes it as if it had never stopped."""
+    out = tmp_path / "stopped"
+    args = case_args(0.01, 0.2, out, "--set", "output.snapshot_interval=0.02")
+    p = subprocess.Popen([mixsph(), "run", *args], env=ENV, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300
+    while time.monotonic() < deadline and p.poll() is None and xdmf_count(out / "run.xdmf") < 2:
+        time.sleep(0.02)
+    p.send_signal(signal.SIGTERM)
+    stdout, stderr = p.communicate(timeout=300)
+    assert p.returncode == 128 + signal.SIGTERM, stderr
+    assert "STOPPED" in stdout and "--restart" in stderr
+    assert json.loads((out / "summary.json").read_text())["status"] == "stopped"
+    r = subprocess.run([mixsph(), "run", "--restart", str(out / "checkpoint.h5"), "--threads", "1", "--quiet"],
+                       env=ENV, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stderr
+    same_run_files(full, out)
+
+
 def test_restart_into_new_folder(killed, full, tmp_path):
     """--out to a fresh folder: new files holding the snapshots and monitor rows from the
     checkpoint on, equal to the uninterrupted run's."""
