@@ -273,7 +273,7 @@ static int cmd_run(int argc, char **argv)
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_stop_signal;
     sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND; /* a second signal has its default effect */
+    sa.sa_flags = SA_RESETHAND | SA_RESTART; /* a second signal has its default effect */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
     for (int c = 1; c <= chunks && st == MIXSPH_OK && !stop_signal; c++) {
