@@ -175,7 +175,7 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
 mixsph_status mixsph_sim_resume_output_dir(mixsph_sim *s, const char *dir);
 
 /** Write the particle snapshots also as CSV files snap_NNNN.csv (on = 1, the default) or only
- *  into run.h5 (on = 0; the CSV files cost 10-20 times as much to write). */
+ *  into run.h5 (on = 0; the CSV files cost 10-30 times as much to write). */
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on);
 
 /** Wall time this simulation has spent writing CSV snapshots, HDF5 snapshots (with the XDMF
