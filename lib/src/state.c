@@ -15,7 +15,7 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 1u
+#define STATE_VERSION 2u /* 2: neighbour build positions (Verlet ranges) */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
