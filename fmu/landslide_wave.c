@@ -25,7 +25,6 @@
  * Errors (out-of-range or inconsistent parameters, a missing case file, an unstable run, a call
  * in the wrong state) return fmi2Error with a message through the FMI logger, always logged
  * whatever the debug-logging setting. The library never exits, so neither does the FMU. */
-#include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
