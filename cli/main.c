@@ -74,7 +74,7 @@ static void fmt_duration(double s, char *buf, size_t n)
 
 static void json_number(FILE *f, double v)
 {
-    if (isfinite(v)) fprintf(f, "%.9g", v);
+    if (isfinite(v)) fprintf(f, "%.17g", v); /* round-trips exactly */
     else fprintf(f, "null");
 }
 
