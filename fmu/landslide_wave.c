@@ -85,9 +85,9 @@ static const char *const real_param_keys[N_REAL_PARAMS][3] = {
 };
 
 /* Outputs read from the library by name. */
-enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, N_OUTS };
-static const char *const out_names[N_OUTS] = {"run_up",         "landslide_front", "kinetic_energy", "dt",
-                                              "lost_particles", "fixed_particles", "run_up_Z"};
+enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, O_KE_WATER, N_OUTS };
+static const char *const out_names[N_OUTS] = {"run_up",         "landslide_front", "kinetic_energy",      "dt",
+                                              "lost_particles", "fixed_particles", "run_up_Z", "water_kinetic_energy"};
 
 enum mode { MODE_INSTANTIATED, MODE_INIT, MODE_STEP, MODE_TERMINATED, MODE_ERROR };
 
@@ -552,6 +552,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
         case VR_time_of_max_run_up:
         case VR_landslide_front:
         case VR_kinetic_energy:
+        case VR_water_kinetic_energy:
         case VR_dt:
         case VR_max_run_up_Z:
             if (need_sim(in) != fmi2OK) return fmi2Error;
@@ -564,6 +565,7 @@ fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nv
         case VR_time_of_max_run_up: output_max(in, O_RUN_UP, &t, &value[i]); break;
         case VR_landslide_front: value[i] = output_value(in, O_FRONT); break;
         case VR_kinetic_energy: value[i] = output_value(in, O_KE); break;
+        case VR_water_kinetic_energy: value[i] = output_value(in, O_KE_WATER); break;
         case VR_dt: value[i] = output_value(in, O_DT); break;
         case VR_max_run_up_Z: output_max(in, O_RUN_UP_Z, &value[i], &t); break;
         default: break;

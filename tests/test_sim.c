@@ -302,6 +302,39 @@ static void test_unstable(void **state)
 }
 
 /* Output folders: refused at once when they cannot be created or written. */
+/* The kinetic_energy monitor: the kinetic energy of one medium in a region. In a water-only case
+ * over the whole domain it is the kinetic_energy diagnostic (reference: the same sum, so equal
+ * to the last bit); restricted to x <= 0.1 m it is positive and smaller. */
+static void test_kinetic_energy_monitor(void **state)
+{
+    (void)state;
+    const char *from = "\"front\": { \"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\" }";
+    const char *to = "\"ke\": { \"type\": \"kinetic_energy\", \"medium\": \"water\" }, "
+                     "\"ke_left\": { \"type\": \"kinetic_energy\", \"medium\": \"water\", \"x_max\": 0.1 }";
+    const char *at = strstr(CASE_TEXT, from);
+    assert_non_null(at);
+    char *text = malloc(strlen(CASE_TEXT) + strlen(to) + 1);
+    assert_non_null(text);
+    memcpy(text, CASE_TEXT, (size_t)(at - CASE_TEXT));
+    strcpy(text + (at - CASE_TEXT), to);
+    strcat(text, at + strlen(from));
+    mixsph_sim *s = NULL;
+    char err[512];
+    assert_int_equal(mixsph_sim_create_from_text(text, "ke.json", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    free(text);
+    for (int k = 0; k < 200; k++) assert_int_equal(mixsph_sim_step(s), MIXSPH_OK);
+    const long all = mixsph_sim_output_find(s, "kinetic_energy"), ke = mixsph_sim_output_find(s, "ke"),
+               left = mixsph_sim_output_find(s, "ke_left");
+    assert_true(all >= 0 && ke >= 0 && left >= 0);
+    const double e_all = mixsph_sim_output_value(s, (size_t)all), e = mixsph_sim_output_value(s, (size_t)ke),
+                 e_left = mixsph_sim_output_value(s, (size_t)left);
+    print_message("kinetic energy %.6g J/m, of water %.6g, of water at x <= 0.1 m %.6g\n", e_all, e, e_left);
+    assert_true(e_all > 0.0);
+    assert_true(e == e_all);
+    assert_true(e_left > 0.0 && e_left < e);
+    mixsph_sim_destroy(s);
+}
+
 static void test_output_dir(void **state)
 {
     (void)state;
@@ -357,6 +390,7 @@ int main(void)
         cmocka_unit_test(test_advance_in_pieces),
         cmocka_unit_test(test_unstable),
         cmocka_unit_test(test_output_dir),
+        cmocka_unit_test(test_kinetic_energy_monitor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

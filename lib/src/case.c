@@ -542,6 +542,8 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
             else return FAIL(r, "%s: %s.direction: '%s' (expected \"+x\" or \"-x\")", r->origin, path, dir);
         } else if (strcmp(type, "max_elevation") == 0) {
             md->kind = MONITOR_MAX_ELEVATION;
+        } else if (strcmp(type, "kinetic_energy") == 0) {
+            md->kind = MONITOR_KINETIC_ENERGY;
         } else if (strcmp(type, "profile") == 0) {
             md->kind = MONITOR_PROFILE;
             if (!isfinite(md->x_min) || !isfinite(md->x_max))
@@ -563,7 +565,9 @@ static mixsph_status read_monitors(struct reader *r, const cJSON *root, struct c
             for (size_t k = 1; k < nt; k++)
                 if (!(md->times[k] > md->times[k - 1])) return FAIL(r, "%s: %s.times[%zu]: times must increase", r->origin, path, k);
         } else {
-            return FAIL(r, "%s: %s.type: '%s' (expected \"front\", \"max_elevation\", \"profile\" or \"wall_pressure\")",
+            return FAIL(r,
+                        "%s: %s.type: '%s' (expected \"front\", \"max_elevation\", \"kinetic_energy\", \"profile\" or "
+                        "\"wall_pressure\")",
                         r->origin, path, type);
         }
     }

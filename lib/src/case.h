@@ -65,7 +65,13 @@ struct wall {
 
 #define CASE_MAX_PROFILE_TIMES 16
 
-enum monitor_kind { MONITOR_FRONT = 0, MONITOR_MAX_ELEVATION = 1, MONITOR_PROFILE = 2, MONITOR_WALL_PRESSURE = 3 };
+enum monitor_kind {
+    MONITOR_FRONT = 0,
+    MONITOR_MAX_ELEVATION = 1,
+    MONITOR_PROFILE = 2,
+    MONITOR_WALL_PRESSURE = 3,
+    MONITOR_KINETIC_ENERGY = 4
+};
 
 struct monitor_def {
     char name[CASE_NAME_LEN];

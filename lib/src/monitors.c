@@ -96,6 +96,13 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
         }
         return best;
     }
+    if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
+        double e = 0.0;
+        for (size_t i = 0; i < P->n; i++)
+            if (P->state[i] <= MIXSPH_STATE_FIXED && P->medium[i] == md->medium && in_region(md, P->x[i], P->z[i]))
+                e += 0.5 * P->m[i] * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
+        return e;
+    }
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
         if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;

@@ -73,6 +73,11 @@ def test_simulate_fmu_matches_the_executable(fmu_run_phi35, tmp_path):
     # max_run_up is the running maximum of the samples
     assert np.all(np.diff(res["max_run_up"]) >= 0)
     assert np.nanmax(res["run_up"]) <= res["max_run_up"][-1] + 1e-12
+    # the water's own kinetic energy (monitor of the case): part of the total, nonzero once the
+    # landslide has hit the reservoir
+    assert np.all(res["water_kinetic_energy"] <= res["kinetic_energy"] * (1 + 1e-12))
+    assert np.nanmax(res["water_kinetic_energy"]) > 0.0
+    assert np.nanmax(res["water_kinetic_energy"]) < np.nanmax(res["kinetic_energy"])
     # full-scale map of the case: Z = 1211.8 z + 0.3
     assert res["max_run_up_Z"][-1] == pytest.approx(1211.8 * res["max_run_up"][-1] + 0.3, rel=1e-12)
 
