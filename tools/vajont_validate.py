@@ -32,7 +32,8 @@ d_eta% = |Z - Z_exp| / (Z_exp - Z_still) * 100 with Z_exp = 863.0, Z_still = 700
 
 Printed: the paper's Tables 4-5 beside ours (elapsed time, max run-up, its time, Z, d_eta%), the
 steps, particles, lost particles, the mass balance (largest relative change of the total mass of
-fluid and granular particles), the wall-crossing corrections, the largest density variation
+fluid and granular particles), the wall-crossing corrections, the particles found below the bed
+or behind the plate in the snapshots (none should be), the largest density variation
 |rho / rho0 - 1| of the snapshots (rho0: the medium's reference density, the mixture density (5)
 for grains; the paper asks for <= 1 %) and whether the paper's ordering holds
 (lower phi, V2, raises the run-up; saturation, V4, lowers it). Written: OUT/vajont_table.csv,
@@ -303,6 +304,7 @@ class Result:
     drho: float = math.nan            # max |rho / rho0 - 1| of mobile particles over the snapshots
     drho_t: float = math.nan          # its time [s]
     drho99: float = math.nan          # max over the snapshots of the 99th percentile of |rho / rho0 - 1|
+    crossed: int = -1                 # most particles found below the bed or behind the plate in a snapshot
     profiles: dict = field(default_factory=dict)   # name -> mt.Profile at the max run-up
 
     @property
@@ -361,7 +363,29 @@ def density_variation(outdir, rho0):
     return best, t_best, p99
 
 
-def load_result(job, rho0=None):
+def crossed_walls(outdir, bed, plate_index, dx):
+    """Most fluid and granular particles, over the snapshots, whose centre lies below the bed
+    polyline (0 <= x <= its end) or behind the plate's face (x < face, within its z span; the face
+    is half a spacing ahead of the plate's first layer of wall particles). -1 without snapshots."""
+    worst = -1
+    for _, path in mt.list_snapshots(outdir):
+        _, snap = mt.read_snapshot(path)
+        live = snap["state"] <= mt.STATE_FIXED
+        x, z = snap["x"][live], snap["z"][live]
+        n = 0
+        if bed is not None:
+            inside = (x >= bed[0, 0]) & (x <= bed[-1, 0])
+            n += int(np.sum(inside & (z < np.interp(x, bed[:, 0], bed[:, 1]))))
+        if plate_index is not None:
+            pw = (snap["state"] == mt.STATE_WALL) & (snap["medium"] == plate_index)
+            if pw.any():
+                face = snap["x"][pw].max() + 0.5 * dx
+                n += int(np.sum((x < face) & (z > snap["z"][pw].min()) & (z < snap["z"][pw].max())))
+        worst = max(worst, n)
+    return worst
+
+
+def load_result(job, rho0=None, walls=None):
     r = Result(job.paper, job.dx, job.outdir, job.source)
     if job.source == "not run":
         r.status = "not run"
@@ -400,6 +424,8 @@ def load_result(job, rho0=None):
                 r.vmax_stop = float(np.nanmax(v[sel]))
     if rho0 is not None:
         r.drho, r.drho_t, r.drho99 = density_variation(job.outdir, rho0)
+    if walls is not None:
+        r.crossed = crossed_walls(job.outdir, walls[0], walls[1], job.dx)
     for name in PROFILE_NAMES:
         path = os.path.join(job.outdir, f"profile_{name}_atmax.csv")
         if os.path.isfile(path):
@@ -465,7 +491,8 @@ def write_csv(path, results):
               "wall_time_s", "particle_steps_per_s", "paper_elapsed_s", "run_up_m", "paper_run_up_m", "t_run_up_s",
               "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
               "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
-              "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "outdir"]
+              "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "crossed_walls",
+              "outdir"]
 
     def v(x):
         if isinstance(x, float):
@@ -481,7 +508,7 @@ def write_csv(path, results):
                 f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
                 r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
                 r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.drho,
-                r.drho_t, r.drho99, r.outdir)])
+                r.drho_t, r.drho99, r.crossed, r.outdir)])
 
 
 def write_md(path, results, header_lines, checks):
@@ -715,7 +742,11 @@ def main():
                 break
 
     try:
-        results = [load_result(job, reference_densities(case_json, job.paper.sets)) for job in jobs]
+        wall_defs = case_json.get("walls", {})
+        bed = wall_defs.get("bed", {}).get("polyline")
+        bed = np.array(bed, dtype=float) if bed else None
+        plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
+        results = [load_result(job, reference_densities(case_json, job.paper.sets), (bed, plate)) for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     used_threads = sorted({r.threads for r in results if r.ok})
@@ -751,7 +782,9 @@ def main():
     for r in results:
         if r.status in ("not run", "missing", "no summary"):
             continue
-        print(f"  V{r.paper.run}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, mass drift "
+        crossed = str(r.crossed) if r.crossed >= 0 else "n/a (no snapshots)"
+        print(f"  V{r.paper.run}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, particles below the bed "
+              f"or behind the plate (most in a snapshot) {crossed}, mass drift "
               f"{fmt(r.mass_drift, '.1e')}, wall-crossing corrections {fmt(r.wall_corr, '.0f')}, "
               f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, max |rho/rho0 - 1| over the "
               f"snapshots {fmt(100 * r.drho, '.2f')} % (t = {fmt(r.drho_t, '.1f')} s; 99th percentile <= "

@@ -94,3 +94,20 @@ def test_load_result_and_outputs(tmp_path):
     assert os.path.getsize(png_path) > 1000
     with open(csv_path) as f:
         assert f.readline().startswith("run,change,dx_m")
+
+
+def test_crossed_walls(tmp_path):
+    d = str(tmp_path / "run")
+    os.makedirs(d)
+    bed = np.array([[0.0, 0.28], [0.66, 0.22], [0.72, 0.0], [0.75, 0.0], [1.02, 0.46], [1.81, 0.878]])
+    rows = ["0,0.5,0.30,0,0,1000,0,0,0,0",     # above the bed, ahead of the plate: fine
+            "1,0.73,-0.01,0,0,1000,0,0,0,0",   # below the basin's floor: crossed the bed
+            "2,0.05,0.50,0,0,1722,0,0,1,0",    # behind the plate's face (x < 0.10): crossed the plate
+            "3,0.05,0.40,0,0,0,0,0,1,2",       # the plate's wall particles (wall index 1)
+            "4,0.05,0.80,0,0,0,0,0,1,2",
+            "5,0.73,-0.01,0,0,1000,0,0,0,3"]   # lost particles do not count
+    with open(os.path.join(d, "snap_0000.csv"), "w") as f:
+        f.write("# t = 0.5 s\nid,x,z,vx,vz,rho,p,mu,medium,state\n" + "\n".join(rows) + "\n")
+    assert vv.crossed_walls(d, bed, 1, 0.1) == 2
+    assert vv.crossed_walls(d, bed, None, 0.1) == 1
+    assert vv.crossed_walls(str(tmp_path), bed, 1, 0.1) == -1
