@@ -196,3 +196,103 @@ def nearest_snapshot(outdir, t):
     if not snaps:
         return None
     return min(snaps, key=lambda s: abs(s[0] - t))
+
+
+# ---- helpers shared by the validation scripts (vajont_validate.py, erosive_dambreak.py) ---------
+
+
+def show(path):
+    """A path as short as it reads: relative to the current folder when inside it."""
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
+
+
+def num(v):
+    """A number for the command line: 0.01 -> '0.01', 20700.0 -> '20700', 1e12 -> '1000000000000'."""
+    v = float(v)
+    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
+
+
+def fmt(v, spec, na="n/a"):
+    """``format(v, spec)`` for a finite number, else ``na``."""
+    return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na
+
+
+def fmt_duration(s):
+    """Seconds as 42s, 3m07s or 1h05m ('--' when not finite)."""
+    if not math.isfinite(s):
+        return "--"
+    s = int(round(s))
+    if s < 60:
+        return f"{s}s"
+    if s < 3600:
+        return f"{s // 60}m{s % 60:02d}s"
+    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
+
+
+def clean_outdir(d, stamp_name):
+    """Remove the files an earlier run left in folder d (a shorter run must not show stale
+    profiles or snapshots); stamp_name is the script's record of the run's settings."""
+    if not os.path.isdir(d):
+        return
+    for name in os.listdir(d):
+        if name in ("summary.json", "monitors.csv", "mixsph.log", stamp_name) or \
+                (name.endswith(".csv") and name.startswith(("profile_", "snap_"))):
+            os.remove(os.path.join(d, name))
+
+
+def reusable(outdir, stamp, stamp_name, keys, t_end, t_tol):
+    """(True, why) when outdir already holds a finished run (summary status ok, simulated to t_end
+    within t_tol) whose stamp file records the same values of ``keys`` as ``stamp``; else
+    (False, why not)."""
+    summ_path = os.path.join(outdir, "summary.json")
+    if not os.path.isfile(summ_path):
+        return False, "no summary.json"
+    try:
+        summ = read_summary(summ_path)
+    except ToolError as e:
+        return False, str(e)
+    if summ.get("status") != "ok":
+        return False, f"its summary.json says status '{summ.get('status')}'"
+    st = summ.get("simulated_time_s")
+    if not isinstance(st, (int, float)) or abs(st - t_end) > t_tol:
+        return False, f"it ran to t = {st} s, not t_end = {t_end:g} s"
+    stamp_path = os.path.join(outdir, stamp_name)
+    if os.path.isfile(stamp_path):
+        try:
+            with open(stamp_path) as f:
+                old = json.load(f)
+        except (OSError, ValueError):
+            old = None
+        if not isinstance(old, dict) or any(old.get(k) != stamp.get(k) for k in keys):
+            return False, f"{show(stamp_path)} records other settings"
+    return True, f"summary ok, t = {st:.4g} s"
+
+
+def last_time(monitors_csv):
+    """Simulated time of the last complete line of a growing monitors.csv (nan if none)."""
+    try:
+        with open(monitors_csv, "rb") as f:
+            f.seek(0, os.SEEK_END)
+            n = f.tell()
+            f.seek(max(0, n - 4096))
+            raw = f.read()
+    except OSError:
+        return math.nan
+    lines = raw.decode(errors="replace").split("\n")
+    lines = lines[1:-1] if n > 4096 else lines[:-1]   # drop a cut first line and the unfinished last one
+    for line in reversed(lines):
+        try:
+            return float(line.split(",", 1)[0])
+        except ValueError:
+            continue
+    return math.nan
+
+
+def tail(path, n=8):
+    """The last n lines of a text file ([] if it cannot be read)."""
+    try:
+        with open(path, errors="replace") as f:
+            return f.read().splitlines()[-n:]
+    except OSError:
+        return []

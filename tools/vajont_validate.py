@@ -70,6 +70,7 @@ import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mixsph_tools as mt  # noqa: E402
+from mixsph_tools import fmt, fmt_duration, last_time, num, show, tail  # noqa: E402
 
 PROG = "vajont_validate.py"
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -116,37 +117,16 @@ def warn(msg):
     print(f"{PROG}: warning: {msg}", file=sys.stderr)
 
 
-def show(path):
-    rel = os.path.relpath(path)
-    return path if rel.startswith("..") else rel
-
-
-def num(v):
-    v = float(v)
-    return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
-
-
-def fmt(v, spec, na="n/a"):
-    return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na
-
-
-def fmt_duration(s):
-    if not math.isfinite(s):
-        return "--"
-    s = int(round(s))
-    if s < 60:
-        return f"{s}s"
-    if s < 3600:
-        return f"{s // 60}m{s % 60:02d}s"
-    return f"{s // 3600}h{(s % 3600) // 60:02d}m"
-
-
 def d_eta(z):
     """The paper's error (13) in the lab frame [%]."""
     return 100.0 * abs(z - EXP_RUN_UP) / 0.1345 if math.isfinite(z) else math.nan
 
 
 # ---- runs -----------------------------------------------------------------------------------------
+
+
+STAMP = "vajont_run.json"
+STAMP_KEYS = ("run", "dx", "sets", "t_end", "case")
 
 
 @dataclass
@@ -160,74 +140,16 @@ class Job:
     message: str = ""
 
 
-OUTPUT_FILES = ("summary.json", "monitors.csv", "mixsph.log", "vajont_run.json")
-
-
-def clean_outdir(d):
-    if not os.path.isdir(d):
-        return
-    for name in os.listdir(d):
-        if name in OUTPUT_FILES or (name.endswith(".csv") and name.startswith(("profile_", "snap_"))):
-            os.remove(os.path.join(d, name))
-
-
 def reusable(job, t_end):
-    summ_path = os.path.join(job.outdir, "summary.json")
-    if not os.path.isfile(summ_path):
-        return False, "no summary.json"
-    try:
-        summ = mt.read_summary(summ_path)
-    except mt.ToolError as e:
-        return False, str(e)
-    if summ.get("status") != "ok":
-        return False, f"its summary.json says status '{summ.get('status')}'"
-    st = summ.get("simulated_time_s")
-    if not isinstance(st, (int, float)) or abs(st - t_end) > T_TOL:
-        return False, f"it ran to t = {st} s, not t_end = {t_end:g} s"
-    stamp_path = os.path.join(job.outdir, "vajont_run.json")
-    if os.path.isfile(stamp_path):
-        try:
-            with open(stamp_path) as f:
-                old = json.load(f)
-        except (OSError, ValueError):
-            old = None
-        if not isinstance(old, dict) or any(old.get(k) != job.stamp.get(k) for k in ("run", "dx", "sets", "t_end", "case")):
-            return False, f"{show(stamp_path)} records other settings"
-    return True, f"summary ok, t = {st:.4g} s"
-
-
-def last_time(monitors_csv):
-    try:
-        with open(monitors_csv, "rb") as f:
-            f.seek(0, os.SEEK_END)
-            n = f.tell()
-            f.seek(max(0, n - 4096))
-            raw = f.read()
-    except OSError:
-        return math.nan
-    lines = raw.decode(errors="replace").split("\n")
-    lines = lines[1:-1] if n > 4096 else lines[:-1]
-    for line in reversed(lines):
-        try:
-            return float(line.split(",", 1)[0])
-        except ValueError:
-            continue
-    return math.nan
-
-
-def tail(path, n=8):
-    try:
-        with open(path, errors="replace") as f:
-            return f.read().splitlines()[-n:]
-    except OSError:
-        return []
+    """(True, why) when job.outdir already holds this run, finished ok."""
+    return mt.reusable(job.outdir, job.stamp, STAMP, STAMP_KEYS, t_end, T_TOL)
 
 
 def run_job(job, t_end, progress_every):
     """Run one job to completion. Returns the exit code of mixsph."""
     os.makedirs(job.outdir, exist_ok=True)
-    clean_outdir(job.outdir)
-    with open(os.path.join(job.outdir, "vajont_run.json"), "w") as f:
+    mt.clean_outdir(job.outdir, STAMP)
+    with open(os.path.join(job.outdir, STAMP), "w") as f:
         json.dump(job.stamp, f, indent=2)
         f.write("\n")
     with open(os.path.join(job.outdir, "mixsph.log"), "w") as log:
