@@ -35,6 +35,8 @@ Printed table, one row per run, ours beside the paper's:
   |z_run - z_ref| / z_ref * 100, bins empty in either run left out. The reference is Run 4 for
   Runs 1-3 and Run 2 for Runs 5-7, as in the paper; it must be among --runs (with --reuse an
   earlier run of it costs nothing), else the cell says "n/a (reference not run)";
+- the same error with the interface taken as the 0.5 iso-line of the sediment fraction (column
+  "f=0.5"; from the CSV snapshot at that time, so grains lifted above the bed do not count);
 - the maximum rise of the bed load at the left wall (summary ``bedload_rise_left_wall`` max: top
   of the sediment within x < 0.02 m, over the run) and its time, paper ~0.3 m;
 - the peak left-wall pressure (summary ``left_wall_pressure`` max) and its time, paper ~10 kPa;
@@ -156,6 +158,7 @@ class Result:
     p_peak_t: float = math.nan
     t_wall: float = math.nan     # water reaches the left wall [s]
     interface: mt.Profile = None
+    interface_frac: mt.Profile = None   # 0.5 iso-line of the sediment fraction, from the snapshot
     free_surface: mt.Profile = None
     cells: dict = field(default_factory=dict)   # computed comparison cells
 
@@ -262,7 +265,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
 # ---- analysis -------------------------------------------------------------------------------------
 
 
-def load_result(job, at):
+def load_result(job, at, dx, sediment):
     r = Result(job.paper, job.outdir, job.source)
     summ_path = os.path.join(job.outdir, "summary.json")
     if job.source == "not run":
@@ -290,7 +293,39 @@ def load_result(job, at):
             warn(f"{show(mon_path)}: no column 'water_front'")
     r.interface = mt.find_profile(job.outdir, "interface", at)
     r.free_surface = mt.find_profile(job.outdir, "free_surface", at)
+    r.interface_frac = fraction_interface(job.outdir, at, dx, sediment)
     return r
+
+
+def fraction_interface(outdir, at, dx, sediment, h_over_dx=1.3, bin_width=0.01, x_max=0.5):
+    """The mixture-water interface at time ``at`` as the 0.5 iso-line of the sediment fraction:
+    along the vertical through each bin centre, from the floor up, the first height where the
+    Shepard (kernel-weighted) fraction of sediment particles among the non-wall particles falls
+    below 0.5 (linear between samples dx/8 apart; cubic-spline kernel, h = 1.3 dx, as in the
+    library). Unlike the top-most particle of the profile monitor, a few grains lifted above
+    the bed do not count. From the CSV snapshot taken at ``at`` (within 1e-3 s); None without it."""
+    snap = mt.nearest_snapshot(outdir, at)
+    if snap is None or abs(snap[0] - at) > 1e-3:
+        return None
+    t_snap, d = mt.read_snapshot(snap[1])
+    keep = (d["state"] != mt.STATE_WALL) & (d["state"] != mt.STATE_LOST)
+    x, z, sed = d["x"][keep], d["z"][keep], (d["medium"][keep] == sediment).astype(float)
+    h = h_over_dx * dx
+    xs = np.arange(0.5 * bin_width, x_max, bin_width)
+    zs = np.arange(0.0, float(np.max(z, initial=0.0)) + 2 * h, dx / 8)
+    out = np.full(len(xs), math.nan)
+    for k, xb in enumerate(xs):
+        near = np.abs(x - xb) < 2 * h
+        q = np.hypot(x[near][None, :] - xb, z[near][None, :] - zs[:, None]) / h
+        w = np.where(q < 1, 1 - 1.5 * q ** 2 + 0.75 * q ** 3, np.where(q < 2, 0.25 * (2 - q) ** 3, 0.0))
+        den = w.sum(axis=1)
+        f = np.where(den > 0, (w * sed[near][None, :]).sum(axis=1) / np.where(den > 0, den, 1.0), 0.0)
+        low = np.nonzero(f < 0.5)[0]
+        if len(low) == 0:
+            continue
+        j = low[0]
+        out[k] = zs[0] if j == 0 else zs[j - 1] + (f[j - 1] - 0.5) / (f[j - 1] - f[j]) * (zs[j] - zs[j - 1])
+    return mt.Profile(snap[1], "interface_fraction", t_snap, at, xs, out)
 
 
 def interface_error(run_prof, ref_prof, x_max=ERR_X_MAX):
@@ -314,15 +349,17 @@ def compare(results, at):
             c["ref"] = "-"
             c["saving"] = c["err"] = "(reference)"
             c["paper_saving"] = c["paper_err"] = "(ref)"
-            c.update(saving_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0)
+            c["err_frac"] = "(reference)"
+            c.update(saving_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0, err_frac_v=math.nan)
             continue
         c["ref"] = str(p.ref)
         paper_ref = PAPER[p.ref]
         c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / paper_ref.elapsed_s)
         c["paper_saving"] = f"{c['paper_saving_v']:.0f}"
         c["paper_err"] = fmt(p.err_percent, ".2f", "-")
-        c["saving_v"] = c["err_v"] = math.nan
+        c["saving_v"] = c["err_v"] = c["err_frac_v"] = math.nan
         c["err_bins"] = 0
+        c["err_frac"] = "n/a"
         ref = by_run.get(p.ref)
         if not r.ok:
             c["saving"] = c["err"] = "n/a (run failed)" if r.status not in ("not run", "missing") else "n/a"
@@ -347,6 +384,10 @@ def compare(results, at):
             e, n = interface_error(r.interface, ref.interface)
             c["err_v"], c["err_bins"] = e, n
             c["err"] = f"{e:.2f}" if n else "n/a (no common bins)"
+        if r.interface_frac is not None and ref.interface_frac is not None:
+            e, n = interface_error(r.interface_frac, ref.interface_frac)
+            c["err_frac_v"] = e
+            c["err_frac"] = f"{e:.2f}" if n else "n/a"
 
 
 # ---- table ----------------------------------------------------------------------------------------
@@ -398,7 +439,8 @@ def table(results, at, dx, t_end, threads_note):
         ("", "run", ">"), ("", "mu_thr", ">"), ("", "mu0", ">"), ("", "status", "<"),
         ("wall time [s]", "mixsph", ">"), ("wall time [s]", "paper", ">"),
         ("saving vs ref [%]", "ref", ">"), ("saving vs ref [%]", "mixsph", ">"), ("saving vs ref [%]", "paper", ">"),
-        (f"interface err [%], t={at:g} s", "mixsph", ">"), (f"interface err [%], t={at:g} s", "paper", ">"),
+        (f"interface err [%], t={at:g} s", "mixsph", ">"), (f"interface err [%], t={at:g} s", "f=0.5", ">"),
+        (f"interface err [%], t={at:g} s", "paper", ">"),
         ("bed-load rise, wall", "max [m]", ">"), ("bed-load rise, wall", "t [s]", ">"),
         ("peak p, left wall", "[kPa]", ">"), ("peak p, left wall", "t [s]", ">"),
         ("water at wall", "t [s]", ">"),
@@ -413,12 +455,12 @@ def table(results, at, dx, t_end, threads_note):
             str(p.run), p.label_thr, p.label_mu0, status,
             fmt(r.wall, ".1f"), f"{p.elapsed_s:,.0f}",
             c["ref"], c["saving"], c["paper_saving"],
-            c["err"], c["paper_err"],
+            c["err"], c["err_frac"], c["paper_err"],
             fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
             fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
             fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"),
         ])
-    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "",
+    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "",
                  f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}"]
     print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
           f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
@@ -427,7 +469,9 @@ def table(results, at, dx, t_end, threads_note):
     print_table(cols, rows, [paper_row])
     print(f"interface err: mean over the 0.01 m bins with x <= {ERR_X_MAX:g} m of |z_run - z_ref| / z_ref * 100, "
           f"z = top of the sediment at t = {at:g} s;")
-    print("               reference Run 4 for Runs 1-3, Run 2 for Runs 5-7 (the paper's 'aver. err.').")
+    print("               reference Run 4 for Runs 1-3, Run 2 for Runs 5-7 (the paper's 'aver. err.');")
+    print("               f=0.5: the same with z = 0.5 iso-line of the sediment fraction (from the snapshot at that time;")
+    print("               lifted grains do not count; n/a without the snapshot).")
     print("saving:        100 (1 - wall / wall of the reference run), the paper's from its elapsed times.")
     print(f"bed-load rise: max over the run of the top of the sediment within x < 0.02 m "
           f"(paper: ~{PAPER_BEDLOAD_RISE:g} m for the converged runs).")
@@ -440,7 +484,8 @@ def write_csv(path, results, dx, t_end, at):
     fields = ["run", "mu_thr_Pa_s", "mu0_Pa_s", "dx_m", "t_end_s", "status", "source", "threads",
               "simulated_time_s", "wall_time_s", "particle_steps_per_s", "paper_elapsed_s",
               "ref_run", "saving_percent", "paper_saving_percent",
-              "compare_time_s", "interface_err_percent", "interface_err_bins", "paper_err_percent",
+              "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
+              "paper_err_percent",
               "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
               "water_at_left_wall_t_s", "outdir"]
 
@@ -458,7 +503,7 @@ def write_csv(path, results, dx, t_end, at):
                 p.run, p.mu_thr, p.mu0, dx, t_end, r.status, r.source, r.threads,
                 r.sim_time, r.wall, r.psteps, float(p.elapsed_s),
                 p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
-                at, c["err_v"], c["err_bins"], p.err_percent,
+                at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
                 r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir)])
 
 
@@ -582,6 +627,10 @@ def main():
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
     if not math.isfinite(t_end):
         fail(f"{show(case)}: no numerics.t_end (give --t-end)")
+    media = list(case_json.get("media", {})) if isinstance(case_json.get("media"), dict) else []
+    if "sediment" not in media:
+        fail(f"{show(case)}: no medium 'sediment' (the interface is the top of it)")
+    sediment = media.index("sediment")   # the library numbers the media in the case file's order
     prof_times = [float(t) for t in case_json.get("monitors", {}).get("interface", {}).get("times", [])]
     if not any(abs(t - args.at) < 1e-9 for t in prof_times):
         fail(f"--at {args.at:g}: the case's interface profile is written at t = "
@@ -630,7 +679,7 @@ def main():
     failed = run_jobs(to_run, jobs_n, t_end, args.progress)
 
     try:
-        results = [load_result(job, args.at) for job in jobs]
+        results = [load_result(job, args.at, args.dx, sediment) for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     compare(results, args.at)

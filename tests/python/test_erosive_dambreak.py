@@ -1,0 +1,83 @@
+"""tools/erosive_dambreak.py without running mixsph: the two interface measures on snapshots and
+profiles written by hand in the formats of cli/main.c and lib/src/monitors.c."""
+
+import math
+import os
+import sys
+
+import numpy as np
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import erosive_dambreak as ed  # noqa: E402
+import mixsph_tools as mt  # noqa: E402
+
+DX = 0.01
+WATER, SEDIMENT = 0, 1
+
+
+def write_snapshot(folder, t, rows):
+    """snap_0000.csv with rows (x, z, medium, state)."""
+    path = os.path.join(folder, "snap_0000.csv")
+    with open(path, "w") as f:
+        f.write(f"# t = {t:.9g} s\n" + ",".join(mt.SNAP_COLUMNS) + "\n")
+        for k, (x, z, medium, state) in enumerate(rows):
+            f.write(f"{k},{x:.9g},{z:.9g},0,0,1000,0,0,{medium},{state}\n")
+    return path
+
+
+def layered_tank(bed_top, extra=()):
+    """A lattice of spacing DX on 0 <= x <= 0.5: sediment below bed_top, water above up to 0.2 m,
+    a floor of wall particles (medium 0, state wall) below z = 0, plus extra rows."""
+    rows = []
+    for i in range(50):
+        x = (i + 0.5) * DX
+        for k in range(3):
+            rows.append((x, -(k + 0.5) * DX, 0, mt.STATE_WALL))
+        for j in range(20):
+            z = (j + 0.5) * DX
+            rows.append((x, z, SEDIMENT if z < bed_top else WATER, mt.STATE_MOBILE))
+    return rows + list(extra)
+
+
+def test_fraction_interface_of_a_flat_bed_is_the_bed_top(tmp_path):
+    # reference: sediment rows at z = 0.005 ... 0.065, water from 0.075: with a symmetric kernel on
+    # a regular lattice the sediment fraction is 1/2 exactly midway, at z = 0.07 m; tolerance
+    # DX/20 (the linear interpolation between samples DX/8 apart)
+    write_snapshot(tmp_path, 0.5, layered_tank(0.07))
+    prof = ed.fraction_interface(str(tmp_path), 0.5, DX, SEDIMENT)
+    assert prof is not None and len(prof.x) == 50
+    inner = (prof.x > 2.6 * DX) & (prof.x < 0.5 - 2.6 * DX)   # away from the lattice's open ends
+    assert np.all(np.abs(prof.z[inner] - 0.07) < DX / 20), prof.z[inner]
+
+
+def test_lifted_grains_move_the_top_particle_but_not_the_fraction_interface(tmp_path):
+    # one grain lifted 0.05 m above the bed at x = 0.105: the top-particle profile of that bin
+    # jumps to it, the 0.5 iso-line stays at the bed (within DX/20 as above)
+    lifted = [(0.105, 0.125, SEDIMENT, mt.STATE_MOBILE)]
+    write_snapshot(tmp_path, 0.5, layered_tank(0.07, lifted))
+    prof = ed.fraction_interface(str(tmp_path), 0.5, DX, SEDIMENT)
+    k = int(np.argmin(np.abs(prof.x - 0.105)))
+    assert abs(prof.z[k] - 0.07) < DX / 20
+    flat = mt.Profile("", "interface", 0.5, 0.5, prof.x, np.full(len(prof.x), 0.07))
+    top = flat.z.copy()
+    top[k] = 0.125 + DX / 2   # what the profile monitor reports: highest centre + dx/2
+    err_top, n_top = ed.interface_error(mt.Profile("", "interface", 0.5, 0.5, prof.x, top), flat)
+    err_frac, _ = ed.interface_error(prof, flat)
+    assert n_top == 25                         # bins with centre x <= 0.25 m
+    assert abs(err_top - (0.13 - 0.07) / 0.07 * 100 / 25) < 1e-9   # one bin off by 86 %
+    assert err_frac < 0.1
+
+
+def test_fraction_interface_needs_the_snapshot_at_that_time(tmp_path):
+    write_snapshot(tmp_path, 0.45, layered_tank(0.07))
+    assert ed.fraction_interface(str(tmp_path), 0.5, DX, SEDIMENT) is None
+    assert ed.fraction_interface(str(tmp_path / "missing"), 0.5, DX, SEDIMENT) is None
+
+
+def test_interface_error_skips_empty_and_far_bins():
+    x = np.array([0.005, 0.015, 0.025, 0.3])
+    ref = mt.Profile("", "interface", 0.5, 0.5, x, np.array([0.1, 0.1, math.nan, 0.1]))
+    run = mt.Profile("", "interface", 0.5, 0.5, x, np.array([0.11, math.nan, 0.2, 0.5]))
+    err, n = ed.interface_error(run, ref)
+    assert n == 1 and abs(err - 10.0) < 1e-9
