@@ -90,22 +90,21 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
 #define FORCES_LANE_IN(k, m) ((k) < (m) ? 1.0 : 0.0)
 
-/* Add the chunk's lane values v[] to a[jb..jb+m): a vector add for a full chunk, scalar adds
- * for the last partial one (never a write past the range: another thread may own it). */
+/* Add the chunk's lane values v[] to a[jb..jb+m): masked vector loads and stores (AVX-512,
+ * AVX2), so a partial chunk needs no scalar tail and never writes past the range (another
+ * thread may own what follows). */
 FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const double *restrict v)
 {
-    if (m == FORCES_CHUNK) {
 #pragma omp simd
-        for (size_t k = 0; k < FORCES_CHUNK; k++) a[jb + k] += v[k];
-    } else {
-        for (size_t k = 0; k < m; k++) a[jb + k] += v[k];
-    }
+    for (size_t k = 0; k < FORCES_CHUNK; k++)
+        if (k < m) a[jb + k] += v[k];
 }
 
-/* Continuity between i and candidates [b, e): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
+/* Continuity between i and its nr ranges of candidates [rng[2r], rng[2r+1]) (one call per
+ * particle: one set of lane sums, reduced once): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
  * and same-medium neighbour counts. */
-FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b,
-                                    size_t e, double *di, double *ni, const int wendland)
+FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
+                                    const uint32_t *restrict rng, int nr, double *di, double *ni, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
@@ -113,7 +112,8 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
-    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+    for (int r = 0; r < nr; r++)
+    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
         const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK];
 #pragma omp simd
@@ -138,20 +138,21 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     }
 }
 
-/* Velocity gradient of granular particle i, gathered over candidates [b, e): the uncorrected
+/* Velocity gradient of granular particle i, gathered over its nr ranges of candidates: the uncorrected
  * G = sum_j V_j (u_j - u_i) (x) grad_i W and the correction matrix
  * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (MODEL.md section 5). Walls enter
  * with their no-slip velocity, so grains feel the shear of a wall. Only granular particles need
  * it, so it is a gather over them alone rather than part of the symmetric pass. */
-FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i, size_t b,
-                                  size_t e, double *acc_i, const int wendland)
+FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
+                                  const uint32_t *restrict rng, int nr, double *acc_i, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], uxi = P->uvx[i], uzi = P->uvz[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict uvx = P->uvx, *restrict uvz = P->uvz;
     const double *restrict vol = P->vol;
     const struct pair_ctx Xl = *X;
     double a[7][FORCES_CHUNK] = {{0}};
-    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+    for (int r = 0; r < nr; r++)
+    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
         const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -173,11 +174,11 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
         for (size_t k = 0; k < FORCES_CHUNK; k++) acc_i[q] += a[q][k];
 }
 
-/* Momentum between i and candidates [b, e): the pair force f_ij (per unit depth) is added to
+/* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth) is added to
  * i and subtracted from j (ax, az hold forces during the pass; forces_compute divides by the
  * masses after it). */
-FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i, size_t b, size_t e,
-                                  double *axi, double *azi, const int wendland)
+FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
+                                  const uint32_t *restrict rng, int nr, double *axi, double *azi, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
@@ -189,7 +190,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict avc = P->avc;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
-    for (size_t jb = b; jb < e; jb += FORCES_CHUNK) {
+    for (int r = 0; r < nr; r++)
+    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
         const size_t n = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
         double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
 #pragma omp simd
@@ -245,9 +247,7 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0;
-        const uint32_t *r = NB->rng + 4 * i;
-        continuity_range(X, P, i, r[0], r[1], &di, &ni, wendland);
-        continuity_range(X, P, i, r[2], r[3], &di, &ni, wendland);
+        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, wendland);
         P->drho[i] += di;
         P->ax[i] += ni;
     }
@@ -258,11 +258,8 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
                               struct kinematics *restrict K, size_t i)
 {
     double acc[7] = {0};
-    const uint32_t *r = G->rng + 6 * i;
-    for (int row = 0; row < 3; row++) {
-        if (X->wendland) gradient_range(X, P, i, r[2 * row], r[2 * row + 1], acc, 1);
-        else gradient_range(X, P, i, r[2 * row], r[2 * row + 1], acc, 0);
-    }
+    if (X->wendland) gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 1);
+    else gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 0);
     K->gux[i] = acc[0];
     K->guz[i] = acc[1];
     K->gwx[i] = acc[2];
@@ -277,9 +274,7 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
 {
     for (size_t i = b0; i < b1; i++) {
         double sx = 0.0, sz = 0.0;
-        const uint32_t *r = NB->rng + 4 * i;
-        momentum_range(X, P, i, r[0], r[1], &sx, &sz, wendland);
-        momentum_range(X, P, i, r[2], r[3], &sx, &sz, wendland);
+        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, wendland);
         P->ax[i] += sx;
         P->az[i] += sz;
     }
@@ -382,12 +377,13 @@ void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double 
     struct particles *P = &s->P;
     const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
     double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
-    momentum_range(&X, P, i, j, j + 1, &sx, &sz, X.wendland);
+    const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, X.wendland);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
     P->az[j] = save[1];
-    continuity_range(&X, P, i, j, j + 1, &di, &ni, X.wendland);
+    continuity_range(&X, P, i, pair, 1, &di, &ni, X.wendland);
     *drho = P->rho[i] * di;
     P->ax[j] = save[0];
     P->drho[j] = save[2];
