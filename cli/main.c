@@ -72,6 +72,18 @@ static void fmt_duration(double s, char *buf, size_t n)
     else snprintf(buf, n, "%dh%02dm", (int)(s / 3600), (int)fmod(s / 60, 60));
 }
 
+/* A JSON string: quotes, backslashes and control characters escaped. */
+static void json_string(FILE *f, const char *v)
+{
+    fputc('"', f);
+    for (const unsigned char *c = (const unsigned char *)v; *c; c++) {
+        if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
+        else if (*c < 0x20) fprintf(f, "\\u%04x", *c);
+        else fputc(*c, f);
+    }
+    fputc('"', f);
+}
+
 static void json_number(FILE *f, double v)
 {
     if (isfinite(v)) fprintf(f, "%.17g", v); /* round-trips exactly */
@@ -97,26 +109,39 @@ static int full_scale_outputs(const mixsph_sim *s, size_t k, long *km, long *kz)
     return *km >= 0 && *kz >= 0;
 }
 
-static int write_summary(const char *dir, const mixsph_sim *s, const char *case_path, int threads, double wall,
-                         const char *status_text)
+/* summary.json. The rates cover the work of this process: from simulated time t0 and step
+ * step0 (not 0 after --restart) to now, in `wall` seconds. */
+static int write_summary(const char *dir, const mixsph_sim *s, const char *case_path, const char *restart, int threads,
+                         double wall, double t0, unsigned long long step0, const char *status_text)
 {
     char path[1100];
     snprintf(path, sizeof path, "%s/summary.json", dir);
     FILE *f = fopen(path, "w");
     if (!f) return -1;
-    const double psteps = (double)mixsph_sim_particles(s) * (double)mixsph_sim_steps(s);
-    fprintf(f, "{\n  \"case\": \"%s\",\n  \"case_file\": \"%s\",\n  \"status\": \"%s\",\n", mixsph_sim_name(s), case_path,
-            status_text);
+    const double psteps = (double)mixsph_sim_particles(s) * (double)(mixsph_sim_steps(s) - step0);
+    const double simulated = mixsph_sim_time(s) - t0;
+    fprintf(f, "{\n  \"case\": ");
+    json_string(f, mixsph_sim_name(s));
+    fprintf(f, ",\n  \"case_file\": ");
+    json_string(f, case_path);
+    fprintf(f, ",\n  \"status\": \"%s\",\n", status_text);
     fprintf(f, "  \"particles\": %zu,\n  \"wall_particles\": %zu,\n  \"steps\": %llu,\n", mixsph_sim_particles(s),
             mixsph_sim_wall_particles(s), (unsigned long long)mixsph_sim_steps(s));
     fprintf(f, "  \"threads\": %d,\n  \"simulated_time_s\": ", threads);
     json_number(f, mixsph_sim_time(s));
+    if (restart) { /* this process continued a checkpoint: where it started */
+        fprintf(f, ",\n  \"restarted_from\": ");
+        json_string(f, restart);
+        fprintf(f, ",\n  \"restart_time_s\": ");
+        json_number(f, t0);
+        fprintf(f, ",\n  \"restart_step\": %llu", step0);
+    }
     fprintf(f, ",\n  \"wall_time_s\": ");
     json_number(f, wall);
     fprintf(f, ",\n  \"particle_steps_per_s\": ");
     json_number(f, wall > 0 ? psteps / wall : NAN);
     fprintf(f, ",\n  \"wall_s_per_simulated_s\": ");
-    json_number(f, mixsph_sim_time(s) > 0 ? wall / mixsph_sim_time(s) : NAN);
+    json_number(f, simulated > 0 ? wall / simulated : NAN);
     fprintf(f, ",\n  \"outputs\": {\n");
     const size_t n = mixsph_sim_output_count(s);
     for (size_t k = 0; k < n; k++) {
@@ -265,7 +290,8 @@ static int cmd_run(int argc, char **argv)
     if (!quiet && restart)
         fprintf(stderr, "mixsph: restarting from %s at t = %.6g s, step %llu\n", restart, mixsph_sim_time(s),
                 (unsigned long long)mixsph_sim_steps(s));
-    const double t_end = mixsph_sim_end_time(s), t0 = now();
+    const double t_end = mixsph_sim_end_time(s), t0 = now(), sim_t0 = mixsph_sim_time(s);
+    const unsigned long long step0 = mixsph_sim_steps(s); /* rates count this process's work only */
     double last_print = 0.0, last_ckpt = t0;
     unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
@@ -289,9 +315,10 @@ static int cmd_run(int argc, char **argv)
             last_print = el;
             const double ts = mixsph_sim_time(s);
             char eta[32];
-            fmt_duration(ts > 0 ? el * (t_end - ts) / ts : NAN, eta, sizeof eta);
+            fmt_duration(ts > sim_t0 ? el * (t_end - ts) / (ts - sim_t0) : NAN, eta, sizeof eta);
             fprintf(stderr, "\r  t = %.4f / %.4f s  steps %llu  %.0f steps/s  dt %.3g s  ETA %s   ", ts, t_end,
-                    (unsigned long long)mixsph_sim_steps(s), mixsph_sim_steps(s) / (el > 0 ? el : 1), mixsph_sim_dt(s), eta);
+                    (unsigned long long)mixsph_sim_steps(s), (double)(mixsph_sim_steps(s) - step0) / (el > 0 ? el : 1),
+                    mixsph_sim_dt(s), eta);
         }
     }
     if (tty) fprintf(stderr, "\n");
@@ -304,12 +331,12 @@ static int cmd_run(int argc, char **argv)
                     (int)stop_signal, mixsph_sim_time(s), ckpt);
     }
     if (st != MIXSPH_OK) fprintf(stderr, "mixsph: %s\n", mixsph_sim_last_error(s));
-    if (write_summary(dir, s, case_path, threads, wall,
+    if (write_summary(dir, s, case_path, restart, threads, wall, sim_t0, step0,
                       st != MIXSPH_OK ? mixsph_status_string(st) : stopped ? "stopped" : "ok") != 0) {
         fprintf(stderr, "mixsph: %s/summary.json: cannot write\n", dir);
         if (st == MIXSPH_OK) st = MIXSPH_ERR_IO;
     }
-    const double psteps = (double)mixsph_sim_particles(s) * (double)mixsph_sim_steps(s);
+    const double psteps = (double)mixsph_sim_particles(s) * (double)(mixsph_sim_steps(s) - step0);
     printf("%s: %s, %zu particles, %llu steps, %.2f s wall, %.3g particle-steps/s, t = %.4g s\n", mixsph_sim_name(s),
            st != MIXSPH_OK ? "FAILED" : stopped ? "STOPPED" : "done", mixsph_sim_particles(s), (unsigned long long)mixsph_sim_steps(s), wall,
            wall > 0 ? psteps / wall : 0.0, mixsph_sim_time(s));

@@ -12,6 +12,7 @@ Runs are small: the water dam break at dx = 0.02 m (706 particles with the walls
 run must live long enough to be killed, dx = 0.01 m; one OpenMP thread, passive waiting.
 """
 import json
+import math
 import os
 import pathlib
 import shutil
@@ -240,6 +241,18 @@ def test_restart_equals_uninterrupted(killed, full, tmp_path):
     same_run_files(full, cont)
     with h5py.File(cont / "run.h5", "r") as f:
         assert f.attrs["restarts"] == 1 and f.attrs["last_restart_time"] == t_ckpt
+    # the summary's rates count the continuation's own work (from the checkpoint), not the
+    # steps and simulated time of the whole run over the continuation's wall time
+    summ = json.loads((cont / "summary.json").read_text())
+    whole = json.loads((full / "summary.json").read_text())
+    assert summ["status"] == "ok" and summ["steps"] == whole["steps"]
+    assert summ["restarted_from"] == str(cont / "checkpoint.h5") and summ["restart_time_s"] == t_ckpt
+    step_ckpt = summ["restart_step"]
+    assert 0 < step_ckpt < summ["steps"]
+    wall = summ["wall_time_s"]
+    assert math.isclose(summ["particle_steps_per_s"], summ["particles"] * (summ["steps"] - step_ckpt) / wall, rel_tol=1e-12)
+    assert math.isclose(summ["wall_s_per_simulated_s"], wall / (summ["simulated_time_s"] - t_ckpt), rel_tol=1e-12)
+    assert "restarted_from" not in whole
 
 
 def test_sigterm_checkpoints_and_restart_equals_uninterrupted(full, tmp_path):
