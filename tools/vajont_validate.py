@@ -395,17 +395,32 @@ def print_table(rows):
     print("\n".join([head, rule] + [line(r) for r in rows[:-1]] + [rule, line(rows[-1]), rule]))
 
 
+ORDER_TOL = 0.001  # [m] run-up differences below this are no ordering (paper's: 15 and 17 mm)
+
+
 def ordering(results):
-    """The paper's ordering: V2 (lower phi) above V1, V4 (saturated) below V1."""
+    """The paper's ordering: V2 (lower phi) above V1, V4 (saturated) below V1. Each check is
+    (what, verdict, detail), verdict True (holds), False (does not) or None (the two run-ups
+    differ by less than ORDER_TOL: neither)."""
     by = {r.paper.run: r for r in results if r.ok and math.isfinite(r.run_up)}
     out = []
+
+    def verdict(d, sign):
+        return None if abs(d) < ORDER_TOL else d * sign > 0
+
     if 1 in by and 2 in by:
         d = by[2].run_up - by[1].run_up
-        out.append(("lower phi (V2) raises the run-up", d > 0, f"V2 - V1 = {d * 1000:+.1f} mm (paper +15 mm)"))
+        out.append(("lower phi (V2) raises the run-up", verdict(d, +1), f"V2 - V1 = {d * 1000:+.1f} mm (paper +15 mm)"))
     if 1 in by and 4 in by:
         d = by[4].run_up - by[1].run_up
-        out.append(("saturation (V4) lowers the run-up", d < 0, f"V4 - V1 = {d * 1000:+.1f} mm (paper -17 mm)"))
+        out.append(("saturation (V4) lowers the run-up", verdict(d, -1), f"V4 - V1 = {d * 1000:+.1f} mm (paper -17 mm)"))
     return out
+
+
+def verdict_text(holds):
+    if holds is None:
+        return f"undecided, the run-ups differ by less than {ORDER_TOL * 1000:g} mm"
+    return "holds" if holds else "does NOT hold"
 
 
 def write_csv(path, results):
@@ -445,7 +460,7 @@ def write_md(path, results, header_lines, checks):
         if checks:
             f.write("\n")
             for what, holds, detail in checks:
-                f.write(f"- {what}: {'holds' if holds else 'does NOT hold'} ({detail})\n")
+                f.write(f"- {what}: {verdict_text(holds)} ({detail})\n")
 
 
 # ---- figure ---------------------------------------------------------------------------------------
@@ -698,7 +713,7 @@ def main():
     if checks:
         print()
         for what, holds, detail in checks:
-            print(f"ordering: {what}: {'holds' if holds else 'does NOT hold'} ({detail})")
+            print(f"ordering: {what}: {verdict_text(holds)} ({detail})")
     print()
     print("stability (plate starts at t = 0, stops at t = 0.8 s):")
     for r in results:

@@ -111,3 +111,21 @@ def test_crossed_walls(tmp_path):
     assert vv.crossed_walls(d, bed, 1, 0.1) == 2
     assert vv.crossed_walls(d, bed, None, 0.1) == 1
     assert vv.crossed_walls(str(tmp_path), bed, 1, 0.1) == -1
+
+
+def test_ordering_verdicts():
+    # the paper: V2 - V1 = +15 mm (holds), V4 - V1 = -17 mm (holds); a difference below
+    # ORDER_TOL = 1 mm is no ordering either way
+    def result(run, z):
+        r = vv.Result(vv.PAPER[run], 0.01, "", "reused")
+        r.status, r.run_up = "ok", z
+        return r
+
+    checks = vv.ordering([result(1, 0.712), result(2, 0.727), result(4, 0.695)])
+    assert [c[1] for c in checks] == [True, True]
+    checks = vv.ordering([result(1, 0.712), result(2, 0.700), result(4, 0.720)])
+    assert [c[1] for c in checks] == [False, False]
+    checks = vv.ordering([result(1, 0.712), result(2, 0.7125), result(4, 0.7117)])
+    assert [c[1] for c in checks] == [None, None]
+    assert "undecided" in vv.verdict_text(None) and vv.verdict_text(False) == "does NOT hold"
+    assert vv.ordering([result(1, 0.712)]) == []
