@@ -105,11 +105,15 @@ def test_crossed_walls(tmp_path):
             "2,0.05,0.50,0,0,1722,0,0,1,0",    # behind the plate's face (x < 0.10): crossed the plate
             "3,0.05,0.40,0,0,0,0,0,1,2",       # the plate's wall particles (wall index 1)
             "4,0.05,0.80,0,0,0,0,0,1,2",
-            "5,0.73,-0.01,0,0,1000,0,0,0,3"]   # lost particles do not count
+            "5,0.73,-0.01,0,0,1000,0,0,0,3",   # lost particles do not count
+            # on the opposite slope's line to the CSV's 7 digits (4e-8 m below it as written,
+            # 1e-7 m above it in run.h5): within CROSS_TOL, not a crossing (run V4, dx = 0.0075)
+            "6,1.235541,0.5740457,0,0,1000,0,0,0,0",
+            "7,1.235541,0.5740357,0,0,1000,0,0,0,0"]   # 1e-5 m below it: a crossing
     with open(os.path.join(d, "snap_0000.csv"), "w") as f:
         f.write("# t = 0.5 s\nid,x,z,vx,vz,rho,p,mu,medium,state\n" + "\n".join(rows) + "\n")
-    assert vv.crossed_walls(d, bed, 1, 0.1) == 2
-    assert vv.crossed_walls(d, bed, None, 0.1) == 1
+    assert vv.crossed_walls(d, bed, 1, 0.1) == 3
+    assert vv.crossed_walls(d, bed, None, 0.1) == 2
     assert vv.crossed_walls(str(tmp_path), bed, 1, 0.1) == -1
 
 
