@@ -419,12 +419,55 @@ static void test_pore_pressure(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* ---- (c) tension cut-off (an option, not the paper's model) ------------------------------- */
+
+/* Grains stretched 1 % below and compressed 1 % above the mixture density: with the cut-off the
+ * stretched ones get the background pressure (0 here) instead of c^2 (rho - rho0) < 0 (linear EOS,
+ * MODEL.md section 3), the compressed ones keep c^2 (rho - rho0); without it both follow the EOS. */
+static void check_tension(const char *media, int cutoff)
+{
+    mixsph_sim *s = create_ok(media);
+    struct particles *P = &s->P;
+    const struct medium *m = &s->cfg.media[0];
+    assert_int_equal(m->tension_cutoff, cutoff);
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i)) P->rho[i] = m->rho0 * (P->z[i] < 0.05 ? 0.99 : 1.01);
+    integrate_eos(s);
+    long stretched = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i)) continue;
+        const double eos = m->c * m->c * (P->rho[i] - m->rho0); /* -688.9 or +688.9 Pa */
+        if (P->z[i] < 0.05) {
+            stretched++;
+            if (cutoff) assert_true(P->p[i] == 0.0);
+            else assert_rel(P->p[i], eos, 1e-12);
+        } else {
+            assert_rel(P->p[i], eos, 1e-12);
+        }
+    }
+    assert_int_equal(stretched, 200);
+    mixsph_sim_destroy(s);
+}
+
+static void test_tension_cutoff(void **state)
+{
+    (void)state;
+    check_tension(DRY_SAND, 0); /* default: off */
+    check_tension("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                  "\"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": true }",
+                  1);
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu_thr\": 320e3, \"tension_cutoff\": 2 }",
+                 "media.sand.tension_cutoff");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse_dry),      cmocka_unit_test(test_parse_saturated),
         cmocka_unit_test(test_parse_mu1),      cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_transitions),    cmocka_unit_test(test_pore_pressure),
+        cmocka_unit_test(test_tension_cutoff),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -307,7 +307,7 @@ static mixsph_status read_sound_speed(struct reader *r, const cJSON *it, const c
 static mixsph_status read_granular(struct reader *r, const cJSON *it, const char *path, struct case_def *c, struct medium *md)
 {
     static const char *const keys[] = {"type", "rho", "K", "c", "porosity", "phi", "d50", "saturated", "pore_fluid",
-                                       "mu_thr", "mu0", "mu1", NULL};
+                                       "mu_thr", "mu0", "mu1", "tension_cutoff", NULL};
     TRY(check_keys(r, it, path, keys));
     md->kind = MEDIUM_GRANULAR;
     TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho_grain));
@@ -351,6 +351,8 @@ static mixsph_status read_granular(struct reader *r, const cJSON *it, const char
         TRY(get_num(r, it, path, "mu_thr", 1, 0.0, 1, 1e12, &md->mu_thr));
         TRY(get_num(r, it, path, "mu0", 0, 0.0, 1, 1e12, &md->mu0));
     }
+    md->tension_cutoff = 0;
+    TRY(get_bool(r, it, path, "tension_cutoff", &md->tension_cutoff));
     md->mu = 0.0;
     md->alpha_m = 0.0;
     return MIXSPH_OK;

@@ -36,6 +36,7 @@ struct medium {
     double mu_thr;     /* threshold viscosity [Pa s] */
     double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
     int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
+    int tension_cutoff; /* granular: no tensile pressure, p >= background pressure (off: the paper's model) */
 };
 
 struct body {

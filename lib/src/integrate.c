@@ -59,7 +59,9 @@ void integrate_eos(mixsph_sim *s)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
         const struct medium *m = &M[P->medium[i]];
-        P->p[i] = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
+        double p = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
+        if (m->tension_cutoff && p < pb) p = pb; /* a cohesionless medium carries no tension */
+        P->p[i] = p;
         P->inv_rho[i] = 1.0 / P->rho[i];
         P->vol[i] = P->m[i] * P->inv_rho[i];
         P->avc[i] = m->kind == MEDIUM_FLUID ? m->alpha_m * m->c * s->h : 0.0;

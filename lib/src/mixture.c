@@ -16,7 +16,9 @@
  * slope of z_top over +-2 columns. The pressure of a fixed particle follows the mobile granular
  * particles around it (the paper), extrapolated hydrostatically as at walls:
  *   p_i = sum_j (p_j + rho_j g (z_j - z_i)) W_ij / sum_j W_ij  over mobile granular j;
- * with no such neighbour it keeps the pressure of its own density. */
+ * with no such neighbour it keeps the pressure of its own density. A medium with
+ * `tension_cutoff` (not the paper's model, an option) has its pressure floored at the
+ * background pressure here and in the equation of state (integrate.c). */
 #include <math.h>
 #include <stdlib.h>
 
@@ -151,6 +153,10 @@ void mixture_update(mixsph_sim *s)
             sw += w;
             sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
         }
-        if (sw > 0.0) P->p[i] = sp / sw;
+        if (sw > 0.0) {
+            const double pb = s->cfg.p_background;
+            const double p = sp / sw;
+            P->p[i] = s->cfg.media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
+        }
     }
 }
