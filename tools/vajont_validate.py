@@ -4,7 +4,7 @@ compare them with Manenti et al. (2018), Section 3.2, Tables 3-5 and Figs 7-10.
 
     python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--out out/vajont]
                                     [--reuse] [--t-end T] [--plot-runs 1,2,4] [--mixsph build/mixsph]
-                                    [--case cases/vajont_padua.json]
+                                    [--case cases/vajont_padua.json] [--set KEY=VALUE]...
 
 Runs are done one after the other (each with --threads N, default all cores). Run k is
 ``mixsph run CASE --out OUT/V<k>_dx<D> --set numerics.dx=... --set parameters.<...>=...
@@ -19,7 +19,9 @@ Runs are done one after the other (each with --threads N, default all cores). Ru
     V6   as V4, mu0 = 10 kPa s,  dx x 1.5                  0.0075
 
 ``--dx D`` is the spacing of V1-V4; V5 and V6 keep the paper's ratios to it (1.25 D and 1.5 D), so
-``--dx 0.005`` gives exactly the paper's runs. ``--reuse`` keeps a run whose summary.json says
+``--dx 0.005`` gives exactly the paper's runs. ``--set KEY=VALUE`` (repeatable) is passed to every
+run after the run's own overrides (e.g. ``--set parameters.tension_cutoff=1``, ``--set
+media.water.alpha_m=0.0375``): a sensitivity study of all runs at once. ``--reuse`` keeps a run whose summary.json says
 "ok" for the same t_end and settings (recorded in OUT/V<k>_dx<D>/vajont_run.json).
 
 Run-up (the case's monitor ``run_up``, lib/src/monitors.c): the highest z of a water particle
@@ -618,6 +620,9 @@ def main():
     ap.add_argument("--plot-runs", default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")
     ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable")
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", "vajont_padua.json"), help="case file")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
+                    help="an override passed to every run after the run's own (repeatable), "
+                    "e.g. parameters.tension_cutoff=1")
     ap.add_argument("--progress", type=float, default=60.0,
                     help="print the simulated time every this many seconds (default 60, 0: never)")
     args = ap.parse_args()
@@ -630,6 +635,16 @@ def main():
         fail("--threads must be at least 1")
     if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
         fail("--t-end must be a positive number of seconds")
+    extra = []
+    for text in args.sets:
+        key, eq, value = text.partition("=")
+        try:
+            v = float(value)
+        except ValueError:
+            v = math.nan
+        if not eq or not key or not math.isfinite(v):
+            fail(f"--set {text}: expected KEY=VALUE with a finite number, e.g. parameters.tension_cutoff=1")
+        extra.append((key, v))
     mixsph = os.path.abspath(args.mixsph)
     if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
         fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
@@ -654,12 +669,13 @@ def main():
         dx = round(args.dx * p.dx_ratio, 12)
         d = os.path.join(out, f"V{k}_dx{dx:g}")
         cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(dx)}"]
-        for key, val in p.sets:
+        sets = list(p.sets) + extra
+        for key, val in sets:
             cmd += ["--set", f"{key}={num(val)}"]
         if args.t_end is not None:
             cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
         cmd += ["--threads", str(threads), "--quiet"]
-        stamp = {"run": k, "dx": dx, "sets": [list(s) for s in p.sets], "t_end": t_end, "case": case,
+        stamp = {"run": k, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
                  "threads": threads, "command": cmd}
         jobs.append(Job(p, dx, d, cmd, stamp))
 
@@ -688,13 +704,15 @@ def main():
         bed = wall_defs.get("bed", {}).get("polyline")
         bed = np.array(bed, dtype=float) if bed else None
         plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
-        results = [load_result(job, reference_densities(case_json, job.paper.sets), (bed, plate)) for job in jobs]
+        results = [load_result(job, reference_densities(case_json, list(job.paper.sets) + extra), (bed, plate))
+                   for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     used_threads = sorted({r.threads for r in results if r.ok})
     head = (f"Vajont (Padua 1968, test No. 48), mixsph versus Manenti et al. (2018) Tables 4-5: V1-V4 at dx = "
             f"{args.dx:g} m (paper {PAPER_DX:g} m), t_end = {t_end:g} s, threads "
-            f"{','.join(str(t) for t in used_threads) or threads}; paper: SPHERA on 16 cores at 2.3 GHz")
+            f"{','.join(str(t) for t in used_threads) or threads}; paper: SPHERA on 16 cores at 2.3 GHz"
+            + "".join(f"; with {k}={num(v)}" for k, v in extra))
     print()
     print(head)
     print()
