@@ -704,8 +704,7 @@ def main():
         bed = wall_defs.get("bed", {}).get("polyline")
         bed = np.array(bed, dtype=float) if bed else None
         plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
-        results = [load_result(job, reference_densities(case_json, list(job.paper.sets) + extra), (bed, plate))
-                   for job in jobs]
+        results = [load_result(job, reference_densities(case_json, job.stamp["sets"]), (bed, plate)) for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     used_threads = sorted({r.threads for r in results if r.ok})
