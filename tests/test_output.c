@@ -286,6 +286,8 @@ static void test_restart_equals_uninterrupted(void **state)
     assert_int_equal(mixsph_sim_set_output_dir(b, db), MIXSPH_OK);
     assert_int_equal(mixsph_sim_advance_to(b, 0.03), MIXSPH_OK);
     snprintf(ck, sizeof ck, "%s/checkpoint.h5", db);
+    const double wall_ck = mixsph_sim_run_wall_time(b); /* B's stepping time up to its checkpoint */
+    assert_true(wall_ck > 0.0);
     assert_int_equal(mixsph_sim_write_checkpoint(b, ck), MIXSPH_OK);
     assert_int_equal(mixsph_sim_advance_to(b, 0.08), MIXSPH_OK);
     mixsph_sim_destroy(b); /* the "crash": later snapshots and rows are in its files */
@@ -294,9 +296,13 @@ static void test_restart_equals_uninterrupted(void **state)
     char err[512];
     assert_int_equal(mixsph_sim_create_from_checkpoint(ck, &c, err, sizeof err), MIXSPH_OK);
     assert_true(mixsph_sim_time(c) >= 0.03 && mixsph_sim_time(c) < 0.031);
+    /* the run's wall time carries over the restart: B's up to the checkpoint (not the work B
+     * redid after it), then C's own on top */
+    assert_true(mixsph_sim_run_wall_time(c) == wall_ck);
     assert_int_equal(mixsph_sim_set_threads(c, 1), MIXSPH_OK);
     assert_int_equal(mixsph_sim_resume_output_dir(c, db), MIXSPH_OK);
     assert_int_equal(mixsph_sim_advance_to(c, 0.12), MIXSPH_OK);
+    assert_true(mixsph_sim_run_wall_time(c) > wall_ck);
     same_state(a, c);
     mixsph_sim_destroy(a);
     mixsph_sim_destroy(c);

@@ -55,6 +55,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <hdf5.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,12 +92,6 @@ struct output {
 
 enum { T_CSV = 0, T_HDF5 = 1, T_CKPT = 2 };
 
-static double clock_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* ---- HDF5 errors: never printed, the innermost message kept -------------------------------- */
 
@@ -650,11 +645,11 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
 mixsph_status output_snapshot(mixsph_sim *s)
 {
     const long index = s->snap_index;
-    const double t0 = clock_s();
+    const double t0 = sim_clock_s();
     mixsph_status st = MIXSPH_OK;
     if (s->csv_snapshots_off) s->snap_index++;
     else st = monitors_snapshot(s);
-    const double t1 = clock_s();
+    const double t1 = sim_clock_s();
     s->out_seconds[T_CSV] += t1 - t0;
     struct output *o = s->h5;
     if (st != MIXSPH_OK || !o) return st;
@@ -667,7 +662,7 @@ mixsph_status output_snapshot(mixsph_sim *s)
     if (snaps_push(o, (struct snap_rec){index, s->t, s->step, s->P.n}))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     if (xdmf_write(s, o) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));
-    s->out_seconds[T_HDF5] += clock_s() - t1;
+    s->out_seconds[T_HDF5] += sim_clock_s() - t1;
     return MIXSPH_OK;
 }
 
@@ -700,7 +695,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
 {
     if (!s) return MIXSPH_ERR_ARG;
     if (!path || !*path) return SIM_FAIL(s, MIXSPH_ERR_ARG, "checkpoint: no file name");
-    const double t0 = clock_s();
+    const double t0 = sim_clock_s();
     void *buf = NULL;
     size_t len = 0;
     mixsph_status st = mixsph_sim_save_state(s, &buf, &len);
@@ -727,6 +722,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
               attr_str(f, "mixsph_version", MIXSPH_VERSION) || attr_str(f, "case_name", s->cfg.name) ||
               attr_str(f, "case_origin", s->case_origin ? s->case_origin : "") || attr_str(f, "created_utc", created) ||
               attr_f64(f, "time", s->t) || attr_i64(f, "step", (long long)s->step) ||
+              attr_f64(f, "run_wall_time_s", s->run_wall_s) ||
               dset_write(f, "state", H5T_STD_U8LE, H5T_NATIVE_UINT8, len, 0, buf, "1",
                          "mixsph_sim_save_state buffer (versioned, checksummed; same build and machine type)");
     if (f >= 0) bad |= H5Fclose(f) < 0;
@@ -747,7 +743,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     }
     if (bad) remove(tmp);
     free(tmp);
-    s->out_seconds[T_CKPT] += clock_s() - t0;
+    s->out_seconds[T_CKPT] += sim_clock_s() - t0;
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;
 }
 
@@ -763,6 +759,7 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
     mixsph_status st = MIXSPH_OK;
     unsigned char *buf = NULL;
     size_t len = 0;
+    double run_wall = NAN;
     const hid_t fapl = fapl_nolock();
     const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
     if (f < 0) h5_cause(&c); /* before any other call clears it */
@@ -784,6 +781,9 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
         }
         if (sp >= 0) H5Sclose(sp);
         if (d >= 0) H5Dclose(d);
+        /* the run's wall time up to the checkpoint (absent from older checkpoints: unknown) */
+        if (H5Aexists(f, "run_wall_time_s") <= 0 || attr_read_f64(f, "run_wall_time_s", &run_wall) != 0)
+            run_wall = NAN;
         H5Fclose(f);
     }
     quiet_off(&q);
@@ -791,6 +791,7 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
         char msg[900];
         st = mixsph_sim_create_from_state(buf, len, out, msg, sizeof msg);
         if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
+        else (*out)->run_wall_s = run_wall;
     }
     free(buf);
     return st;

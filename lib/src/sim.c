@@ -6,6 +6,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 
 #include "eos.h"
@@ -359,12 +360,23 @@ static mixsph_status sim_outputs_due(mixsph_sim *s)
 mixsph_status mixsph_sim_step(mixsph_sim *s)
 {
     if (!s) return MIXSPH_ERR_ARG;
+    const double t0 = sim_clock_s();
     mixsph_status st = MIXSPH_OK;
     if (s->step == 0 && s->n_samples == 0) st = sim_outputs_due(s);
     if (st == MIXSPH_OK) st = integrate_step(s);
     if (st == MIXSPH_OK) st = sim_outputs_due(s);
+    s->run_wall_s += sim_clock_s() - t0;
     return st;
 }
+
+double sim_clock_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->run_wall_s : NAN; }
 
 mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
 {

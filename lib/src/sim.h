@@ -84,6 +84,7 @@ struct mixsph_sim {
     FILE *monitor_csv;
     struct output *h5;            /* run.h5 and run.xdmf (output.c); NULL without an output folder */
     double out_seconds[3];        /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
+    double run_wall_s;            /* wall time stepping this run since t = 0, incl. before a restart [s] */
     int csv_snapshots_off;        /* no snap_NNNN.csv (run.h5 only) */
 
     char err[1024];
@@ -99,6 +100,9 @@ void walls_move(mixsph_sim *s, double t_from, double dt);
 void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old, double x0, double z0,
                 double *x1, double *z1, double *vx, double *vz, long *clips);
 void walls_pressure(mixsph_sim *s);
+
+/* sim.c: monotonic wall clock [s] */
+double sim_clock_s(void);
 
 /* forces.c */
 int forces_compute(mixsph_sim *s);

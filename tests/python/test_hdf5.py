@@ -233,8 +233,9 @@ def test_restart_equals_uninterrupted(killed, full, tmp_path):
     shutil.copytree(killed, cont)
     with h5py.File(cont / "checkpoint.h5", "r") as c:
         t_ckpt = c.attrs["time"]
+        wall_ckpt = c.attrs["run_wall_time_s"]
         assert c["state"].dtype == np.uint8 and c.attrs["format"] == "mixsph-checkpoint"
-    assert 0 < t_ckpt < 0.2
+    assert 0 < t_ckpt < 0.2 and wall_ckpt > 0
     r = subprocess.run([mixsph(), "run", "--restart", str(cont / "checkpoint.h5"), "--threads", "1", "--quiet"],
                        env=ENV, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stderr
@@ -253,6 +254,11 @@ def test_restart_equals_uninterrupted(killed, full, tmp_path):
     assert math.isclose(summ["particle_steps_per_s"], summ["particles"] * (summ["steps"] - step_ckpt) / wall, rel_tol=1e-12)
     assert math.isclose(summ["wall_s_per_simulated_s"], wall / (summ["simulated_time_s"] - t_ckpt), rel_tol=1e-12)
     assert "restarted_from" not in whole
+    # the run's wall time adds the killed run's time up to its checkpoint to the continuation's
+    # (both measured around the steps, so it is not the sum of the processes' wall times)
+    assert summ["run_wall_time_s"] > wall_ckpt
+    assert math.isclose(summ["run_wall_time_s"] - wall_ckpt, wall, rel_tol=0.5)
+    assert 0 < whole["run_wall_time_s"] <= whole["wall_time_s"]
 
 
 def test_sigterm_checkpoints_and_restart_equals_uninterrupted(full, tmp_path):
