@@ -3,8 +3,9 @@
 and compare them with the paper.
 
     python tools/erosive_dambreak.py [--runs 2,5,6,7] [--dx 0.01] [--out out/erosive]
-                                     [--threads N] [--jobs J] [--reuse] [--mixsph build/mixsph]
-                                     [--case cases/erosive_dambreak.json] [--t-end T] [--at 0.5]
+                                     [--threads N] [--jobs J] [--reuse] [--checkpoint-every S]
+                                     [--mixsph build/mixsph] [--case cases/erosive_dambreak.json]
+                                     [--t-end T] [--at 0.5]
 
 Each selected run k is ``mixsph run CASE --out OUT/run<k>_dx<D> --set numerics.dx=D --set
 media.sediment.mu_thr=... --set media.sediment.mu0=... --threads N --quiet`` (stdout and stderr in
@@ -21,12 +22,16 @@ OUT/run<k>_dx<D>/mixsph.log). The paper's runs (viscosities in kPa s; the case t
 
 ``--jobs J`` runs up to J runs at once, each with max(1, cores // J) threads unless ``--threads``
 is given. ``--reuse`` keeps a run whose summary.json says "ok" for the same t_end (and the same
-settings, recorded in OUT/run<k>_dx<D>/erosive_run.json). ``--t-end T`` shortens every run (for
+settings, recorded in OUT/run<k>_dx<D>/erosive_run.json) and continues an unfinished one (killed,
+stopped, cut off with its session) from the checkpoint it left: every run writes
+OUT/run<k>_dx<D>/checkpoint.h5 every ``--checkpoint-every`` seconds of wall time (default 600), so
+the paper's dx = 0.005, hours per run, can be done in pieces. ``--t-end T`` shortens every run (for
 tests: the profiles at t = 0.5 s then do not exist and the columns that need them say n/a).
 
 Printed table, one row per run, ours beside the paper's:
 
-- wall time of the run (summary.json ``wall_time_s``) and the paper's total elapsed time;
+- wall time of the run (summary.json ``run_wall_time_s``: over all its pieces when it was
+  continued from checkpoints) and the paper's total elapsed time;
 - saving versus the reference run, 100 (1 - wall / wall_ref), ours and the paper's (Run 6 vs
   Run 2: 71 %; Run 2 vs Run 4: 69 %);
 - interface error versus the reference run, ours and the paper's "aver. err.": the mean, over the
@@ -140,6 +145,8 @@ class Job:
     t0: float = 0.0
     source: str = ""      # "ran", "reused", "FAILED"
     message: str = ""     # why it failed
+    checkpoint: str = None  # continue this unfinished run's checkpoint (cmd is then its restart)
+    ts0: float = 0.0        # simulated time at the start [s] (the checkpoint's when continued)
 
 
 @dataclass
@@ -189,23 +196,15 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
         while pending or running:
             while pending and len(running) < n_parallel and not stop:
                 job = pending.pop(0)
-                os.makedirs(job.outdir, exist_ok=True)
-                mt.clean_outdir(job.outdir, STAMP)
-                with open(os.path.join(job.outdir, STAMP), "w") as f:
-                    json.dump(job.stamp, f, indent=2)
-                    f.write("\n")
-                job.log = open(os.path.join(job.outdir, "mixsph.log"), "w")
-                job.log.write("$ " + " ".join(job.cmd) + "\n")
-                job.log.flush()
                 job.t0 = time.monotonic()
+                job.ts0 = mt.checkpoint_time(job.checkpoint) if job.checkpoint else 0.0
                 try:
-                    job.proc = subprocess.Popen(job.cmd, stdout=job.log, stderr=subprocess.STDOUT,
-                                                stdin=subprocess.DEVNULL)
+                    job.proc, job.log = mt.launch(job.outdir, STAMP, job.stamp, job.cmd, job.checkpoint)
                 except OSError as e:
-                    job.log.close()
                     fail(f"cannot start {job.cmd[0]}: {e}")
                 running.append(job)
-                print(f"run {job.paper.run}: started ({job.threads} thread{'s' if job.threads > 1 else ''}) "
+                how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
+                print(f"run {job.paper.run}: {how} ({job.threads} thread{'s' if job.threads > 1 else ''}) "
                       f"-> {show(job.outdir)}/  (log: mixsph.log)", flush=True)
             if pending and stop and not running:
                 break
@@ -242,7 +241,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                 for job in running:
                     ts = last_time(os.path.join(job.outdir, "monitors.csv"))
                     el = now - job.t0
-                    eta = fmt_duration(el * (t_end - ts) / ts) if math.isfinite(ts) and ts > 0 else "--"
+                    eta = fmt_duration(el * (t_end - ts) / (ts - job.ts0)) if math.isfinite(ts) and ts > job.ts0 else "--"
                     parts.append(f"run {job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s (ETA {eta})")
                 print(f"  [{fmt_duration(now - t_start)}] " + ", ".join(parts), flush=True)
     except KeyboardInterrupt:
@@ -278,8 +277,8 @@ def load_result(job, at, dx, sediment):
     r.status = str(summ.get("status"))
     r.threads = int(summ.get("threads") or 0)
     r.sim_time = float(summ.get("simulated_time_s") or math.nan)
-    r.wall = float(summ.get("wall_time_s") or math.nan)
-    r.psteps = float(summ.get("particle_steps_per_s") or math.nan)
+    r.wall = mt.run_wall_time(summ)
+    r.psteps = mt.run_particle_steps_per_s(summ)
     r.rise = mt.summary_value(summ, "bedload_rise_left_wall", "max")
     r.rise_t = mt.summary_value(summ, "bedload_rise_left_wall", "t_max")
     r.p_peak = mt.summary_value(summ, "left_wall_pressure", "max")
@@ -593,7 +592,11 @@ def main():
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "erosive"), help="output folder (default out/erosive)")
     ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default max(1, cores // jobs))")
     ap.add_argument("--jobs", type=int, default=1, help="runs at once (default 1)")
-    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings)")
+    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings) "
+                    "and continue unfinished ones from their checkpoints")
+    ap.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
+                    help="each run writes a checkpoint every SECONDS of wall time (default 600; 0: none), "
+                    "from which --reuse continues it after an interruption")
     ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"),
                     help="mixsph executable (default build/mixsph)")
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", "erosive_dambreak.json"),
@@ -615,6 +618,8 @@ def main():
         fail("--threads must be at least 1")
     if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
         fail("--t-end must be a positive number of seconds")
+    if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
+        fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
     mixsph = os.path.abspath(args.mixsph)
     if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
         fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
@@ -657,6 +662,8 @@ def main():
         if args.t_end is not None:
             cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
         cmd += ["--threads", str(threads), "--quiet"]
+        if args.checkpoint_every > 0:
+            cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
                  "threads": threads, "command": cmd}
         jobs.append(Job(p, d, cmd, stamp, threads))
@@ -669,8 +676,13 @@ def main():
                 job.source = "reused"
                 print(f"run {job.paper.run}: reused {show(job.outdir)}/ ({why})")
                 continue
-            if os.path.isdir(job.outdir):
-                print(f"run {job.paper.run}: not reused ({why}): running it again")
+            ckpt, why_not = mt.resumable(job.outdir, job.stamp, STAMP, STAMP_KEYS)
+            if ckpt:
+                job.checkpoint = ckpt
+                job.cmd = mt.restart_command(mixsph, ckpt, threads, args.checkpoint_every)
+                print(f"run {job.paper.run}: not finished ({why}): continuing it from {show(ckpt)}")
+            elif os.path.isdir(job.outdir):
+                print(f"run {job.paper.run}: not reused ({why}; not continued: {why_not}): running it again")
         to_run.append(job)
     if to_run:
         print(f"{len(to_run)} run(s) of {show(case)} at dx = {args.dx:g} m to t = {t_end:g} s, "

@@ -13,7 +13,8 @@ File formats (cli/main.c, lib/src/monitors.c):
 
 - ``monitors.csv``: header ``t,step,<output>...``, one row per monitor interval, ``nan`` where a
   monitor has no value (e.g. no particle in its window);
-- ``summary.json``: ``status`` ("ok" or the failure), ``wall_time_s``, ``particle_steps_per_s``,
+- ``summary.json``: ``status`` ("ok" or the failure), ``wall_time_s`` (this process),
+  ``run_wall_time_s`` (the run over all its pieces, see ``run_wall_time``), ``particle_steps_per_s``,
   ``simulated_time_s``, ``threads``, ``outputs{name: {final, max, t_max, min, t_min}}`` (null when
   the output never had a value);
 - ``profile_<name>_<k>.csv``: first line ``# profile <name> of <medium> at t = <t> s (requested
@@ -25,6 +26,7 @@ import json
 import math
 import os
 import re
+import subprocess
 from dataclasses import dataclass
 
 import numpy as np
@@ -232,13 +234,30 @@ def fmt_duration(s):
 
 def clean_outdir(d, stamp_name):
     """Remove the files an earlier run left in folder d (a shorter run must not show stale
-    profiles or snapshots); stamp_name is the script's record of the run's settings."""
+    profiles or snapshots, a fresh run must not be continued from an old checkpoint); stamp_name
+    is the script's record of the run's settings."""
     if not os.path.isdir(d):
         return
     for name in os.listdir(d):
-        if name in ("summary.json", "monitors.csv", "mixsph.log", stamp_name) or \
+        if name in ("summary.json", "monitors.csv", "mixsph.log", "checkpoint.h5", stamp_name) or \
                 (name.endswith(".csv") and name.startswith(("profile_", "snap_"))):
             os.remove(os.path.join(d, name))
+
+
+def _stamp_differs(outdir, stamp, stamp_name, keys):
+    """Why the stamp file in outdir does not record the same values of ``keys`` as ``stamp``
+    (None when it does; a missing stamp counts as the same, for folders of older scripts)."""
+    stamp_path = os.path.join(outdir, stamp_name)
+    if not os.path.isfile(stamp_path):
+        return None
+    try:
+        with open(stamp_path) as f:
+            old = json.load(f)
+    except (OSError, ValueError):
+        old = None
+    if not isinstance(old, dict) or any(old.get(k) != stamp.get(k) for k in keys):
+        return f"{show(stamp_path)} records other settings"
+    return None
 
 
 def reusable(outdir, stamp, stamp_name, keys, t_end, t_tol):
@@ -257,16 +276,92 @@ def reusable(outdir, stamp, stamp_name, keys, t_end, t_tol):
     st = summ.get("simulated_time_s")
     if not isinstance(st, (int, float)) or abs(st - t_end) > t_tol:
         return False, f"it ran to t = {st} s, not t_end = {t_end:g} s"
-    stamp_path = os.path.join(outdir, stamp_name)
-    if os.path.isfile(stamp_path):
-        try:
-            with open(stamp_path) as f:
-                old = json.load(f)
-        except (OSError, ValueError):
-            old = None
-        if not isinstance(old, dict) or any(old.get(k) != stamp.get(k) for k in keys):
-            return False, f"{show(stamp_path)} records other settings"
+    why = _stamp_differs(outdir, stamp, stamp_name, keys)
+    if why:
+        return False, why
     return True, f"summary ok, t = {st:.4g} s"
+
+
+def resumable(outdir, stamp, stamp_name, keys):
+    """(checkpoint path, why) when outdir holds an unfinished run of the same settings (its stamp
+    file records the same ``keys``, t_end included) that left a checkpoint (``mixsph run
+    --checkpoint-every``, or one stopped by SIGTERM): ``mixsph run --restart`` continues it
+    bit-identically. (None, why not) otherwise. Call it for a run that is not reusable."""
+    ckpt = os.path.join(outdir, "checkpoint.h5")
+    if not os.path.isfile(ckpt):
+        return None, "no checkpoint.h5"
+    if not os.path.isfile(os.path.join(outdir, stamp_name)):
+        return None, f"no {stamp_name} to tell which run it is"
+    why = _stamp_differs(outdir, stamp, stamp_name, keys)
+    if why:
+        return None, why
+    return ckpt, "an unfinished run of the same settings left a checkpoint"
+
+
+def launch(outdir, stamp_name, stamp, cmd, checkpoint=None):
+    """Start ``mixsph run`` for a script's run in outdir, its output in outdir/mixsph.log.
+    Fresh (checkpoint None): the folder is cleaned and the stamp written, then ``cmd`` runs.
+    Continued: ``cmd`` is a ``mixsph run --restart`` of ``checkpoint``; the folder is kept (the
+    run's files go on from the checkpoint), the log is appended to. Returns (process, log file);
+    raises OSError when the process cannot start."""
+    os.makedirs(outdir, exist_ok=True)
+    if checkpoint is None:
+        clean_outdir(outdir, stamp_name)
+        with open(os.path.join(outdir, stamp_name), "w") as f:
+            json.dump(stamp, f, indent=2)
+            f.write("\n")
+    log = open(os.path.join(outdir, "mixsph.log"), "a" if checkpoint else "w")
+    log.write("$ " + " ".join(cmd) + "\n")
+    log.flush()
+    try:
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
+    except OSError:
+        log.close()
+        raise
+    return proc, log
+
+
+def checkpoint_time(path):
+    """Simulated time [s] of a checkpoint file (its ``time`` attribute); nan if unreadable."""
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            return float(f.attrs["time"])
+    except Exception:   # noqa: BLE001 - only for a progress estimate
+        return math.nan
+
+
+def restart_command(mixsph, checkpoint, threads, checkpoint_every):
+    """The ``mixsph run --restart`` command continuing a checkpoint in its own folder."""
+    cmd = [mixsph, "run", "--restart", checkpoint, "--threads", str(threads), "--quiet"]
+    if checkpoint_every > 0:
+        cmd += ["--checkpoint-every", num(checkpoint_every)]
+    return cmd
+
+
+def run_particle_steps_per_s(summary):
+    """Particle-steps per second of a whole run (all its pieces, see ``run_wall_time``)."""
+    if "restarted_from" not in summary:
+        v = summary.get("particle_steps_per_s")
+        return float(v) if isinstance(v, (int, float)) else math.nan
+    try:
+        return float(summary["particles"]) * float(summary["steps"]) / run_wall_time(summary)
+    except (KeyError, TypeError, ValueError, ZeroDivisionError):
+        return math.nan
+
+
+def run_wall_time(summary):
+    """The wall time of a whole run from its summary.json: ``run_wall_time_s`` (the time spent
+    stepping, over all its pieces when it was continued from checkpoints), else ``wall_time_s``
+    for a run made in one piece; nan for a continued run whose first pieces' time is unknown
+    (a checkpoint of a build that did not record it)."""
+    w = summary.get("run_wall_time_s")
+    if isinstance(w, (int, float)) and math.isfinite(w):
+        return float(w)
+    if "restarted_from" in summary:
+        return math.nan
+    w = summary.get("wall_time_s")
+    return float(w) if isinstance(w, (int, float)) else math.nan
 
 
 def last_time(monitors_csv):

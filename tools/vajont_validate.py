@@ -3,7 +3,8 @@
 compare them with Manenti et al. (2018), Section 3.2, Tables 3-5 and Figs 7-10.
 
     python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--out out/vajont]
-                                    [--reuse] [--t-end T] [--plot-runs 1,2,4] [--mixsph build/mixsph]
+                                    [--reuse] [--checkpoint-every S] [--t-end T] [--plot-runs 1,2,4]
+                                    [--mixsph build/mixsph]
                                     [--case cases/vajont_padua.json] [--set KEY=VALUE]...
 
 Runs are done one after the other (each with --threads N, default all cores). Run k is
@@ -22,7 +23,11 @@ Runs are done one after the other (each with --threads N, default all cores). Ru
 ``--dx 0.005`` gives exactly the paper's runs. ``--set KEY=VALUE`` (repeatable) is passed to every
 run after the run's own overrides (e.g. ``--set parameters.tension_cutoff=1``, ``--set
 media.water.alpha_m=0.0375``): a sensitivity study of all runs at once. ``--reuse`` keeps a run whose summary.json says
-"ok" for the same t_end and settings (recorded in OUT/V<k>_dx<D>/vajont_run.json).
+"ok" for the same t_end and settings (recorded in OUT/V<k>_dx<D>/vajont_run.json) and continues an
+unfinished one (killed, stopped, cut off with its session) from the checkpoint it left: every run
+writes OUT/V<k>_dx<D>/checkpoint.h5 every ``--checkpoint-every`` seconds of wall time (default
+600), so the paper's dx = 0.005, hours per run, can be done in pieces. Elapsed times are the
+runs' ``run_wall_time_s`` (over all their pieces).
 
 Run-up (the case's monitor ``run_up``, lib/src/monitors.c): the highest z of a water particle
 centre over the opposite slope (x in [0.75, 1.81] m) among the water particles that have at least
@@ -140,6 +145,7 @@ class Job:
     stamp: dict
     source: str = ""       # "ran", "reused", "FAILED", "not run"
     message: str = ""
+    checkpoint: str = None  # continue this unfinished run's checkpoint (cmd is then its restart)
 
 
 def reusable(job, t_end):
@@ -149,20 +155,15 @@ def reusable(job, t_end):
 
 def run_job(job, t_end, progress_every):
     """Run one job to completion. Returns the exit code of mixsph."""
-    os.makedirs(job.outdir, exist_ok=True)
-    mt.clean_outdir(job.outdir, STAMP)
-    with open(os.path.join(job.outdir, STAMP), "w") as f:
-        json.dump(job.stamp, f, indent=2)
-        f.write("\n")
-    with open(os.path.join(job.outdir, "mixsph.log"), "w") as log:
-        log.write("$ " + " ".join(job.cmd) + "\n")
-        log.flush()
-        t0 = time.monotonic()
-        try:
-            proc = subprocess.Popen(job.cmd, stdout=log, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL)
-        except OSError as e:
-            fail(f"cannot start {job.cmd[0]}: {e}")
-        print(f"V{job.paper.run}: started, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
+    t0 = time.monotonic()
+    ts0 = mt.checkpoint_time(job.checkpoint) if job.checkpoint else 0.0   # simulated time at the start
+    try:
+        proc, log = mt.launch(job.outdir, STAMP, job.stamp, job.cmd, job.checkpoint)
+    except OSError as e:
+        fail(f"cannot start {job.cmd[0]}: {e}")
+    with log:
+        how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
+        print(f"V{job.paper.run}: {how}, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
         last = t0
         try:
             while proc.poll() is None:
@@ -172,7 +173,7 @@ def run_job(job, t_end, progress_every):
                     last = now
                     ts = last_time(os.path.join(job.outdir, "monitors.csv"))
                     el = now - t0
-                    eta = el * (t_end - ts) / ts if math.isfinite(ts) and ts > 0 else math.nan
+                    eta = el * (t_end - ts) / (ts - ts0) if math.isfinite(ts) and ts > ts0 else math.nan
                     print(f"  [{fmt_duration(el)}] V{job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s "
                           f"(ETA {fmt_duration(eta)})", flush=True)
         except KeyboardInterrupt:
@@ -329,8 +330,8 @@ def load_result(job, rho0=None, walls=None):
     r.particles = int(s.get("particles") or 0)
     r.steps = int(s.get("steps") or 0)
     r.sim_time = float(s.get("simulated_time_s") or math.nan)
-    r.wall = float(s.get("wall_time_s") or math.nan)
-    r.psteps = float(s.get("particle_steps_per_s") or math.nan)
+    r.wall = mt.run_wall_time(s)
+    r.psteps = mt.run_particle_steps_per_s(s)
     r.run_up = mt.summary_value(s, "run_up", "max")
     r.t_run_up = mt.summary_value(s, "run_up", "t_max")
     r.Z = mt.summary_value(s, "run_up_Z", "max")
@@ -615,7 +616,11 @@ def main():
                     help="particle spacing of V1-V4 [m] (default 0.02; the paper's is 0.005; V5, V6: x1.25, x1.5)")
     ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default: all cores)")
     ap.add_argument("--out", default=os.path.join(ROOT, "out", "vajont"), help="output folder (default out/vajont)")
-    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings)")
+    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings) "
+                    "and continue unfinished ones from their checkpoints")
+    ap.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
+                    help="each run writes a checkpoint every SECONDS of wall time (default 600; 0: none), "
+                    "from which --reuse continues it after an interruption")
     ap.add_argument("--t-end", type=float, help="end time [s] (default the case's 1.6 s; for short tests)")
     ap.add_argument("--plot-runs", default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")
     ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable")
@@ -635,6 +640,8 @@ def main():
         fail("--threads must be at least 1")
     if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
         fail("--t-end must be a positive number of seconds")
+    if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
+        fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
     extra = []
     for text in args.sets:
         key, eq, value = text.partition("=")
@@ -675,6 +682,8 @@ def main():
         if args.t_end is not None:
             cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
         cmd += ["--threads", str(threads), "--quiet"]
+        if args.checkpoint_every > 0:
+            cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
                  "threads": threads, "command": cmd}
         jobs.append(Job(p, dx, d, cmd, stamp))
@@ -688,8 +697,13 @@ def main():
                 job.source = "reused"
                 print(f"V{job.paper.run}: reused {show(job.outdir)}/ ({why})")
                 continue
-            if os.path.isdir(job.outdir):
-                print(f"V{job.paper.run}: not reused ({why}): running it again")
+            ckpt, why_not = mt.resumable(job.outdir, job.stamp, STAMP, STAMP_KEYS)
+            if ckpt:
+                job.checkpoint = ckpt
+                job.cmd = mt.restart_command(mixsph, ckpt, threads, args.checkpoint_every)
+                print(f"V{job.paper.run}: not finished ({why}): continuing it from {show(ckpt)}")
+            elif os.path.isdir(job.outdir):
+                print(f"V{job.paper.run}: not reused ({why}; not continued: {why_not}): running it again")
         rc = run_job(job, t_end, args.progress)
         if rc != 0:
             failed.append(job)

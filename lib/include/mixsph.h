@@ -96,7 +96,8 @@ double mixsph_sim_end_time(const mixsph_sim *s);  /**< end time of the case [s] 
 double mixsph_sim_dt(const mixsph_sim *s);        /**< last time step [s] */
 uint64_t mixsph_sim_steps(const mixsph_sim *s);   /**< steps taken */
 /** Wall-clock seconds this run has spent in mixsph_sim_step (and so advance_to), the outputs due at
- *  the case's intervals included: this process's time plus, after a restart from a checkpoint,
+ *  the case's intervals and the checkpoints written included: this process's time plus, after a
+ *  restart from a checkpoint,
  *  the run's time up to that checkpoint (carried by it; NaN when the checkpoint was written by a
  *  build that did not record it). mixsph_sim_load_state leaves it alone (it is not physics). */
 double mixsph_sim_run_wall_time(const mixsph_sim *s);

@@ -743,7 +743,9 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     }
     if (bad) remove(tmp);
     free(tmp);
-    s->out_seconds[T_CKPT] += sim_clock_s() - t0;
+    const double spent = sim_clock_s() - t0;
+    s->out_seconds[T_CKPT] += spent;
+    s->run_wall_s += spent; /* the run's time includes its checkpoints (after this one's attribute) */
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;
 }
 

@@ -81,3 +81,35 @@ def test_interface_error_skips_empty_and_far_bins():
     run = mt.Profile("", "interface", 0.5, 0.5, x, np.array([0.11, math.nan, 0.2, 0.5]))
     err, n = ed.interface_error(run, ref)
     assert n == 1 and abs(err - 10.0) < 1e-9
+
+
+def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
+    # As tools/vajont_validate.py: a run cut off with SIGKILL is continued by --reuse from its
+    # checkpoint and ends bit-identical to an uninterrupted one (one thread), its wall time the
+    # run's over both pieces. Run 6 at dx 0.02 to t = 0.1 s, cut off after t = 0.03 s.
+    import json
+    import subprocess
+    from tool_helpers import ENV, cut_off
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        import pytest
+        pytest.skip("build/mixsph not built")
+    tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph,
+            "--runs", "6", "--dx", "0.02", "--t-end", "0.1", "--threads", "1", "--progress", "0",
+            "--checkpoint-every", "0.5"]
+    cut, whole = tmp_path / "cut", tmp_path / "whole"
+    run_dir = cut / "run6_dx0.02"
+    carried = cut_off(tool + ["--out", str(cut)], str(run_dir), 0.03)
+    r = subprocess.run(tool + ["--out", str(cut), "--reuse"], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "run 6: not finished (no summary.json): continuing it from" in r.stdout
+    r2 = subprocess.run(tool + ["--out", str(whole)], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r2.returncode == 0, r2.stdout + r2.stderr
+    with open(run_dir / "summary.json") as f:
+        summ = json.load(f)
+    assert summ["status"] == "ok" and summ["run_wall_time_s"] > carried > 0
+    assert (run_dir / "monitors.csv").read_bytes() == (whole / "run6_dx0.02" / "monitors.csv").read_bytes()
+    import csv
+    with open(cut / "erosive_table.csv") as f:
+        row = next(csv.DictReader(f))
+    assert math.isclose(float(row["wall_time_s"]), summ["run_wall_time_s"], rel_tol=1e-5)   # 6 digits in the CSV

@@ -12,6 +12,7 @@ import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 sys.path.insert(0, os.path.join(ROOT, "tools"))
+import mixsph_tools as mt  # noqa: E402
 import vajont_validate as vv  # noqa: E402
 
 
@@ -158,3 +159,51 @@ def test_set_reaches_every_run(tmp_path):
     bad = subprocess.run(tool + ["--set", "parameters.tension_cutoff"], capture_output=True, text=True, timeout=60)
     assert bad.returncode == 2
     assert "--set parameters.tension_cutoff: expected KEY=VALUE" in bad.stderr
+
+
+def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
+    # A validation run cut off (the script and mixsph killed with SIGKILL, as at the end of a
+    # session) is continued by --reuse from the checkpoint it left, not run again: the result is
+    # bit-identical to an uninterrupted run (one thread: monitors.csv equal byte for byte, as the
+    # CLI's restart guarantees), and the elapsed time is the run's over both pieces. V1 at dx 0.03
+    # to t = 0.3 s (seconds), checkpoints every 0.5 s of wall time, cut off after t = 0.1 s.
+    import subprocess
+    from tool_helpers import ENV, cut_off
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        pytest.skip("build/mixsph not built")
+    tool = [sys.executable, os.path.join(ROOT, "tools", "vajont_validate.py"), "--mixsph", mixsph,
+            "--runs", "1", "--dx", "0.03", "--t-end", "0.3", "--threads", "1", "--progress", "0",
+            "--checkpoint-every", "0.5"]
+    cut, whole = tmp_path / "cut", tmp_path / "whole"
+    run_dir = cut / "V1_dx0.03"
+    carried = cut_off(tool + ["--out", str(cut)], str(run_dir), 0.1)
+    assert carried > 0
+
+    r = subprocess.run(tool + ["--out", str(cut), "--reuse"], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "V1: not finished (no summary.json): continuing it from" in r.stdout
+    r2 = subprocess.run(tool + ["--out", str(whole)], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r2.returncode == 0, r2.stdout + r2.stderr
+    with open(run_dir / "summary.json") as f:
+        summ = json.load(f)
+    assert summ["status"] == "ok" and summ["restarted_from"].endswith("checkpoint.h5")
+    assert summ["run_wall_time_s"] > carried and summ["wall_time_s"] > 0
+    assert (run_dir / "monitors.csv").read_bytes() == (whole / "V1_dx0.03" / "monitors.csv").read_bytes()
+    # the table's elapsed time is the whole run's
+    res = vv.load_result(vv.Job(vv.PAPER[1], 0.03, str(run_dir), [], {}, source="ran"))
+    assert res.wall == summ["run_wall_time_s"]
+    # a third call reuses the finished run
+    r3 = subprocess.run(tool + ["--out", str(cut), "--reuse"], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r3.returncode == 0 and "V1: reused" in r3.stdout
+
+
+def test_run_wall_time_of_summaries():
+    # one piece: its wall time; continued: the run's over all pieces; continued from a checkpoint
+    # that did not record it (an older build): unknown, not the last piece's
+    assert mt.run_wall_time({"wall_time_s": 12.0}) == 12.0
+    assert mt.run_wall_time({"wall_time_s": 12.0, "run_wall_time_s": 11.5}) == 11.5
+    summ = {"wall_time_s": 12.0, "run_wall_time_s": math.nan, "restarted_from": "c.h5", "particles": 10, "steps": 5}
+    assert math.isnan(mt.run_wall_time(summ)) and math.isnan(mt.run_particle_steps_per_s(summ))
+    summ["run_wall_time_s"] = 25.0
+    assert mt.run_particle_steps_per_s(summ) == 2.0

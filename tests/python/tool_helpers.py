@@ -1,0 +1,32 @@
+"""Helpers for the tests of the tools/ validation scripts that run mixsph."""
+
+import os
+import signal
+import subprocess
+import sys
+import time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(ROOT, "tools"))
+import mixsph_tools as mt  # noqa: E402
+
+ENV = dict(os.environ, OMP_WAIT_POLICY="passive")   # the tests share the cores
+
+
+def cut_off(cmd, run_dir, t_min, timeout=240):
+    """Start a script (cmd) and kill it and its mixsph with SIGKILL, as the end of a session does,
+    once run_dir holds a checkpoint and monitors.csv has reached t_min. Returns the run's
+    time up to its last checkpoint (the checkpoint's ``run_wall_time_s``)."""
+    import h5py
+    p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=ENV, start_new_session=True)
+    ckpt = os.path.join(run_dir, "checkpoint.h5")
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and p.poll() is None and not (
+            os.path.exists(ckpt) and mt.last_time(os.path.join(run_dir, "monitors.csv")) >= t_min):
+        time.sleep(0.05)
+    os.killpg(p.pid, signal.SIGKILL)
+    p.wait()
+    assert p.returncode == -signal.SIGKILL, "the run ended before it could be cut off"
+    assert not os.path.exists(os.path.join(run_dir, "summary.json"))
+    with h5py.File(ckpt, "r") as f:
+        return float(f.attrs["run_wall_time_s"])
