@@ -89,13 +89,32 @@ enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, O_KE_WATER, N
 static const char *const out_names[N_OUTS] = {"run_up",         "landslide_front", "kinetic_energy",      "dt",
                                               "lost_particles", "fixed_particles", "run_up_Z", "water_kinetic_energy"};
 
+/* Boolean parameters: passed to the case as 0/1 overrides of `key` when the host sets them. */
+enum { B_SATURATED, B_TENSION_CUTOFF, N_BOOL_PARAMS };
+static const struct {
+    fmi2ValueReference vr;
+    const char *name, *key;
+    int start;
+} bool_params[N_BOOL_PARAMS] = {
+    {VR_saturated, "saturated", "parameters.saturated", START_saturated},
+    {VR_tension_cutoff, "tension_cutoff", "parameters.tension_cutoff", START_tension_cutoff},
+};
+
+/* The Boolean parameter of value reference vr, or -1. */
+static int bool_param(fmi2ValueReference vr)
+{
+    for (int k = 0; k < N_BOOL_PARAMS; k++)
+        if (bool_params[k].vr == vr) return k;
+    return -1;
+}
+
 enum mode { MODE_INSTANTIATED, MODE_INIT, MODE_STEP, MODE_TERMINATED, MODE_ERROR };
 
 /* The instance's settings: what a saved FMU state carries besides the library state. */
 struct settings {
     double real[N_REAL_PARAMS];
     int real_set[N_REAL_PARAMS]; /* set by the host: passed to the case as an override */
-    int saturated, saturated_set;
+    int flag[N_BOOL_PARAMS], flag_set[N_BOOL_PARAMS]; /* Boolean parameters (bool_params) */
     int threads;
     char case_file[FMU_PATH_LEN];
     double push_velocity; /* [m/s] along the plate's direction of travel */
@@ -251,7 +270,7 @@ static void settings_default(struct settings *s)
 {
     memset(s, 0, sizeof *s);
     for (int k = 0; k < N_REAL_PARAMS; k++) s->real[k] = real_params[k].start;
-    s->saturated = START_saturated;
+    for (int k = 0; k < N_BOOL_PARAMS; k++) s->flag[k] = bool_params[k].start;
     s->threads = START_threads;
     snprintf(s->case_file, sizeof s->case_file, "%s", START_case_file);
     s->push_velocity = START_push_velocity;
@@ -266,7 +285,8 @@ static size_t settings_overrides(const struct settings *s, mixsph_override *ov, 
         if (!s->real_set[k]) continue;
         for (int j = 0; real_param_keys[k][j] && n < cap; j++) ov[n++] = (mixsph_override){real_param_keys[k][j], s->real[k]};
     }
-    if (s->saturated_set && n < cap) ov[n++] = (mixsph_override){"parameters.saturated", s->saturated ? 1.0 : 0.0};
+    for (int k = 0; k < N_BOOL_PARAMS; k++)
+        if (s->flag_set[k] && n < cap) ov[n++] = (mixsph_override){bool_params[k].key, s->flag[k] ? 1.0 : 0.0};
     /* Landslide kinematics: the plate's law v(t) becomes speed_scale v(t / time_scale); the
      * duration scales with time_scale, the stroke with speed_scale time_scale. */
     if ((s->real_set[P_PLATE_DURATION_SCALE] || s->real_set[P_PLATE_STROKE_SCALE]) && n + 2 <= cap) {
@@ -601,7 +621,8 @@ fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (!check(in, "fmi2GetBoolean", M_ANY)) return fmi2Error;
     if (nvr > 0 && (!vr || !value)) return reject(in, "fmi2GetBoolean: NULL array");
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == VR_saturated) value[i] = in->set.saturated ? fmi2True : fmi2False;
+        const int b = bool_param(vr[i]);
+        if (b >= 0) value[i] = in->set.flag[b] ? fmi2True : fmi2False;
         else if (vr[i] == VR_push_external) value[i] = in->set.push_external ? fmi2True : fmi2False;
         else return reject(in, "fmi2GetBoolean: no Boolean variable with value reference %u", vr[i]);
     }
@@ -684,10 +705,11 @@ fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t
     if (!check(in, "fmi2SetBoolean", M_ALIVE)) return fmi2Error;
     if (nvr > 0 && (!vr || !value)) return reject(in, "fmi2SetBoolean: NULL array");
     for (size_t i = 0; i < nvr; i++) {
-        if (vr[i] == VR_saturated) {
-            if (param_settable(in, "saturated") != fmi2OK) return fmi2Error;
-            in->set.saturated = value[i] ? 1 : 0;
-            in->set.saturated_set = 1;
+        const int b = bool_param(vr[i]);
+        if (b >= 0) {
+            if (param_settable(in, bool_params[b].name) != fmi2OK) return fmi2Error;
+            in->set.flag[b] = value[i] ? 1 : 0;
+            in->set.flag_set[b] = 1;
         } else if (vr[i] == VR_push_external) {
             in->set.push_external = value[i] ? 1 : 0;
             if (in->mode == MODE_STEP && apply_push(in) != fmi2OK) return fmi2Error;

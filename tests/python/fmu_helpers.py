@@ -31,6 +31,7 @@ CASE_KEYS = {
     "mu_thr": ["parameters.mu_thr"],
     "dx": ["numerics.dx"],
     "output_interval": ["output.monitor_interval"],
+    "tension_cutoff": ["parameters.tension_cutoff"],
 }
 
 ENV = {"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}
@@ -145,7 +146,7 @@ def run_mixsph(overrides, out_dir, t_end=None):
     cmd = [str(MIXSPH), "run", str(CASE), "--threads", "1", "--quiet", "--out", str(out_dir)]
     for name, value in overrides.items():
         for key in CASE_KEYS[name]:
-            cmd += ["--set", f"{key}={value!r}"]
+            cmd += ["--set", f"{key}={int(value) if isinstance(value, bool) else value!r}"]
     if t_end is not None:
         cmd += ["--set", f"numerics.t_end={t_end!r}"]
     subprocess.run(cmd, check=True, env={**os.environ, **ENV}, stdout=subprocess.DEVNULL)
