@@ -113,3 +113,12 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     with open(cut / "erosive_table.csv") as f:
         row = next(csv.DictReader(f))
     assert math.isclose(float(row["wall_time_s"]), summ["run_wall_time_s"], rel_tol=1e-5)   # 6 digits in the CSV
+
+
+def test_bad_checkpoint_interval_is_refused_before_any_run(tmp_path):
+    import subprocess
+    for tool in ("erosive_dambreak.py", "vajont_validate.py"):
+        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool), "--checkpoint-every", "-1",
+                            "--out", str(tmp_path / tool)], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and "--checkpoint-every must be a number of seconds >= 0" in r.stderr, r.stderr
+        assert not (tmp_path / tool).exists()
