@@ -4,7 +4,8 @@
     mon = mt.read_monitors("out/x/monitors.csv")        # {"t": array, "water_front": array, ...}
     summ = mt.read_summary("out/x/summary.json")        # dict; JSON null -> nan in "outputs"
     prof = mt.find_profile("out/x", "interface", 0.5)   # Profile or None (not written)
-    t, snap = mt.read_snapshot("out/x/snap_0003.csv")  # (time, {"x": array, ...})
+    t, snap = mt.read_snapshot("out/x/snap_0003.csv")  # (time, {"x": array, ...}); list_snapshots
+                                                        # gives run.h5 snapshots of --no-csv runs
 
 Every reader raises ``ToolError`` with a message naming the file and what is wrong; the scripts
 catch it and print it (no traceback for a user's mistake).
@@ -167,17 +168,58 @@ def snapshot_time(path):
     return float(m.group(1))
 
 
+H5_REF = "::"   # a snapshot in run.h5: "<folder>/run.h5::<group name under /snapshots>"
+
+
 def list_snapshots(outdir):
-    """[(t, path)] of the snap_NNNN.csv files of an output folder, by time."""
+    """[(t, ref)] of the snapshots of an output folder, by time: its snap_NNNN.csv files (ref: the
+    path), or, when it has none (a run with ``--no-csv``), the complete snapshots of its run.h5
+    (ref: ``<folder>/run.h5::<group>``). ``read_snapshot`` reads either."""
     snaps = []
     for path in glob.glob(os.path.join(glob.escape(outdir), "snap_*.csv")):
         if re.fullmatch(r"snap_\d+\.csv", os.path.basename(path)):
             snaps.append((snapshot_time(path), path))
+    if not snaps and os.path.isfile(os.path.join(outdir, "run.h5")):
+        snaps = _h5_snapshots(os.path.join(outdir, "run.h5"))
     return sorted(snaps)
 
 
+def _h5_snapshots(path):
+    """[(t, ref)] of the complete snapshots of a run.h5 (a group with its time and positions)."""
+    import h5py
+    try:
+        with h5py.File(path, "r", locking=False) as f:
+            groups = f.get("snapshots")
+            if groups is None:
+                return []
+            return [(float(g.attrs["time"]), f"{path}{H5_REF}{name}") for name, g in groups.items()
+                    if "time" in g.attrs and all(d in g for d in ("position", "velocity", "state"))]
+    except (OSError, KeyError) as e:
+        raise ToolError(f"{path}: cannot read its snapshots: {e}") from None
+
+
+def _read_h5_snapshot(ref):
+    """(t, {column: array}) of a run.h5 snapshot, the columns of the CSV snapshots."""
+    import h5py
+    path, name = ref.split(H5_REF, 1)
+    try:
+        with h5py.File(path, "r", locking=False) as f:
+            g = f["snapshots"][name]
+            pos, vel = g["position"][()], g["velocity"][()]
+            cols = {"id": g["id"][()], "x": pos[:, 0], "z": pos[:, 1], "vx": vel[:, 0], "vz": vel[:, 1],
+                    "rho": g["density"][()], "p": g["pressure"][()], "mu": g["viscosity"][()],
+                    "medium": g["medium"][()], "state": g["state"][()]}
+            t = float(g.attrs["time"])
+    except (OSError, KeyError) as e:
+        raise ToolError(f"{path}: cannot read snapshot {name}: {e}") from None
+    return t, {k: np.asarray(v, dtype=float) for k, v in cols.items()}
+
+
 def read_snapshot(path):
-    """(t, {column: array}) of one snap_NNNN.csv (columns id,x,z,vx,vz,rho,p,mu,medium,state)."""
+    """(t, {column: array}) of one snapshot of list_snapshots: a snap_NNNN.csv (columns
+    id,x,z,vx,vz,rho,p,mu,medium,state) or a run.h5 snapshot (the same columns)."""
+    if H5_REF in path:
+        return _read_h5_snapshot(path)
     t = snapshot_time(path)
     with open(path) as f:
         f.readline()

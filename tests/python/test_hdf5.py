@@ -355,3 +355,23 @@ def test_plot_snapshot_png_and_gif(ref, tmp_path):
     from PIL import Image
     with Image.open(gif) as im:
         assert im.format == "GIF" and im.n_frames == 5
+
+
+def test_tools_read_the_snapshots_of_a_run_without_csv(full, tmp_path):
+    # tools/mixsph_tools.py: a folder without snap_NNNN.csv (a --no-csv run) gives its run.h5
+    # snapshots, with the CSV snapshots' columns and values (the CSV prints 6-7 significant digits)
+    sys.path.insert(0, str(ROOT / "tools"))
+    import mixsph_tools as mt
+    h5only = tmp_path / "h5only"
+    h5only.mkdir()
+    shutil.copy(full / "run.h5", h5only / "run.h5")
+    csv_snaps, h5_snaps = mt.list_snapshots(str(full)), mt.list_snapshots(str(h5only))
+    assert len(csv_snaps) == len(h5_snaps) >= 10
+    for (tc, refc), (th, refh) in zip(csv_snaps, h5_snaps):
+        assert refh.endswith(".h5" + mt.H5_REF + refh.split(mt.H5_REF)[1]) and math.isclose(tc, th, rel_tol=1e-8)
+        _, c = mt.read_snapshot(refc)
+        _, h = mt.read_snapshot(refh)
+        order = np.argsort(c["id"])    # CSV rows in memory order, run.h5 rows by id
+        assert set(h) == set(c)
+        for k in c:
+            assert np.allclose(c[k][order], h[k], rtol=1e-5, atol=1e-9), k
