@@ -97,9 +97,9 @@ double mixsph_sim_dt(const mixsph_sim *s);        /**< last time step [s] */
 uint64_t mixsph_sim_steps(const mixsph_sim *s);   /**< steps taken */
 /** Wall-clock seconds this run has spent in mixsph_sim_step (and so advance_to), the outputs due at
  *  the case's intervals and the checkpoints written included: this process's time plus, after a
- *  restart from a checkpoint,
- *  the run's time up to that checkpoint (carried by it; NaN when the checkpoint was written by a
- *  build that did not record it). mixsph_sim_load_state leaves it alone (it is not physics). */
+ *  restart from a checkpoint, the run's time up to that checkpoint (carried by it; NaN when the
+ *  checkpoint was written by a build that did not record it). mixsph_sim_load_state leaves it
+ *  alone (it is not physics). */
 double mixsph_sim_run_wall_time(const mixsph_sim *s);
 size_t mixsph_sim_particles(const mixsph_sim *s); /**< fluid + granular particles */
 size_t mixsph_sim_wall_particles(const mixsph_sim *s);

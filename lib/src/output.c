@@ -92,7 +92,6 @@ struct output {
 
 enum { T_CSV = 0, T_HDF5 = 1, T_CKPT = 2 };
 
-
 /* ---- HDF5 errors: never printed, the innermost message kept -------------------------------- */
 
 struct quiet {
