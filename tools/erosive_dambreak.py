@@ -178,11 +178,6 @@ STAMP = "erosive_run.json"
 STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case")
 
 
-def reusable(job, t_end):
-    """(True, why) when OUT/run<k>_dx<D> already holds this run, finished ok."""
-    return mt.reusable(job.outdir, job.stamp, STAMP, STAMP_KEYS, t_end, T_TOL)
-
-
 def run_jobs(jobs, n_parallel, t_end, progress_every):
     """Run the jobs, at most n_parallel at once; a failed run does not stop the others, except
     for bad usage or input (exit 2), which would repeat. Returns the failed jobs."""
@@ -670,19 +665,9 @@ def main():
 
     to_run = []
     for job in jobs:
-        if args.reuse:
-            ok, why = reusable(job, t_end)
-            if ok:
-                job.source = "reused"
-                print(f"run {job.paper.run}: reused {show(job.outdir)}/ ({why})")
-                continue
-            ckpt, why_not = mt.resumable(job.outdir, job.stamp, STAMP, STAMP_KEYS)
-            if ckpt:
-                job.checkpoint = ckpt
-                job.cmd = mt.restart_command(mixsph, ckpt, threads, args.checkpoint_every)
-                print(f"run {job.paper.run}: not finished ({why}): continuing it from {show(ckpt)}")
-            elif os.path.isdir(job.outdir):
-                print(f"run {job.paper.run}: not reused ({why}; not continued: {why_not}): running it again")
+        if args.reuse and not mt.plan_reuse(job, f"run {job.paper.run}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
+                                            threads, args.checkpoint_every):
+            continue
         to_run.append(job)
     if to_run:
         print(f"{len(to_run)} run(s) of {show(case)} at dx = {args.dx:g} m to t = {t_end:g} s, "

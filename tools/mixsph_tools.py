@@ -340,6 +340,27 @@ def resumable(outdir, stamp, stamp_name, keys):
     return ckpt, "an unfinished run of the same settings left a checkpoint"
 
 
+def plan_reuse(job, label, stamp_name, keys, t_end, t_tol, mixsph, threads, checkpoint_every):
+    """The --reuse decision of a script's run ``job`` (with outdir, stamp, cmd, source,
+    checkpoint), printed under ``label``: a finished run of the same settings is kept
+    (job.source = "reused"; returns False, nothing to run); an unfinished one that left a
+    checkpoint is continued (job.checkpoint set, job.cmd its ``mixsph run --restart``); else the
+    run starts afresh. Returns True when the job is to be run."""
+    ok, why = reusable(job.outdir, job.stamp, stamp_name, keys, t_end, t_tol)
+    if ok:
+        job.source = "reused"
+        print(f"{label}: reused {show(job.outdir)}/ ({why})")
+        return False
+    ckpt, why_not = resumable(job.outdir, job.stamp, stamp_name, keys)
+    if ckpt:
+        job.checkpoint = ckpt
+        job.cmd = restart_command(mixsph, ckpt, threads, checkpoint_every)
+        print(f"{label}: not finished ({why}): continuing it from {show(ckpt)}")
+    elif os.path.isdir(job.outdir):
+        print(f"{label}: not reused ({why}; not continued: {why_not}): running it again")
+    return True
+
+
 def launch(outdir, stamp_name, stamp, cmd, checkpoint=None):
     """Start ``mixsph run`` for a script's run in outdir, its output in outdir/mixsph.log.
     Fresh (checkpoint None): the folder is cleaned and the stamp written, then ``cmd`` runs.

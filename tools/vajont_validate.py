@@ -148,11 +148,6 @@ class Job:
     checkpoint: str = None  # continue this unfinished run's checkpoint (cmd is then its restart)
 
 
-def reusable(job, t_end):
-    """(True, why) when job.outdir already holds this run, finished ok."""
-    return mt.reusable(job.outdir, job.stamp, STAMP, STAMP_KEYS, t_end, T_TOL)
-
-
 def run_job(job, t_end, progress_every):
     """Run one job to completion. Returns the exit code of mixsph."""
     t0 = time.monotonic()
@@ -691,19 +686,9 @@ def main():
     signal.signal(signal.SIGTERM, on_sigterm)
     failed = []
     for job in jobs:
-        if args.reuse:
-            ok, why = reusable(job, t_end)
-            if ok:
-                job.source = "reused"
-                print(f"V{job.paper.run}: reused {show(job.outdir)}/ ({why})")
-                continue
-            ckpt, why_not = mt.resumable(job.outdir, job.stamp, STAMP, STAMP_KEYS)
-            if ckpt:
-                job.checkpoint = ckpt
-                job.cmd = mt.restart_command(mixsph, ckpt, threads, args.checkpoint_every)
-                print(f"V{job.paper.run}: not finished ({why}): continuing it from {show(ckpt)}")
-            elif os.path.isdir(job.outdir):
-                print(f"V{job.paper.run}: not reused ({why}; not continued: {why_not}): running it again")
+        if args.reuse and not mt.plan_reuse(job, f"V{job.paper.run}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
+                                            threads, args.checkpoint_every):
+            continue
         rc = run_job(job, t_end, args.progress)
         if rc != 0:
             failed.append(job)
