@@ -32,10 +32,13 @@
  * threads: results are bit-identical for any thread count.
  *
  * Two passes per step: continuity (with the newest velocities) before the EOS, momentum after;
- * see integrate.c for why. With granular media the velocity gradient of each grain (for its
+ * see integrate.c for why. Both run at the same positions over the same ranges, so the
+ * continuity pass stores the kernel factor F of every lane and the momentum pass reads it
+ * (fcache_layout below). With granular media the velocity gradient of each grain (for its
  * strain rate) is gathered right after the continuity pass, over its gather ranges (all its
  * neighbours, three contiguous ranges). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "sim.h"
@@ -59,6 +62,8 @@
 struct pair_ctx {
     double inv_h, f_fac, eta2, r2max;
     int wendland;
+    double *fk;           /* the kernel-factor cache (see forces_continuity), or NULL */
+    const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
 };
 
 static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
@@ -68,6 +73,8 @@ static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
     X->eta2 = 0.01 * s->h * s->h;
     X->r2max = s->K.r2max;
     X->wendland = s->K.type == KERNEL_WENDLAND_C2;
+    X->fk = NULL;
+    X->fk_off = NULL;
 }
 
 /* F(r) of kernel.h without branches: 0 beyond 2h. `wendland` is a compile-time constant in each
@@ -104,7 +111,8 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * particle: one set of lane sums, reduced once): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
  * and same-medium neighbour counts. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                    const uint32_t *restrict rng, int nr, double *di, double *ni, const int wendland)
+                                    const uint32_t *restrict rng, int nr, double *di, double *ni,
+                                    double *restrict fk, const int wendland, const int store)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
@@ -122,8 +130,10 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             const double in = FORCES_LANE_IN(k, m);
             const double rx = xi - x[j], rz = zi - z[j];
             const double r2 = rx * rx + rz * rz;
-            const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * pair_f(&Xl, r2, wendland) * in;
+            const double F = pair_f(&Xl, r2, wendland) * in;
+            const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * F;
             const double c = (r2 < Xl.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
+            if (store) fk[k] = F;
             acc[k] += vol[j] * uf;
             cnt[k] += c;
             dj[k] = voli * uf;
@@ -131,6 +141,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
         }
         chunk_add(P->drho, jb, m, dj);
         chunk_add(P->ax, jb, m, cj); /* ax holds neighbour counts in this pass */
+        if (store) fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *di += acc[k];
@@ -178,7 +189,8 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
  * i and subtracted from j (ax, az hold forces during the pass; forces_compute divides by the
  * masses after it). */
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                  const uint32_t *restrict rng, int nr, double *axi, double *azi, const int wendland)
+                                  const uint32_t *restrict rng, int nr, double *axi, double *azi,
+                                  const double *restrict fk, const int wendland, const int cached)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
@@ -200,7 +212,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double in = FORCES_LANE_IN(k, n);
             const double rx = xi - x[j], rz = zi - z[j];
             const double r2 = rx * rx + rz * rz;
-            const double F = pair_f(&Xl, r2, wendland) * in;
+            const double F = cached ? fk[k] : pair_f(&Xl, r2, wendland) * in;
             const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
             /* one division for 1 / (r^2 + eta^2) and 1 / (mu_i + mu_j) (a wall takes the
              * viscosity of the particle it meets; mu_i + mu_j > 0 but for wall-wall pairs,
@@ -231,6 +243,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         }
         chunk_add(P->ax, jb, n, ajx);
         chunk_add(P->az, jb, n, ajz);
+        if (cached) fk += FORCES_CHUNK;
     }
     double tx = 0.0, tz = 0.0;
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -243,11 +256,11 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
 
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
 FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                   size_t b0, size_t b1, const int wendland)
+                                   size_t b0, size_t b1, const int wendland, const int store)
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0;
-        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, wendland);
+        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, store ? X->fk + X->fk_off[i] : NULL, wendland, store);
         P->drho[i] += di;
         P->ax[i] += ni;
     }
@@ -270,11 +283,11 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                 size_t b0, size_t b1, const int wendland)
+                                 size_t b0, size_t b1, const int wendland, const int cached)
 {
     for (size_t i = b0; i < b1; i++) {
         double sx = 0.0, sz = 0.0;
-        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, wendland);
+        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL, wendland, cached);
         P->ax[i] += sx;
         P->az[i] += sz;
     }
@@ -284,16 +297,60 @@ FORCES_CLONES
 static void continuity_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                             size_t b0, size_t b1)
 {
-    if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1);
-    else continuity_walk(X, NB, P, b0, b1, 0);
+    if (X->fk) {
+        if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1, 1);
+        else continuity_walk(X, NB, P, b0, b1, 0, 1);
+    } else {
+        if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1, 0);
+        else continuity_walk(X, NB, P, b0, b1, 0, 0);
+    }
 }
 
 FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1);
-    else momentum_walk(X, NB, P, b0, b1, 0);
+    if (X->fk) {
+        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1);
+        else momentum_walk(X, NB, P, b0, b1, 0, 1);
+    } else {
+        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 0);
+        else momentum_walk(X, NB, P, b0, b1, 0, 0);
+    }
+}
+
+/* The kernel-factor cache: the continuity pass stores F(r_ij) of every lane it evaluates (masked
+ * lanes 0), and the momentum pass of the same step, at the same positions and over the same
+ * ranges, reads it instead of evaluating the kernel again (a square root and, for the cubic
+ * spline, a division per lane): the same numbers, so results are unchanged. Lanes of particle i
+ * start at fk_off[i], FORCES_CHUNK per chunk of each of its two ranges. Returns -1 if the cache
+ * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
+static int fcache_layout(mixsph_sim *s, size_t n)
+{
+    if (s->fk_off_cap < n + 1) {
+        size_t *o = realloc(s->fk_off, (n + 1) * sizeof *o);
+        if (!o) return -1;
+        s->fk_off = o;
+        s->fk_off_cap = n + 1;
+    }
+    const uint32_t *rng = s->NB.rng;
+    size_t total = 0;
+    for (size_t i = 0; i < n; i++) {
+        s->fk_off[i] = total;
+        for (int r = 0; r < 2; r++) {
+            const size_t len = rng[4 * i + 2 * r + 1] - rng[4 * i + 2 * r];
+            total += (len + FORCES_CHUNK - 1) / FORCES_CHUNK * FORCES_CHUNK;
+        }
+    }
+    s->fk_off[n] = total;
+    if (s->fk_cap < total) {
+        const size_t cap = total + total / 4 + FORCES_CHUNK;
+        free(s->fk);
+        s->fk = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
+        s->fk_cap = s->fk ? cap : 0;
+        if (!s->fk) return -1;
+    }
+    return 0;
 }
 
 typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, struct particles *restrict, size_t, size_t);
@@ -326,6 +383,11 @@ int forces_continuity(mixsph_sim *s)
     const size_t n = s->C.start[s->C.ncell];
     memset(P->drho, 0, n * sizeof(double));
     memset(P->ax, 0, n * sizeof(double));
+    s->fk_valid = fcache_layout(s, n) == 0;
+    if (s->fk_valid) {
+        X.fk = s->fk;
+        X.fk_off = s->fk_off;
+    }
     for_bands(s, continuity_band, &X);
     if (s->has_granular) {
         const struct medium *M = s->cfg.media;
@@ -356,6 +418,11 @@ int forces_compute(mixsph_sim *s)
     const size_t n = s->C.start[s->C.ncell];
     memset(P->ax, 0, n * sizeof(double));
     memset(P->az, 0, n * sizeof(double));
+    if (s->fk_valid) { /* the continuity pass of this step filled it, at these positions */
+        X.fk = s->fk;
+        X.fk_off = s->fk_off;
+    }
+    s->fk_valid = 0;
     for_bands(s, momentum_band, &X);
     const double g = s->cfg.g;
     int bad = 0;
@@ -378,12 +445,12 @@ void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double 
     const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
     double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, X.wendland);
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, X.wendland, 0);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
     P->az[j] = save[1];
-    continuity_range(&X, P, i, pair, 1, &di, &ni, X.wendland);
+    continuity_range(&X, P, i, pair, 1, &di, &ni, NULL, X.wendland, 0);
     *drho = P->rho[i] * di;
     P->ax[j] = save[0];
     P->drho[j] = save[2];

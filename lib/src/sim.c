@@ -287,6 +287,8 @@ void mixsph_sim_destroy(mixsph_sim *s)
     neighbours_free(&s->NB);
     neighbours_gather_free(&s->G);
     free(s->near_wall);
+    free(s->fk);
+    free(s->fk_off);
     case_free(&s->cfg);
     for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
     free(s->ov_key);

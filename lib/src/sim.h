@@ -58,6 +58,9 @@ struct mixsph_sim {
     struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
     struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
+    double *fk;                   /* kernel factors of the pair lanes, continuity -> momentum pass (forces.c) */
+    size_t *fk_off, fk_cap, fk_off_cap;
+    int fk_valid;                 /* fk holds this step's factors (set by the continuity pass, used once) */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
     int has_granular;             /* any granular medium: strain rates and regimes every step */

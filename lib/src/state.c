@@ -277,6 +277,7 @@ int state_same_case(const mixsph_sim *s, const char *text, const char *const *ke
 /* Cells and neighbour lists from the build positions (the particles are in their build order). */
 static mixsph_status state_relist(mixsph_sim *s)
 {
+    s->fk_valid = 0;
     if (cells_index(&s->C, &s->P, s->NB.x0, s->NB.z0) != 0 ||
         neighbours_relist(&s->NB, &s->C, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particles not in cell order (or out of memory)");
