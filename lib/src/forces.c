@@ -293,30 +293,27 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
     }
 }
 
+/* Call walk(X, ..., wendland, cached) with both flags as constants: one inlined copy of the walk
+ * per kernel and per use of the kernel-factor cache. */
+#define FORCES_DISPATCH(walk, X, ...)                                        \
+    do {                                                                     \
+        const int c_ = (X)->fk != NULL;                                      \
+        if ((X)->wendland) c_ ? walk(X, __VA_ARGS__, 1, 1) : walk(X, __VA_ARGS__, 1, 0); \
+        else c_ ? walk(X, __VA_ARGS__, 0, 1) : walk(X, __VA_ARGS__, 0, 0);   \
+    } while (0)
+
 FORCES_CLONES
 static void continuity_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                             size_t b0, size_t b1)
 {
-    if (X->fk) {
-        if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1, 1);
-        else continuity_walk(X, NB, P, b0, b1, 0, 1);
-    } else {
-        if (X->wendland) continuity_walk(X, NB, P, b0, b1, 1, 0);
-        else continuity_walk(X, NB, P, b0, b1, 0, 0);
-    }
+    FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1);
 }
 
 FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    if (X->fk) {
-        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1);
-        else momentum_walk(X, NB, P, b0, b1, 0, 1);
-    } else {
-        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 0);
-        else momentum_walk(X, NB, P, b0, b1, 0, 0);
-    }
+    FORCES_DISPATCH(momentum_walk, X, NB, P, b0, b1);
 }
 
 /* The kernel-factor cache: the continuity pass stores F(r_ij) of every lane it evaluates (masked
