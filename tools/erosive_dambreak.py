@@ -33,7 +33,8 @@ Printed table, one row per run, ours beside the paper's:
 - wall time of the run (summary.json ``run_wall_time_s``: over all its pieces when it was
   continued from checkpoints) and the paper's total elapsed time;
 - saving versus the reference run, 100 (1 - wall / wall_ref), ours and the paper's (Run 6 vs
-  Run 2: 71 %; Run 2 vs Run 4: 69 %);
+  Run 2: 71 %; Run 2 vs Run 4: 69 %), and ours by steps, 100 (1 - steps / steps_ref), which
+  does not depend on the machine's load (a step costs the same in every run of one resolution);
 - interface error versus the reference run, ours and the paper's "aver. err.": the mean, over the
   0.01 m bins of the interface profile (top of the sediment, i.e. the mixture-water interface) at
   t = 0.5 s with bin centre x <= 0.25 m (near the left corner, where the paper compares), of
@@ -158,6 +159,7 @@ class Result:
     threads: int = 0
     sim_time: float = math.nan
     wall: float = math.nan
+    steps: float = math.nan      # time steps of the whole run (all its pieces)
     psteps: float = math.nan
     rise: float = math.nan
     rise_t: float = math.nan
@@ -273,6 +275,7 @@ def load_result(job, at, dx, sediment):
     r.threads = int(summ.get("threads") or 0)
     r.sim_time = float(summ.get("simulated_time_s") or math.nan)
     r.wall = mt.run_wall_time(summ)
+    r.steps = float(summ.get("steps") or math.nan)
     r.psteps = mt.run_particle_steps_per_s(summ)
     r.rise = mt.summary_value(summ, "bedload_rise_left_wall", "max")
     r.rise_t = mt.summary_value(summ, "bedload_rise_left_wall", "t_max")
@@ -344,14 +347,17 @@ def compare(results, at):
             c["saving"] = c["err"] = "(reference)"
             c["paper_saving"] = c["paper_err"] = "(ref)"
             c["err_frac"] = "(reference)"
-            c.update(saving_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0, err_frac_v=math.nan)
+            c["saving_steps"] = "(reference)"
+            c.update(saving_v=math.nan, saving_steps_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0,
+                     err_frac_v=math.nan)
             continue
         c["ref"] = str(p.ref)
         paper_ref = PAPER[p.ref]
         c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / paper_ref.elapsed_s)
         c["paper_saving"] = f"{c['paper_saving_v']:.0f}"
         c["paper_err"] = fmt(p.err_percent, ".2f", "-")
-        c["saving_v"] = c["err_v"] = c["err_frac_v"] = math.nan
+        c["saving_v"] = c["saving_steps_v"] = c["err_v"] = c["err_frac_v"] = math.nan
+        c["saving_steps"] = "n/a"
         c["err_bins"] = 0
         c["err_frac"] = "n/a"
         ref = by_run.get(p.ref)
@@ -370,6 +376,9 @@ def compare(results, at):
             c["saving"] = f"{c['saving_v']:.0f}"
         else:
             c["saving"] = "n/a"
+        if math.isfinite(r.steps) and math.isfinite(ref.steps) and ref.steps > 0:
+            c["saving_steps_v"] = 100.0 * (1.0 - r.steps / ref.steps)
+            c["saving_steps"] = f"{c['saving_steps_v']:.0f}"
         if r.interface is None:
             c["err"] = f"n/a (no profile at t={at:g} s)"
         elif ref.interface is None:
@@ -432,7 +441,8 @@ def table(results, at, dx, t_end, threads_note):
     cols = [
         ("", "run", ">"), ("", "mu_thr", ">"), ("", "mu0", ">"), ("", "status", "<"),
         ("wall time [s]", "mixsph", ">"), ("wall time [s]", "paper", ">"),
-        ("saving vs ref [%]", "ref", ">"), ("saving vs ref [%]", "mixsph", ">"), ("saving vs ref [%]", "paper", ">"),
+        ("saving vs ref [%]", "ref", ">"), ("saving vs ref [%]", "mixsph", ">"), ("saving vs ref [%]", "steps", ">"),
+        ("saving vs ref [%]", "paper", ">"),
         (f"interface err [%], t={at:g} s", "mixsph", ">"), (f"interface err [%], t={at:g} s", "f=0.5", ">"),
         (f"interface err [%], t={at:g} s", "paper", ">"),
         ("bed-load rise, wall", "max [m]", ">"), ("bed-load rise, wall", "t [s]", ">"),
@@ -448,13 +458,13 @@ def table(results, at, dx, t_end, threads_note):
         rows.append([
             str(p.run), p.label_thr, p.label_mu0, status,
             fmt(r.wall, ".1f"), f"{p.elapsed_s:,.0f}",
-            c["ref"], c["saving"], c["paper_saving"],
+            c["ref"], c["saving"], c["saving_steps"], c["paper_saving"],
             c["err"], c["err_frac"], c["paper_err"],
             fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
             fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
             fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"),
         ])
-    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "",
+    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "", "",
                  f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}"]
     print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
           f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
@@ -466,7 +476,9 @@ def table(results, at, dx, t_end, threads_note):
     print("               reference Run 4 for Runs 1-3, Run 2 for Runs 5-7 (the paper's 'aver. err.');")
     print("               f=0.5: the same with z = 0.5 iso-line of the sediment fraction (from the snapshot at that time;")
     print("               lifted grains do not count; n/a without the snapshot).")
-    print("saving:        100 (1 - wall / wall of the reference run), the paper's from its elapsed times.")
+    print("saving:        100 (1 - wall / wall of the reference run), the paper's from its elapsed times;")
+    print("               steps: 100 (1 - steps / steps of the reference run), which the machine's load does not change")
+    print("               (a step costs the same in every run of one resolution).")
     print(f"bed-load rise: max over the run of the top of the sediment within x < 0.02 m "
           f"(paper: ~{PAPER_BEDLOAD_RISE:g} m for the converged runs).")
     print(f"water at wall: first monitor sample with water_front < {WALL_REACH_X:g} m "
@@ -481,7 +493,7 @@ def write_csv(path, results, dx, t_end, at):
               "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
               "paper_err_percent",
               "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
-              "water_at_left_wall_t_s", "outdir"]
+              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent"]
 
     def v(x):
         if isinstance(x, float):
@@ -498,7 +510,8 @@ def write_csv(path, results, dx, t_end, at):
                 r.sim_time, r.wall, r.psteps, float(p.elapsed_s),
                 p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
                 at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
-                r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir)])
+                r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir,
+                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"])])
 
 
 # ---- figure ---------------------------------------------------------------------------------------

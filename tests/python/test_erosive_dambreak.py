@@ -83,6 +83,20 @@ def test_interface_error_skips_empty_and_far_bins():
     assert n == 1 and abs(err - 10.0) < 1e-9
 
 
+def test_savings_by_wall_time_and_by_steps_against_the_reference_run():
+    # Reference: Run 2 for Run 6 (the paper's Table 2); saving = 100 (1 - x / x_ref) for the wall
+    # time and for the steps (exact arithmetic on these numbers).
+    r2 = ed.Result(paper=ed.PAPER[2], outdir="", source="ran", status="ok", wall=100.0, steps=400.0)
+    r6 = ed.Result(paper=ed.PAPER[6], outdir="", source="ran", status="ok", wall=50.0, steps=100.0)
+    ed.compare([r2, r6], 0.5)
+    assert r6.cells["saving_v"] == 50.0 and r6.cells["saving"] == "50"
+    assert r6.cells["saving_steps_v"] == 75.0 and r6.cells["saving_steps"] == "75"
+    assert r2.cells["saving_steps"] == "n/a"   # Run 2's own reference, Run 4, is not among them
+    r6_alone = ed.Result(paper=ed.PAPER[6], outdir="", source="ran", status="ok", wall=50.0, steps=100.0)
+    ed.compare([r6_alone], 0.5)
+    assert r6_alone.cells["saving_steps"] == "n/a" and math.isnan(r6_alone.cells["saving_steps_v"])
+
+
 def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     # As tools/vajont_validate.py: a run cut off with SIGKILL is continued by --reuse from its
     # checkpoint and ends bit-identical to an uninterrupted one (one thread), its wall time the
