@@ -461,13 +461,63 @@ static void test_tension_cutoff(void **state)
                  "media.sand.tension_cutoff");
 }
 
+/* ---- (d) held fixed grains (option hold_fixed, SPHERA's momentum routine) ------------------ */
+
+/* The bed at rest, every grain FIXED: one whole step. A fixed grain is never drifted; without the
+ * option it receives its forces and the two half kicks (MODEL.md section 6's reading), so the
+ * grains still fixed after the step carry v = dt/2 a from the second kick (their forces do not
+ * balance exactly at the free surface and the walls); with `hold_fixed` it gets no acceleration
+ * (SPHERA zeroes the acceleration of a particle with mu = mu_thr), so v stays exactly 0. */
+static void check_hold(const char *media, int hold)
+{
+    mixsph_sim *s = create_ok(media);
+    struct particles *P = &s->P;
+    assert_int_equal(s->cfg.media[0].hold_fixed, hold);
+    assert_int_equal(s->n_fixed, 400);
+    double *x0 = calloc(P->n, sizeof *x0), *z0 = calloc(P->n, sizeof *z0);
+    assert_true(x0 && z0);
+    for (size_t i = 0; i < P->n; i++) {
+        x0[P->id[i]] = P->x[i];
+        z0[P->id[i]] = P->z[i];
+    }
+    assert_int_equal(integrate_step(s), MIXSPH_OK);
+    long fixed = 0, moving = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i)) continue;
+        assert_true(P->x[i] == x0[P->id[i]] && P->z[i] == z0[P->id[i]]); /* fixed at the step's start: not drifted */
+        if (P->state[i] != MIXSPH_STATE_FIXED) continue;
+        fixed++;
+        if (P->vx[i] != 0.0 || P->vz[i] != 0.0) moving++;
+    }
+    print_message("hold_fixed = %d: %ld grains fixed after one step, %ld of them with a nonzero velocity\n", hold, fixed,
+                  moving);
+    assert_true(fixed > 0);
+    if (hold) assert_int_equal(moving, 0);
+    else assert_true(moving > 0);
+    free(x0);
+    free(z0);
+    mixsph_sim_destroy(s);
+}
+
+static void test_hold_fixed(void **state)
+{
+    (void)state;
+    check_hold(DRY_SAND, 0); /* default: off */
+    check_hold("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+               "\"mu_thr\": 320e3, \"mu0\": 5e3, \"hold_fixed\": true }",
+               1);
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu_thr\": 320e3, \"hold_fixed\": \"yes\" }",
+                 "media.sand.hold_fixed");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_parse_dry),      cmocka_unit_test(test_parse_saturated),
         cmocka_unit_test(test_parse_mu1),      cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_transitions),    cmocka_unit_test(test_pore_pressure),
-        cmocka_unit_test(test_tension_cutoff),
+        cmocka_unit_test(test_tension_cutoff), cmocka_unit_test(test_hold_fixed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

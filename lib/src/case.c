@@ -248,7 +248,7 @@ static int find_motion(const struct case_def *c, const char *name)
 
 static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", NULL};
+    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", "pressure_smoothing", NULL};
     const cJSON *n;
     TRY(get_obj(r, root, "", "numerics", 1, &n));
     TRY(check_keys(r, n, "numerics", keys));
@@ -269,6 +269,8 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     else return FAIL(r, "%s: numerics.kernel: '%s' (expected \"cubic_spline\" or \"wendland_c2\")", r->origin, kernel);
     c->p_background = 0.0;
     TRY(get_num(r, n, "numerics", "background_pressure", 0, 0.0, 0, 1e9, &c->p_background));
+    c->pressure_smoothing = 0.0;
+    TRY(get_num(r, n, "numerics", "pressure_smoothing", 0, 0.0, 0, 1.0, &c->pressure_smoothing));
     c->wall_layers = (int)layers;
     if ((double)c->wall_layers != layers) return FAIL(r, "%s: numerics.wall_layers: expected an integer", r->origin);
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
@@ -307,7 +309,7 @@ static mixsph_status read_sound_speed(struct reader *r, const cJSON *it, const c
 static mixsph_status read_granular(struct reader *r, const cJSON *it, const char *path, struct case_def *c, struct medium *md)
 {
     static const char *const keys[] = {"type", "rho", "K", "c", "porosity", "phi", "d50", "saturated", "pore_fluid",
-                                       "mu_thr", "mu0", "mu1", "tension_cutoff", NULL};
+                                       "mu_thr", "mu0", "mu1", "tension_cutoff", "hold_fixed", NULL};
     TRY(check_keys(r, it, path, keys));
     md->kind = MEDIUM_GRANULAR;
     TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho_grain));
@@ -353,6 +355,8 @@ static mixsph_status read_granular(struct reader *r, const cJSON *it, const char
     }
     md->tension_cutoff = 0;
     TRY(get_bool(r, it, path, "tension_cutoff", &md->tension_cutoff));
+    md->hold_fixed = 0;
+    TRY(get_bool(r, it, path, "hold_fixed", &md->hold_fixed));
     md->mu = 0.0;
     md->alpha_m = 0.0;
     return MIXSPH_OK;

@@ -36,6 +36,7 @@ struct medium {
     double mu_thr;     /* threshold viscosity [Pa s] */
     double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
     int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
+    int hold_fixed;     /* granular: a fixed grain gets no acceleration (SPHERA's implementation) */
     int tension_cutoff; /* granular: no tensile pressure, p >= background pressure (off: the paper's model) */
 };
 
@@ -121,6 +122,7 @@ struct case_def {
     double t_end;             /* [s] */
     int wall_layers;          /* layers of wall particles behind each wall */
     int kernel;               /* enum kernel_type */
+    double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */

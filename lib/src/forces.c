@@ -60,7 +60,7 @@
 
 /* Per-step constants of the pair loops. */
 struct pair_ctx {
-    double inv_h, f_fac, eta2, r2max;
+    double inv_h, f_fac, eta2, r2max, a_d, g;
     int wendland;
     double *fk;           /* the kernel-factor cache (see forces_continuity), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
@@ -72,6 +72,8 @@ static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
     X->f_fac = s->K.f_fac;
     X->eta2 = 0.01 * s->h * s->h;
     X->r2max = s->K.r2max;
+    X->a_d = s->K.a_d;
+    X->g = s->cfg.g;
     X->wendland = s->K.type == KERNEL_WENDLAND_C2;
     X->fk = NULL;
     X->fk_off = NULL;
@@ -146,6 +148,54 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *di += acc[k];
         *ni += cnt[k];
+    }
+}
+
+/* Partial pressure smoothing (Di Monaco et al. 2011, as SPHERA applies it; option
+ * numerics.pressure_smoothing): between i and its ranges, for pairs of non-wall particles,
+ * B_ij = p_j - p_i + (rho_i + rho_j)/2 g (z_j - z_i) (the difference from the hydrostatic
+ * extrapolation of p_j to z_i, so a hydrostatic field is left unchanged; B_ji = -B_ij):
+ * a_i += B_ij W_ij V_j, u_i += W_ij V_j and a_j -= B_ij W_ij V_i, u_j += W_ij V_i. */
+FORCES_INLINE void smooth_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
+                                const uint32_t *restrict rng, int nr, double g, double *ai, double *ui, const int wendland)
+{
+    const double xi = P->x[i], zi = P->z[i], pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
+    const double *restrict x = P->x, *restrict z = P->z, *restrict p = P->p, *restrict rho = P->rho;
+    const double *restrict vol = P->vol, *restrict tag = P->tag;
+    const double a_d = X->a_d, inv_h = X->inv_h;
+    double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
+    for (int r = 0; r < nr; r++)
+    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
+        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
+#pragma omp simd
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
+            const double rx = xi - x[j], rz = zi - z[j];
+            const double q = sqrt(rx * rx + rz * rz) * inv_h;
+            double w;
+            if (wendland) {
+                double s1 = 1.0 - 0.5 * q;
+                s1 = s1 > 0.0 ? s1 : 0.0;
+                w = a_d * s1 * s1 * s1 * s1 * (2.0 * q + 1.0);
+            } else {
+                double t = 2.0 - q;
+                t = t > 0.0 ? t : 0.0;
+                w = q < 1.0 ? a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q) : 0.25 * a_d * t * t * t;
+            }
+            w *= FORCES_LANE_IN(k, m) * (tag[j] < 0.0 ? 0.0 : 1.0);
+            const double b = (p[j] - pi - 0.5 * (rhoi + rho[j]) * g * rz) * w;
+            sa[k] += b * vol[j];
+            su[k] += w * vol[j];
+            aj[k] = -b * voli;
+            uj[k] = w * voli;
+        }
+        chunk_add(P->ax, jb, m, aj);
+        chunk_add(P->az, jb, m, uj);
+    }
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        *ai += sa[k];
+        *ui += su[k];
     }
 }
 
@@ -290,6 +340,20 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
         momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL, wendland, cached);
         P->ax[i] += sx;
         P->az[i] += sz;
+    }
+}
+
+FORCES_CLONES
+static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P, size_t b0,
+                        size_t b1)
+{
+    for (size_t i = b0; i < b1; i++) {
+        if (P->tag[i] < 0.0) continue; /* walls neither smooth nor are smoothed */
+        double a = 0.0, u = 0.0;
+        if (X->wendland) smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, 1);
+        else smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, 0);
+        P->ax[i] += a;
+        P->az[i] += u;
     }
 }
 
@@ -452,4 +516,34 @@ void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double 
     P->ax[j] = save[0];
     P->drho[j] = save[2];
     P->ax[i] = save[3];
+}
+
+/* The partial pressure smoothing of SPHERA (numerics.pressure_smoothing = theta_P > 0; Di Monaco
+ * et al. 2011), after the equation of state: every non-wall particle's pressure relaxes toward
+ * the kernel mean of its non-wall neighbours' pressures, hydrostatically extrapolated to it,
+ *   p_i += theta_P c_i dt / h * sum_j B_ij W_ij V_j / sum_j W_ij V_j,
+ * and its density follows (rho_i += dp_i / c_i^2), so the next continuity step starts from the
+ * smoothed state. Masses are untouched. A damping of the acoustic noise of weakly compressible
+ * SPH (like delta-SPH's density diffusion); not in MODEL.md, an option (off by default). */
+void forces_smooth_pressure(mixsph_sim *s)
+{
+    struct particles *P = &s->P;
+    struct pair_ctx X;
+    pair_ctx_init(s, &X);
+    const size_t n = s->C.start[s->C.ncell];
+    memset(P->ax, 0, n * sizeof(double));
+    memset(P->az, 0, n * sizeof(double));
+    for_bands(s, smooth_band, &X);
+    const double f = s->cfg.pressure_smoothing * s->dt / s->h;
+    const struct medium *M = s->cfg.media;
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED || !(P->az[i] > 0.0)) continue;
+        const double c = M[P->medium[i]].c;
+        const double dp = f * c * P->ax[i] / P->az[i];
+        P->p[i] += dp;
+        P->rho[i] += dp / (c * c);
+        P->inv_rho[i] = 1.0 / P->rho[i];
+        P->vol[i] = P->m[i] * P->inv_rho[i];
+    }
 }

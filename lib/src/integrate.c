@@ -8,7 +8,10 @@
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
  * Granular particles: after the continuity pass (which also gives their strain rate from
  * v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still gets
- * forces and the kicks, is not drifted and does not limit dt (MODEL.md section 6).
+ * forces and the kicks, is not drifted and does not limit dt (MODEL.md section 6); with the
+ * medium option hold_fixed it gets no kicks either (SPHERA's momentum routine), so its velocity
+ * stays 0. With numerics.pressure_smoothing > 0 the pressures are smoothed (forces.c) right
+ * after the equation of state, before the regime decision reads them.
  * Evaluating both rates in one pass from the same old state would be explicit Euler for the
  * acoustic modes, which grow without bound (found the hard way: the hydrostatic tank blew up).
  * After the drift the particles are re-sorted and the neighbour ranges rebuilt only when one of
@@ -135,8 +138,9 @@ mixsph_status integrate_step(mixsph_sim *s)
     for (size_t i = 0; i < P->n; i++) {
         const int st = P->state[i];
         if (st == MIXSPH_STATE_WALL || st == MIXSPH_STATE_LOST) continue;
-        double vx = P->vx[i] + 0.5 * dt * P->ax[i];
-        double vz = P->vz[i] + 0.5 * dt * P->az[i];
+        const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : 0.5 * dt;
+        double vx = P->vx[i] + kick * P->ax[i];
+        double vz = P->vz[i] + kick * P->az[i];
         if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
             const double x0 = P->x[i], z0 = P->z[i];
             double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
@@ -166,6 +170,7 @@ mixsph_status integrate_step(mixsph_sim *s)
         bad_rho |= !(P->rho[i] > 0.0);
     }
     integrate_eos(s);
+    if (s->cfg.pressure_smoothing > 0.0) forces_smooth_pressure(s);
     if (s->has_granular) mixture_update(s);
     walls_pressure(s);
     if (forces_compute(s) || bad_rho) {
@@ -178,6 +183,7 @@ mixsph_status integrate_step(mixsph_sim *s)
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        if (P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed) continue;
         P->vx[i] += 0.5 * dt * P->ax[i];
         P->vz[i] += 0.5 * dt * P->az[i];
     }

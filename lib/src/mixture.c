@@ -9,7 +9,8 @@
  *   sqrt(II_D), p_w, sigma' = max(p - max(p_w, 0), 0), mu_app = eps_f mu_f + sigma' sin(phi) / (2 sqrt(II_D))
  *   regime: mu_app >= mu_thr -> FIXED (mu = mu_thr, velocity set to 0, not moved next step,
  *           left out of dt); mu0 < mu_app < mu_thr -> mu0; else mu_app.
- * A fixed particle still receives forces and a velocity update every step, so it is mobilised
+ * A fixed particle still receives forces and a velocity update every step (unless its medium
+ * has hold_fixed, SPHERA's rule: then no acceleration, velocity exactly 0), so it is mobilised
  * again as soon as its neighbours shear it enough. The pore pressure of a saturated medium is
  * hydrostatic below the top of its saturated column: p_w = rho_f g (z_top - z) cos^2(alpha),
  * z_top the highest particle of a saturated medium in the particle's dx-wide column, alpha the

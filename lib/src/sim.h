@@ -110,6 +110,7 @@ double sim_clock_s(void);
 /* forces.c */
 int forces_compute(mixsph_sim *s);
 int forces_continuity(mixsph_sim *s);
+void forces_smooth_pressure(mixsph_sim *s);
 void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
 
 /* mixture.c */
