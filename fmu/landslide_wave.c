@@ -61,13 +61,14 @@ enum {
     P_POROSITY,
     P_GRAIN_DENSITY,
     P_OUTPUT_INTERVAL,
+    P_PRESSURE_SMOOTHING,
     N_REAL_PARAMS
 };
 static const struct real_param real_params[N_REAL_PARAMS] = {
     REAL_PARAM(reservoir_level), REAL_PARAM(phi),           REAL_PARAM(mu0),
     REAL_PARAM(mu_thr),          REAL_PARAM(dx),            REAL_PARAM(plate_duration_scale),
     REAL_PARAM(plate_stroke_scale), REAL_PARAM(porosity),   REAL_PARAM(grain_density),
-    REAL_PARAM(output_interval)};
+    REAL_PARAM(output_interval), REAL_PARAM(pressure_smoothing)};
 
 /* Case keys each real parameter overrides (up to 2; NULL-terminated). The plate scales are
  * handled apart (two parameters give two keys). */
@@ -82,6 +83,7 @@ static const char *const real_param_keys[N_REAL_PARAMS][3] = {
     [P_POROSITY] = {"media.slide.porosity", "media.slide_wet.porosity", NULL},
     [P_GRAIN_DENSITY] = {"media.slide.rho", "media.slide_wet.rho", NULL},
     [P_OUTPUT_INTERVAL] = {"output.monitor_interval", NULL, NULL},
+    [P_PRESSURE_SMOOTHING] = {"numerics.pressure_smoothing", NULL, NULL},
 };
 
 /* Outputs read from the library by name. */

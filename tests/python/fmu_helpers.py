@@ -32,6 +32,7 @@ CASE_KEYS = {
     "dx": ["numerics.dx"],
     "output_interval": ["output.monitor_interval"],
     "tension_cutoff": ["parameters.tension_cutoff"],
+    "pressure_smoothing": ["numerics.pressure_smoothing"],
 }
 
 ENV = {"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}

@@ -32,7 +32,8 @@ def test_validate_fmu_finds_no_problem():
     assert md.guid.startswith("{") and "@" not in md.guid and "@" not in (md.version or "")
     names = {v.name: v for v in md.modelVariables}
     for p in ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "dx", "plate_duration_scale",
-              "plate_stroke_scale", "porosity", "grain_density", "output_interval", "case_file", "tension_cutoff"]:
+              "plate_stroke_scale", "porosity", "grain_density", "output_interval", "case_file", "tension_cutoff",
+              "pressure_smoothing"]:
         assert names[p].causality == "parameter", p
     for o in H.OUT_REAL + H.OUT_INT:
         assert names[o].causality == "output" and names[o].start is None, o
@@ -121,6 +122,17 @@ def test_tension_cutoff_parameter_matches_the_executable(fmu_run_phi35, tmp_path
     res = simulate_fmu(H.fmu_path(), start_values={**RUN, "tension_cutoff": True}, stop_time=STOP,
                        output_interval=0.02)
     cli = H.run_mixsph({**RUN, "tension_cutoff": True}, tmp_path / "cli")["outputs"]["run_up"]
+    assert res["max_run_up"][-1] == cli["max"]
+    assert res["max_run_up"][-1] != fmu_run_phi35["max_run_up"][-1]
+
+
+def test_pressure_smoothing_parameter_matches_the_executable(fmu_run_phi35, tmp_path):
+    # the real parameter reaches the case as numerics.pressure_smoothing: the FMU's run is the
+    # executable's with that override (identical with one thread), and not the default run
+    from fmpy import simulate_fmu
+    res = simulate_fmu(H.fmu_path(), start_values={**RUN, "pressure_smoothing": 0.4}, stop_time=STOP,
+                       output_interval=0.02)
+    cli = H.run_mixsph({**RUN, "pressure_smoothing": 0.4}, tmp_path / "cli")["outputs"]["run_up"]
     assert res["max_run_up"][-1] == cli["max"]
     assert res["max_run_up"][-1] != fmu_run_phi35["max_run_up"][-1]
 
@@ -262,6 +274,7 @@ def test_invalid_parameters_give_fmi2error_and_a_logged_message(tmp_path):
     _expect_error(log, f.setReal, [v["phi"]], [95.0], text="phi = 95 is out of range")
     _expect_error(log, f.setReal, [v["mu0"]], [-1.0], text="mu0")
     _expect_error(log, f.setReal, [v["dx"]], [float("nan")], text="dx")
+    _expect_error(log, f.setReal, [v["pressure_smoothing"]], [1.5], text="pressure_smoothing = 1.5 is out of range")
     _expect_error(log, f.setInteger, [v["threads"]], [-2], text="threads")
     # the instance stays usable after a rejected value
     H.start(f, H.COARSE)
