@@ -511,6 +511,136 @@ static void test_hold_fixed(void **state)
                  "media.sand.hold_fixed");
 }
 
+/* ---- (e) fixed bed (numerics.fixed_bed_speed, SPHERA's rule) ------------------------------- */
+
+#define V_FB 0.0125 /* [m/s] the fixed-bed speed of SPHERA's erosive dam-break input */
+
+static mixsph_sim *create_fixed_bed(double v_fb)
+{
+    char text[4096];
+    snprintf(text, sizeof text, CASE_FMT, DRY_SAND);
+    const mixsph_override ov = {"numerics.fixed_bed_speed", v_fb};
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = mixsph_sim_create_from_text(text, "granular_bed.json", &ov, 1, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    mixsph_sim_set_threads(s, 2);
+    return s;
+}
+
+/* The bed's top three rows (z >= 0.065 m) slide at 0.05 m/s > V_FB, the rest is at rest; in
+ * x < 0.1 m the sliding grains are marked FIXED (held at the last decision: they count as at
+ * rest). All velocities are set before the continuity pass, so the strain rates are those of
+ * this field. */
+static void slide_top(mixsph_sim *s)
+{
+    struct particles *P = &s->P;
+    for (size_t i = 0; i < P->n; i++) {
+        const double u = is_grain(s, i) && P->z[i] >= 0.065 ? 0.05 : 0.0;
+        P->vx[i] = P->uvx[i] = u;
+        P->vz[i] = P->uvz[i] = 0.0;
+        if (is_grain(s, i)) P->state[i] = u > 0.0 && P->x[i] < 0.1 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
+    }
+    integrate_eos(s);
+}
+
+/* The same bed with and without the fixed bed. Expected by brute force from the rule: in each
+ * column 2h wide from the domain's x_min, the top is the highest grain at rest or FIXED before
+ * the update (ties: first in memory order); a grain more than 2h below it is frozen: FIXED,
+ * velocity 0, mu = mu_thr, p = p_top + rho0 g (z_top - z) with the top's final pressure, and the
+ * density of that pressure. Every other grain ends exactly as without the option. Here the tops
+ * are z = 0.095 m (x < 0.1 m) and 0.055 m elsewhere, 2h = 0.026 m. */
+static void test_fixed_bed(void **state)
+{
+    (void)state;
+    mixsph_sim *off = create_ok(DRY_SAND), *on = create_fixed_bed(V_FB);
+    assert_true(off->cfg.fixed_bed_speed < 0.0); /* default: off */
+    assert_true(on->cfg.fixed_bed_speed == V_FB);
+    struct particles *P = &on->P, *Q = &off->P;
+    assert_int_equal(P->n, Q->n);
+    const size_t n = P->n;
+    /* the same start: the creation's regime decision already froze grains of `on` (all at rest) */
+    for (size_t i = 0; i < n; i++) {
+        assert_int_equal(P->id[i], Q->id[i]);
+        P->rho[i] = Q->rho[i];
+    }
+    slide_top(off);
+    slide_top(on);
+    const double two_h = 2.0 * on->h, x0 = on->domain[0];
+    uint8_t *st0 = malloc(n);
+    long *top = malloc(n * sizeof *top);
+    assert_true(st0 && top);
+    memcpy(st0, P->state, n);
+    for (size_t i = 0; i < n; i++) {
+        top[i] = -1;
+        if (!is_grain(on, i)) continue;
+        const double col = floor((P->x[i] - x0) / two_h);
+        for (size_t j = 0; j < n; j++) {
+            if (!is_grain(on, j) || floor((P->x[j] - x0) / two_h) != col) continue;
+            const int rest = st0[j] == MIXSPH_STATE_FIXED || hypot(P->vx[j], P->vz[j]) <= V_FB;
+            if (rest && (top[i] < 0 || P->z[j] > P->z[top[i]])) top[i] = (long)j;
+        }
+    }
+    update(off);
+    update(on);
+    const struct medium *m = &on->cfg.media[0];
+    long frozen_left = 0, frozen_right = 0, others = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!is_grain(on, i)) continue;
+        assert_true(top[i] >= 0); /* every column of the bed has grains at rest */
+        const size_t k = (size_t)top[i];
+        /* the top: 0.095 m in the columns with held grains (x < 0.1 m, and the column across x = 0.1 m) */
+        const int high = fabs(P->z[k] - 0.095) < 1e-9;
+        assert_true(high || fabs(P->z[k] - 0.055) < 1e-9);
+        if (P->x[i] < 0.1) assert_true(high);
+        if (P->z[i] < P->z[k] - two_h) {
+            assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
+            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->mu[i] == m->mu_thr);
+            const double p = P->p[k] + m->rho0 * G_ACC * (P->z[k] - P->z[i]);
+            assert_rel(P->p[i], p, REL);
+            assert_rel(P->rho[i], m->rho0 + p / (m->c * m->c), 1e-12);
+            if (high) frozen_left++;
+            else frozen_right++;
+        } else { /* the regime as without the option */
+            assert_int_equal(P->state[i], Q->state[i]);
+            assert_true(P->mu[i] == Q->mu[i] && P->vx[i] == Q->vx[i] && P->rho[i] == Q->rho[i]);
+            if (P->state[i] == MIXSPH_STATE_MOBILE) {
+                assert_true(P->p[i] == Q->p[i]);
+            } else { /* held: from its mobile neighbours (frozen grains are not mobile ones) */
+                double sw = 0.0, sp = 0.0;
+                for (size_t j = 0; j < n; j++) {
+                    if (!is_grain(on, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
+                    const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
+                    if (r2 >= on->K.r2max) continue;
+                    const double w = kernel_w(&on->K, sqrt(r2));
+                    sw += w;
+                    sp += (P->p[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
+                }
+                assert_true(sw > 0.0);
+                assert_rel(P->p[i], sp / sw, REL);
+            }
+            others++;
+        }
+    }
+    print_message("fixed bed: %ld grains frozen below z = 0.069 m (top 0.095 m), %ld below z = 0.029 m (top 0.055 m), "
+                  "%ld others\n", frozen_left, frozen_right, others);
+    assert_true(frozen_left > 0 && frozen_right > 0 && others > 0);
+    assert_int_equal(frozen_left + frozen_right + others, 400);
+    free(st0);
+    free(top);
+    mixsph_sim_destroy(off);
+    mixsph_sim_destroy(on);
+    char text[4096];
+    snprintf(text, sizeof text, CASE_FMT, DRY_SAND);
+    char err[512] = "";
+    mixsph_sim *s = NULL;
+    const mixsph_override bad = {"numerics.fixed_bed_speed", -2.0};
+    assert_int_equal(mixsph_sim_create_from_text(text, "granular_bed.json", &bad, 1, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    print_message("  refused: %s\n", err);
+    assert_non_null(strstr(err, "numerics.fixed_bed_speed"));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -518,6 +648,7 @@ int main(void)
         cmocka_unit_test(test_parse_mu1),      cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_transitions),    cmocka_unit_test(test_pore_pressure),
         cmocka_unit_test(test_tension_cutoff), cmocka_unit_test(test_hold_fixed),
+        cmocka_unit_test(test_fixed_bed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

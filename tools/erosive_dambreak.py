@@ -5,7 +5,7 @@ and compare them with the paper.
     python tools/erosive_dambreak.py [--runs 2,5,6,7] [--dx 0.01] [--out out/erosive]
                                      [--threads N] [--jobs J] [--reuse] [--checkpoint-every S]
                                      [--mixsph build/mixsph] [--case cases/erosive_dambreak.json]
-                                     [--t-end T] [--at 0.5]
+                                     [--t-end T] [--at 0.5] [--set KEY=VALUE]...
 
 Each selected run k is ``mixsph run CASE --out OUT/run<k>_dx<D> --set numerics.dx=D --set
 media.sediment.mu_thr=... --set media.sediment.mu0=... --threads N --quiet`` (stdout and stderr in
@@ -177,7 +177,7 @@ class Result:
 
 
 STAMP = "erosive_run.json"
-STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case")
+STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case", "sets")   # "sets" only with --set
 
 
 def run_jobs(jobs, n_parallel, t_end, progress_every):
@@ -615,6 +615,9 @@ def main():
                     help="time [s] of the profiles compared and plotted, one of the case's profile times (default 0.5)")
     ap.add_argument("--progress", type=float, default=300.0,
                     help="print the simulated time of the running runs every this many seconds (default 300, 0: never)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
+                    help="an override passed to every run after the run's own (repeatable), "
+                    "e.g. numerics.fixed_bed_speed=0.0125")
     args = ap.parse_args()
 
     runs = parse_runs(args.runs)
@@ -628,6 +631,10 @@ def main():
         fail("--t-end must be a positive number of seconds")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
+    try:
+        extra = mt.parse_sets(args.sets, "numerics.fixed_bed_speed=0.0125")
+    except mt.ToolError as e:
+        fail(str(e))
     mixsph = os.path.abspath(args.mixsph)
     if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
         fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
@@ -667,6 +674,8 @@ def main():
         d = os.path.join(out, f"run{k}_dx{args.dx:g}")
         cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(args.dx)}",
                "--set", f"media.sediment.mu_thr={num(p.mu_thr)}", "--set", f"media.sediment.mu0={num(p.mu0)}"]
+        for key, val in extra:
+            cmd += ["--set", f"{key}={num(val)}"]
         if args.t_end is not None:
             cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
         cmd += ["--threads", str(threads), "--quiet"]
@@ -674,6 +683,8 @@ def main():
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
                  "threads": threads, "command": cmd}
+        if extra:   # absent without --set, so the folders of earlier runs stay reusable
+            stamp["sets"] = [list(s) for s in extra]
         jobs.append(Job(p, d, cmd, stamp, threads))
 
     to_run = []
@@ -697,6 +708,7 @@ def main():
     threads_note = f"threads {','.join(str(t) for t in used_threads) or threads}"
     if len(to_run) > 1 and jobs_n > 1:
         threads_note += f", up to {jobs_n} runs at once (wall times share the machine)"
+    threads_note += "".join(f"; with {k}={num(v)}" for k, v in extra)
     print()
     table(results, args.at, args.dx, t_end, threads_note)
     if len(used_threads) > 1:

@@ -251,6 +251,22 @@ def show(path):
     return path if rel.startswith("..") else rel
 
 
+def parse_sets(texts, example):
+    """The --set KEY=VALUE options of a script as [(key, value)]; raises ToolError naming the
+    option on one that is not KEY=VALUE with a finite number (``example`` shows a good one)."""
+    out = []
+    for text in texts:
+        key, eq, value = text.partition("=")
+        try:
+            v = float(value)
+        except ValueError:
+            v = math.nan
+        if not eq or not key or not math.isfinite(v):
+            raise ToolError(f"--set {text}: expected KEY=VALUE with a finite number, e.g. {example}")
+        out.append((key, v))
+    return out
+
+
 def num(v):
     """A number for the command line: 0.01 -> '0.01', 20700.0 -> '20700', 1e12 -> '1000000000000'."""
     v = float(v)

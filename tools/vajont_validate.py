@@ -637,16 +637,10 @@ def main():
         fail("--t-end must be a positive number of seconds")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
-    extra = []
-    for text in args.sets:
-        key, eq, value = text.partition("=")
-        try:
-            v = float(value)
-        except ValueError:
-            v = math.nan
-        if not eq or not key or not math.isfinite(v):
-            fail(f"--set {text}: expected KEY=VALUE with a finite number, e.g. parameters.tension_cutoff=1")
-        extra.append((key, v))
+    try:
+        extra = mt.parse_sets(args.sets, "parameters.tension_cutoff=1")
+    except mt.ToolError as e:
+        fail(str(e))
     mixsph = os.path.abspath(args.mixsph)
     if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
         fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")

@@ -248,7 +248,8 @@ static int find_motion(const struct case_def *c, const char *name)
 
 static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", "pressure_smoothing", NULL};
+    static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", "pressure_smoothing",
+                                        "fixed_bed_speed", NULL};
     const cJSON *n;
     TRY(get_obj(r, root, "", "numerics", 1, &n));
     TRY(check_keys(r, n, "numerics", keys));
@@ -271,6 +272,8 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     TRY(get_num(r, n, "numerics", "background_pressure", 0, 0.0, 0, 1e9, &c->p_background));
     c->pressure_smoothing = 0.0;
     TRY(get_num(r, n, "numerics", "pressure_smoothing", 0, 0.0, 0, 1.0, &c->pressure_smoothing));
+    c->fixed_bed_speed = -1.0;
+    TRY(get_num(r, n, "numerics", "fixed_bed_speed", 0, -1.0, 0, 100.0, &c->fixed_bed_speed));
     c->wall_layers = (int)layers;
     if ((double)c->wall_layers != layers) return FAIL(r, "%s: numerics.wall_layers: expected an integer", r->origin);
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))

@@ -123,6 +123,8 @@ struct case_def {
     int wall_layers;          /* layers of wall particles behind each wall */
     int kernel;               /* enum kernel_type */
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
+    double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
+                                 bed; < 0: off (the default) */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */

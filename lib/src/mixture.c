@@ -19,10 +19,23 @@
  *   p_i = sum_j (p_j + rho_j g (z_j - z_i)) W_ij / sum_j W_ij  over mobile granular j;
  * with no such neighbour it keeps the pressure of its own density. A medium with
  * `tension_cutoff` (not the paper's model, an option) has its pressure floored at the
- * background pressure here and in the equation of state (integrate.c). */
+ * background pressure here and in the equation of state (integrate.c).
+ *
+ * Fixed bed (numerics.fixed_bed_speed = v_fb >= 0; off by default): SPHERA's rule for a granular
+ * bed without an erosion criterion (its erosion_flag 1 with velocity_fixed_bed = v_fb; MODEL.md
+ * section 6 calls it an optimisation, not part of the model). In every vertical column 2h wide
+ * (from the domain's x_min) the highest granular particle no faster than v_fb is the top of the
+ * fixed bed (a grain held fixed at the last regime decision counts as at rest); every grain of
+ * the column more than 2h below that top is frozen whatever its rheology says: FIXED (velocity
+ * 0, not moved, mu = mu_thr) with the hydrostatic pressure of the top particle,
+ *   p_i = p_top + rho0_top g (z_top - z_i),
+ * and the density of that pressure (SPHERA also adds the kinetic pressure of the two particles'
+ * relative velocity, below 1 Pa here: left out). A column without such a particle has no fixed
+ * bed. */
 #include <math.h>
 #include <stdlib.h>
 
+#include "eos.h"
 #include "rheology.h"
 #include "sim.h"
 #include "status.h"
@@ -41,6 +54,10 @@ mixsph_status mixture_alloc(mixsph_sim *s)
     K->nbins = (size_t)ceil((s->domain[1] - s->domain[0]) / s->dx) + 1;
     K->ztop = calloc(K->nbins, sizeof(double));
     if (!K->ztop) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (pore pressure bins)");
+    K->nbed = (size_t)ceil((s->domain[1] - s->domain[0]) / (2.0 * s->h)) + 1;
+    K->bed_z = calloc(K->nbed, sizeof(double));
+    K->bed_ref = calloc(K->nbed, sizeof(long));
+    if (!K->bed_z || !K->bed_ref) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (fixed bed columns)");
     return MIXSPH_OK;
 }
 
@@ -55,6 +72,8 @@ void mixture_free(mixsph_sim *s)
     free(K->lxz);
     free(K->lzz);
     free(K->ztop);
+    free(K->bed_z);
+    free(K->bed_ref);
 }
 
 static size_t bin_of(const mixsph_sim *s, double x)
@@ -81,6 +100,44 @@ static void saturated_tops(mixsph_sim *s)
     }
 }
 
+/* Fixed-bed column of x: columns 2h wide from the domain's x_min. */
+static size_t bed_column(const mixsph_sim *s, double x)
+{
+    double b = floor((x - s->domain[0]) / (2.0 * s->h));
+    if (b < 0) b = 0;
+    if (b > (double)(s->kin.nbed - 1)) b = (double)(s->kin.nbed - 1);
+    return (size_t)b;
+}
+
+/* Top of the fixed bed in every column: the highest granular particle no faster than
+ * fixed_bed_speed (a grain fixed at the last decision counts as at rest); ties go to the first
+ * in memory order, so the choice does not depend on the threads. */
+static void fixed_bed_tops(mixsph_sim *s, size_t n)
+{
+    struct kinematics *K = &s->kin;
+    const struct particles *P = &s->P;
+    const double v2 = s->cfg.fixed_bed_speed * s->cfg.fixed_bed_speed;
+    for (size_t b = 0; b < K->nbed; b++) {
+        K->bed_z[b] = -INFINITY;
+        K->bed_ref[b] = -1;
+    }
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED || s->cfg.media[P->medium[i]].kind != MEDIUM_GRANULAR) continue;
+        if (P->state[i] == MIXSPH_STATE_MOBILE && P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i] > v2) continue;
+        const size_t b = bed_column(s, P->x[i]);
+        if (P->z[i] > K->bed_z[b]) {
+            K->bed_z[b] = P->z[i];
+            K->bed_ref[b] = (long)i;
+        }
+    }
+}
+
+/* Whether grain i lies more than 2h below the top of its column's fixed bed. */
+static int frozen(const mixsph_sim *s, size_t i)
+{
+    return s->P.z[i] < s->kin.bed_z[bed_column(s, s->P.x[i])] - 2.0 * s->h;
+}
+
 /* Pore pressure of a saturated grain at (x, z). */
 static double pore_pressure(const mixsph_sim *s, const struct medium *m, double x, double z)
 {
@@ -103,6 +160,8 @@ void mixture_update(mixsph_sim *s)
     const struct cells *C = &s->C;
     const size_t n = C->start[C->ncell];
     saturated_tops(s);
+    const int fixed_bed = s->cfg.fixed_bed_speed >= 0.0;
+    if (fixed_bed) fixed_bed_tops(s, n);
     long fixed = 0;
 #pragma omp parallel for schedule(static) reduction(+ : fixed) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
@@ -125,7 +184,12 @@ void mixture_update(mixsph_sim *s)
         const double sigma = rheology_effective_stress(P->p[i] - s->cfg.p_background, pw);
         const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
         double mu;
-        if (rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED) {
+        int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
+        if (fixed_bed && frozen(s, i)) {
+            fix = 1;
+            mu = m->mu_thr;
+        }
+        if (fix) {
             P->state[i] = MIXSPH_STATE_FIXED;
             P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
             fixed++;
@@ -141,7 +205,7 @@ void mixture_update(mixsph_sim *s)
     const double g = s->cfg.g;
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED) continue;
+        if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(s, i))) continue;
         const double xi = P->x[i], zi = P->z[i];
         double sw = 0.0, sp = 0.0;
         for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
@@ -159,5 +223,21 @@ void mixture_update(mixsph_sim *s)
             const double p = sp / sw;
             P->p[i] = s->cfg.media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
         }
+    }
+    if (!fixed_bed) return;
+    /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
+     * final: the top is never frozen, and its extrapolation above is done) */
+    const double pb = s->cfg.p_background;
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(s, i)) continue;
+        const size_t top = (size_t)K->bed_ref[bed_column(s, P->x[i])];
+        const struct medium *m = &s->cfg.media[P->medium[i]];
+        double p = P->p[top] + s->cfg.media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+        if (m->tension_cutoff && p < pb) p = pb;
+        P->p[i] = p;
+        P->rho[i] = eos_density(p - pb, m->rho0, m->c);
+        P->inv_rho[i] = 1.0 / P->rho[i];
+        P->vol[i] = P->m[i] * P->inv_rho[i];
     }
 }

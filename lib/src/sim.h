@@ -40,6 +40,11 @@ struct kinematics {
     double *lxx, *lxz, *lzz;       /* correction matrix L (symmetric) [-] */
     double *ztop;                  /* per x-bin of width dx: top of the saturated granular column [m] */
     size_t nbins;
+    /* numerics.fixed_bed_speed >= 0 (SPHERA's fixed bed, mixture.c): per column 2h wide, the
+     * highest granular particle no faster than that speed (bed_ref, -1 for none) and its z [m] */
+    double *bed_z;
+    long *bed_ref;
+    size_t nbed;
 };
 
 struct mixsph_sim {

@@ -136,3 +136,38 @@ def test_bad_checkpoint_interval_is_refused_before_any_run(tmp_path):
                             "--out", str(tmp_path / tool)], capture_output=True, text=True, timeout=120)
         assert r.returncode == 2 and "--checkpoint-every must be a number of seconds >= 0" in r.stderr, r.stderr
         assert not (tmp_path / tool).exists()
+
+
+def test_bad_set_is_refused_before_any_run(tmp_path):
+    import subprocess
+    for tool in ("erosive_dambreak.py", "vajont_validate.py"):
+        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool), "--set", "numerics.fixed_bed_speed",
+                            "--out", str(tmp_path / tool)], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and "--set numerics.fixed_bed_speed: expected KEY=VALUE" in r.stderr, r.stderr
+        assert not (tmp_path / tool).exists()
+
+
+def test_set_reaches_every_run_and_its_stamp(tmp_path):
+    # --set passes an override to every run (after the run's own) and is part of the run's
+    # settings: a folder run without it is not reused for a sweep with it. Run 6, dx 0.02, 0.01 s.
+    import json
+    import subprocess
+    from tool_helpers import ENV
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        import pytest
+        pytest.skip("build/mixsph not built")
+    tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph, "--runs", "6",
+            "--dx", "0.02", "--t-end", "0.01", "--threads", "1", "--progress", "0", "--out", str(tmp_path)]
+    r = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    r = subprocess.run(tool + ["--reuse", "--set", "numerics.fixed_bed_speed=0.0125"], capture_output=True, text=True,
+                       env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "records other settings" in r.stdout and "; with numerics.fixed_bed_speed=0.0125" in r.stdout
+    with open(tmp_path / "run6_dx0.02" / ed.STAMP) as f:
+        stamp = json.load(f)
+    assert stamp["sets"] == [["numerics.fixed_bed_speed", 0.0125]]
+    assert "numerics.fixed_bed_speed=0.0125" in stamp["command"]
+    with open(tmp_path / "run6_dx0.02" / "summary.json") as f:
+        assert json.load(f)["status"] == "ok"
