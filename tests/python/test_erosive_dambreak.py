@@ -129,22 +129,21 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     assert math.isclose(float(row["wall_time_s"]), summ["run_wall_time_s"], rel_tol=1e-5)   # 6 digits in the CSV
 
 
-def test_bad_checkpoint_interval_is_refused_before_any_run(tmp_path):
-    import subprocess
-    for tool in ("erosive_dambreak.py", "vajont_validate.py"):
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool), "--checkpoint-every", "-1",
-                            "--out", str(tmp_path / tool)], capture_output=True, text=True, timeout=120)
-        assert r.returncode == 2 and "--checkpoint-every must be a number of seconds >= 0" in r.stderr, r.stderr
-        assert not (tmp_path / tool).exists()
+BAD_OPTIONS = [
+    (["--checkpoint-every", "-1"], "--checkpoint-every must be a number of seconds >= 0"),
+    (["--set", "numerics.fixed_bed_speed"], "--set numerics.fixed_bed_speed: expected KEY=VALUE"),
+]
 
 
-def test_bad_set_is_refused_before_any_run(tmp_path):
+def test_bad_options_are_refused_before_any_run(tmp_path):
     import subprocess
-    for tool in ("erosive_dambreak.py", "vajont_validate.py"):
-        r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool), "--set", "numerics.fixed_bed_speed",
-                            "--out", str(tmp_path / tool)], capture_output=True, text=True, timeout=120)
-        assert r.returncode == 2 and "--set numerics.fixed_bed_speed: expected KEY=VALUE" in r.stderr, r.stderr
-        assert not (tmp_path / tool).exists()
+    for k, (opts, message) in enumerate(BAD_OPTIONS):
+        for tool in ("erosive_dambreak.py", "vajont_validate.py"):
+            out = tmp_path / f"{k}_{tool}"
+            r = subprocess.run([sys.executable, os.path.join(ROOT, "tools", tool)] + opts + ["--out", str(out)],
+                               capture_output=True, text=True, timeout=120)
+            assert r.returncode == 2 and message in r.stderr, r.stderr
+            assert not out.exists()
 
 
 def test_set_reaches_every_run_and_its_stamp(tmp_path):
