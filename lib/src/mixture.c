@@ -76,12 +76,19 @@ void mixture_free(mixsph_sim *s)
     free(K->bed_ref);
 }
 
+/* Column of x among n columns of the given width from the domain's x_min (clamped to the ends). */
+static size_t column_of(const mixsph_sim *s, double x, double width, size_t n)
+{
+    double b = floor((x - s->domain[0]) / width);
+    if (b < 0) b = 0;
+    if (b > (double)(n - 1)) b = (double)(n - 1);
+    return (size_t)b;
+}
+
+/* Pore-pressure bin of x: columns dx wide. */
 static size_t bin_of(const mixsph_sim *s, double x)
 {
-    double b = floor((x - s->domain[0]) / s->dx);
-    if (b < 0) b = 0;
-    if (b > (double)(s->kin.nbins - 1)) b = (double)(s->kin.nbins - 1);
-    return (size_t)b;
+    return column_of(s, x, s->dx, s->kin.nbins);
 }
 
 /* Top of the saturated granular column in every bin. */
@@ -100,13 +107,10 @@ static void saturated_tops(mixsph_sim *s)
     }
 }
 
-/* Fixed-bed column of x: columns 2h wide from the domain's x_min. */
+/* Fixed-bed column of x: columns 2h wide. */
 static size_t bed_column(const mixsph_sim *s, double x)
 {
-    double b = floor((x - s->domain[0]) / (2.0 * s->h));
-    if (b < 0) b = 0;
-    if (b > (double)(s->kin.nbed - 1)) b = (double)(s->kin.nbed - 1);
-    return (size_t)b;
+    return column_of(s, x, 2.0 * s->h, s->kin.nbed);
 }
 
 /* Top of the fixed bed in every column: the highest granular particle no faster than
