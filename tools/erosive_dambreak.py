@@ -177,7 +177,7 @@ class Result:
 
 
 STAMP = "erosive_run.json"
-STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case", "sets")   # "sets" only with --set
+STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case", "case_sha256", "sets")   # "sets" only with --set
 
 
 def run_jobs(jobs, n_parallel, t_end, progress_every):
@@ -642,6 +642,7 @@ def main():
     try:
         with open(case) as f:
             case_json = json.load(f)
+        case_sha = mt.case_digest(case)
     except (OSError, ValueError) as e:
         fail(f"{show(case)}: cannot read the case: {e}")
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
@@ -682,7 +683,7 @@ def main():
         if args.checkpoint_every > 0:
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
-                 "threads": threads, "command": cmd}
+                 "case_sha256": case_sha, "threads": threads, "command": cmd}
         if extra:   # absent without --set, so the folders of earlier runs stay reusable
             stamp["sets"] = [list(s) for s in extra]
         jobs.append(Job(p, d, cmd, stamp, threads))

@@ -23,6 +23,7 @@ File formats (cli/main.c, lib/src/monitors.c):
 """
 
 import glob
+import hashlib
 import json
 import math
 import os
@@ -302,6 +303,15 @@ def clean_outdir(d, stamp_name):
             os.remove(os.path.join(d, name))
 
 
+def case_digest(path):
+    """SHA-256 (hex) of a case file's bytes: a run's stamp records it, so a run made before the
+    case file was edited is not reused for the edited case (the path alone would not tell)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        h.update(f.read())
+    return h.hexdigest()
+
+
 def _stamp_differs(outdir, stamp, stamp_name, keys):
     """Why the stamp file in outdir does not record the same values of ``keys`` as ``stamp``
     (None when it does; a missing stamp counts as the same, for folders of older scripts)."""
@@ -312,9 +322,12 @@ def _stamp_differs(outdir, stamp, stamp_name, keys):
         with open(stamp_path) as f:
             old = json.load(f)
     except (OSError, ValueError):
-        old = None
-    if not isinstance(old, dict) or any(old.get(k) != stamp.get(k) for k in keys):
-        return f"{show(stamp_path)} records other settings"
+        return f"{show(stamp_path)} records other settings (unreadable)"
+    if not isinstance(old, dict):
+        return f"{show(stamp_path)} records other settings (not a JSON object)"
+    differ = [k for k in keys if old.get(k) != stamp.get(k)]
+    if differ:
+        return f"{show(stamp_path)} records other settings ({', '.join(differ)})"
     return None
 
 

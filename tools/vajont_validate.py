@@ -133,7 +133,7 @@ def d_eta(z):
 
 
 STAMP = "vajont_run.json"
-STAMP_KEYS = ("run", "dx", "sets", "t_end", "case")
+STAMP_KEYS = ("run", "dx", "sets", "t_end", "case", "case_sha256")
 
 
 @dataclass
@@ -648,6 +648,7 @@ def main():
     try:
         with open(case) as f:
             case_json = json.load(f)
+        case_sha = mt.case_digest(case)
     except (OSError, ValueError) as e:
         fail(f"{show(case)}: cannot read the case: {e}")
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
@@ -674,7 +675,7 @@ def main():
         if args.checkpoint_every > 0:
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
-                 "threads": threads, "command": cmd}
+                 "case_sha256": case_sha, "threads": threads, "command": cmd}
         jobs.append(Job(p, dx, d, cmd, stamp))
 
     signal.signal(signal.SIGTERM, on_sigterm)

@@ -170,3 +170,34 @@ def test_set_reaches_every_run_and_its_stamp(tmp_path):
     assert "numerics.fixed_bed_speed=0.0125" in stamp["command"]
     with open(tmp_path / "run6_dx0.02" / "summary.json") as f:
         assert json.load(f)["status"] == "ok"
+
+
+def test_a_run_of_an_edited_case_file_is_not_reused(tmp_path):
+    # The stamp records the case file's SHA-256, not only its path: after the case file is edited
+    # (here its CFL number), --reuse runs again instead of keeping a run of the old content.
+    # Run 6, dx 0.02, to t = 0.01 s, on a copy of the case.
+    import json
+    import shutil
+    import subprocess
+    from tool_helpers import ENV
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        import pytest
+        pytest.skip("build/mixsph not built")
+    case = tmp_path / "erosive.json"
+    shutil.copy(os.path.join(ROOT, "cases", "erosive_dambreak.json"), case)
+    tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph, "--runs", "6",
+            "--dx", "0.02", "--t-end", "0.01", "--threads", "1", "--progress", "0", "--case", str(case),
+            "--out", str(tmp_path / "out"), "--reuse"]
+    first = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
+    assert first.returncode == 0, first.stdout + first.stderr
+    again = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
+    assert again.returncode == 0 and "run 6: reused" in again.stdout, again.stdout + again.stderr
+    c = json.loads(case.read_text())
+    c["numerics"]["cfl"] = 0.09
+    case.write_text(json.dumps(c))
+    edited = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
+    assert edited.returncode == 0, edited.stdout + edited.stderr
+    assert "records other settings (case_sha256)" in edited.stdout and "run 6: reused" not in edited.stdout
+    with open(tmp_path / "out" / "run6_dx0.02" / ed.STAMP) as f:
+        assert json.load(f)["case_sha256"] == mt.case_digest(str(case))
