@@ -88,6 +88,11 @@ STILL_LEVEL = 0.46        # [m] reservoir level of the model
 PAPER_DX = 0.005          # [m]
 PLATE_STOP = 0.8          # [s] the plate stops
 T_TOL = 1e-3              # [s]
+# --sphera: the numerical options of SPHERA's own input for this test (SPHERA v9.0.0,
+# input/release_v_9_0_0/35_2D_Vajont_experiment: partial pressure smoothing TetaP = 0.4 and, in
+# its bed-load block, velocity_fixed_bed = 0 with erosion flag 1). Not part of the model as
+# MODEL.md states it; passed to every run as --set overrides after the run's own, before the user's.
+SPHERA_OPTIONS = (("numerics.pressure_smoothing", 0.4), ("numerics.fixed_bed_speed", 0.0))
 
 
 @dataclass(frozen=True)
@@ -623,6 +628,9 @@ def main():
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                     help="an override passed to every run after the run's own (repeatable), "
                     "e.g. parameters.tension_cutoff=1")
+    ap.add_argument("--sphera", action="store_true",
+                    help="run with the numerical options of SPHERA's own input for this test ("
+                    + ", ".join(f"{k}={num(v)}" for k, v in SPHERA_OPTIONS) + "), before any --set")
     ap.add_argument("--progress", type=float, default=60.0,
                     help="print the simulated time every this many seconds (default 60, 0: never)")
     args = ap.parse_args()
@@ -638,7 +646,8 @@ def main():
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
     try:
-        extra = mt.parse_sets(args.sets, "parameters.tension_cutoff=1")
+        extra = (list(SPHERA_OPTIONS) if args.sphera else []) + mt.parse_sets(args.sets,
+                                                                               "parameters.tension_cutoff=1")
     except mt.ToolError as e:
         fail(str(e))
     mixsph = os.path.abspath(args.mixsph)

@@ -201,3 +201,32 @@ def test_a_run_of_an_edited_case_file_is_not_reused(tmp_path):
     assert "records other settings (case_sha256)" in edited.stdout and "run 6: reused" not in edited.stdout
     with open(tmp_path / "out" / "run6_dx0.02" / ed.STAMP) as f:
         assert json.load(f)["case_sha256"] == mt.case_digest(str(case))
+
+
+def test_sphera_option_passes_spheras_own_settings_to_every_run(tmp_path):
+    # --sphera adds the numerical options of SPHERA's own input for the test (the SPHERA_OPTIONS
+    # of each script) as --set overrides, recorded in the run's stamp and command; a --set of the
+    # user comes after them, so it wins. One very short run of each script at a coarse dx.
+    import json
+    import subprocess
+    import vajont_validate as vv
+    from tool_helpers import ENV
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        import pytest
+        pytest.skip("build/mixsph not built")
+    for mod, args, run_dir in ((ed, ["--runs", "6", "--dx", "0.02"], "run6_dx0.02"),
+                               (vv, ["--runs", "1", "--dx", "0.03"], "V1_dx0.03")):
+        out = tmp_path / mod.__name__
+        tool = [sys.executable, mod.__file__, "--mixsph", mixsph, *args, "--t-end", "0.01", "--threads", "1",
+                "--progress", "0", "--out", str(out), "--sphera", "--set", "numerics.pressure_smoothing=0.1"]
+        r = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
+        assert r.returncode == 0, r.stdout + r.stderr
+        with open(out / run_dir / mod.STAMP) as f:
+            stamp = json.load(f)
+        expected = [list(s) for s in mod.SPHERA_OPTIONS] + [["numerics.pressure_smoothing", 0.1]]
+        assert stamp["sets"][-3:] == expected
+        cmd = " ".join(stamp["command"])
+        assert all(f"{k}={mt.num(v)}" in cmd for k, v in mod.SPHERA_OPTIONS)
+        assert cmd.index("numerics.pressure_smoothing=0.1") > cmd.index(f"numerics.pressure_smoothing="
+                                                                         f"{mt.num(mod.SPHERA_OPTIONS[0][1])}")
