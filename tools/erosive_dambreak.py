@@ -693,7 +693,7 @@ def main():
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
                  "case_sha256": case_sha, "threads": threads, "command": cmd}
-        if extra:   # absent without --set, so the folders of earlier runs stay reusable
+        if extra:   # absent without --set and --sphera, as in the stamps of earlier runs
             stamp["sets"] = [list(s) for s in extra]
         jobs.append(Job(p, d, cmd, stamp, threads))
 
