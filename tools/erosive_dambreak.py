@@ -171,6 +171,7 @@ class Result:
     p_peak: float = math.nan     # [Pa]
     p_peak_t: float = math.nan
     t_wall: float = math.nan     # water reaches the left wall [s]
+    lost: float = math.nan       # particles that left the case's domain (most over the run)
     interface: mt.Profile = None
     interface_frac: mt.Profile = None   # 0.5 iso-line of the sediment fraction, from the snapshot
     free_surface: mt.Profile = None
@@ -286,6 +287,7 @@ def load_result(job, at, dx, sediment):
     r.rise_t = mt.summary_value(summ, "bedload_rise_left_wall", "t_max")
     r.p_peak = mt.summary_value(summ, "left_wall_pressure", "max")
     r.p_peak_t = mt.summary_value(summ, "left_wall_pressure", "t_max")
+    r.lost = mt.summary_value(summ, "lost_particles", "max")
     mon_path = os.path.join(job.outdir, "monitors.csv")
     if os.path.isfile(mon_path):
         mon = mt.read_monitors(mon_path)
@@ -452,7 +454,7 @@ def table(results, at, dx, t_end, threads_note):
         (f"interface err [%], t={at:g} s", "paper", ">"),
         ("bed-load rise, wall", "max [m]", ">"), ("bed-load rise, wall", "t [s]", ">"),
         ("peak p, left wall", "[kPa]", ">"), ("peak p, left wall", "t [s]", ">"),
-        ("water at wall", "t [s]", ">"),
+        ("water at wall", "t [s]", ">"), ("", "lost", ">"),
     ]
     rows = []
     for r in results:
@@ -467,10 +469,10 @@ def table(results, at, dx, t_end, threads_note):
             c["err"], c["err_frac"], c["paper_err"],
             fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
             fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
-            fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"),
+            fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"), fmt(r.lost, ".0f"),
         ])
     paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "", "",
-                 f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}"]
+                 f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}", ""]
     print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
           f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
     print("mu_thr, mu0 in kPa s; the paper's times are SPHERA v8's, on hardware it does not state")
@@ -488,6 +490,8 @@ def table(results, at, dx, t_end, threads_note):
           f"(paper: ~{PAPER_BEDLOAD_RISE:g} m for the converged runs).")
     print(f"water at wall: first monitor sample with water_front < {WALL_REACH_X:g} m "
           f"(paper: the plunging wave hits the left wall at ~{PAPER_T_IMPACT:g} s).")
+    print("lost:          particles that left the case's domain (taken out of the run): spray thrown above its top")
+    print("               (the tank is open) or a particle through a wall, which the solver's wall guard prevents.")
     print("Run 7:         mu1 rheology, mu1 = 5 kPa s, given as mu_thr = 5 kPa s and mu0 = 1e12 Pa s (no limit).")
 
 
@@ -498,7 +502,7 @@ def write_csv(path, results, dx, t_end, at):
               "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
               "paper_err_percent",
               "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
-              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent"]
+              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent", "lost_particles"]
 
     def v(x):
         if isinstance(x, float):
@@ -516,7 +520,7 @@ def write_csv(path, results, dx, t_end, at):
                 p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
                 at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
                 r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir,
-                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"])])
+                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"], r.lost)])
 
 
 # ---- figure ---------------------------------------------------------------------------------------

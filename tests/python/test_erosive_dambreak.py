@@ -127,6 +127,8 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     with open(cut / "erosive_table.csv") as f:
         row = next(csv.DictReader(f))
     assert math.isclose(float(row["wall_time_s"]), summ["run_wall_time_s"], rel_tol=1e-5)   # 6 digits in the CSV
+    # nothing has left the tank's domain by t = 0.1 s (the wave reaches the left wall at ~0.27 s)
+    assert row["lost_particles"] == "0" and summ["outputs"]["lost_particles"]["max"] == 0
 
 
 BAD_OPTIONS = [
