@@ -490,8 +490,8 @@ def table(results, at, dx, t_end, threads_note):
           f"(paper: ~{PAPER_BEDLOAD_RISE:g} m for the converged runs).")
     print(f"water at wall: first monitor sample with water_front < {WALL_REACH_X:g} m "
           f"(paper: the plunging wave hits the left wall at ~{PAPER_T_IMPACT:g} s).")
-    print("lost:          particles that left the case's domain (taken out of the run): spray thrown above its top")
-    print("               (the tank is open) or a particle through a wall, which the solver's wall guard prevents.")
+    print("lost:          particles that left the case's domain and were taken out of the run (in this open tank:")
+    print("               spray thrown above the domain's top); the walls' guard keeps particles from crossing a wall.")
     print("Run 7:         mu1 rheology, mu1 = 5 kPa s, given as mu_thr = 5 kPa s and mu0 = 1e12 Pa s (no limit).")
 
 
