@@ -5,7 +5,8 @@ and compare them with the paper.
     python tools/erosive_dambreak.py [--runs 2,5,6,7] [--dx 0.01] [--out out/erosive]
                                      [--threads N] [--jobs J] [--reuse] [--checkpoint-every S]
                                      [--mixsph build/mixsph] [--case cases/erosive_dambreak.json]
-                                     [--t-end T] [--at 0.5] [--set KEY=VALUE]...
+                                     [--t-end T] [--at 0.5] [--set KEY=VALUE]... [--sphera]
+                                     [--twin REL]
 
 Each selected run k is ``mixsph run CASE --out OUT/run<k>_dx<D> --set numerics.dx=D --set
 media.sediment.mu_thr=... --set media.sediment.mu0=... --threads N --quiet`` (stdout and stderr in
@@ -49,6 +50,12 @@ Printed table, one row per run, ours beside the paper's:
 - the time the water reaches the left wall: first monitor sample (monitors.csv, every 0.005 s)
   with ``water_front`` < 0.02 m, paper ~0.29 s.
 
+``--twin REL`` (e.g. 1e-6) also runs each selected reference run (2, 4) again with gravity
+multiplied by (1 + REL) into OUT/run<k>_dx<D>_twin, a row "<k> twin" compared with run k itself:
+a change far below any physical or numerical error, so its interface error is how far two runs of
+the same model drift apart by t = 0.5 s in this splashing flow - the floor under the errors of the
+other runs against that reference (CSV column ``twin`` = 1).
+
 Writes OUT/erosive_table.csv (the same, one row per run) and OUT/erosive_profiles.png: the
 interface (solid) and the free surface (dashed) at t = 0.5 s of every run for 0 <= x <= 0.5 m,
 like the paper's Figs 3 (Runs 1-4) and 4 (Runs 2, 5-7).
@@ -62,6 +69,7 @@ modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 51
 
 import argparse
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -98,6 +106,11 @@ class PaperRun:
     ref: int              # reference run of the comparison (0: none, this is a reference)
     label_thr: str        # how the table shows mu_thr, mu0 [kPa s]
     label_mu0: str
+    twin: bool = False    # --twin: this run again with gravity x (1 + REL), compared with itself
+
+    @property
+    def name(self):
+        return f"{self.run} twin" if self.twin else str(self.run)
 
 
 PAPER = {
@@ -207,7 +220,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                     fail(f"cannot start {job.cmd[0]}: {e}")
                 running.append(job)
                 how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
-                print(f"run {job.paper.run}: {how} ({job.threads} thread{'s' if job.threads > 1 else ''}) "
+                print(f"run {job.paper.name}: {how} ({job.threads} thread{'s' if job.threads > 1 else ''}) "
                       f"-> {show(job.outdir)}/  (log: mixsph.log)", flush=True)
             if pending and stop and not running:
                 break
@@ -221,14 +234,14 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                 el = time.monotonic() - job.t0
                 if rc == 0:
                     job.source = "ran"
-                    print(f"run {job.paper.run}: done in {fmt_duration(el)}", flush=True)
+                    print(f"run {job.paper.name}: done in {fmt_duration(el)}", flush=True)
                 else:
                     job.source = "FAILED"
                     what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
                     job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else \
                         f"mixsph was killed by signal {-rc}"
                     failed.append(job)
-                    print(f"run {job.paper.run}: FAILED after {fmt_duration(el)}: {job.message}; "
+                    print(f"run {job.paper.name}: FAILED after {fmt_duration(el)}: {job.message}; "
                           f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
                     for line in tail(os.path.join(job.outdir, "mixsph.log")):
                         print(f"    | {line}", flush=True)
@@ -236,7 +249,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                         # bad usage or input: the other runs would fail the same way
                         stop = True
                         print(f"{PROG}: not starting the remaining runs "
-                              f"({', '.join(str(j.paper.run) for j in pending)})", flush=True)
+                              f"({', '.join(j.paper.name for j in pending)})", flush=True)
             now = time.monotonic()
             if progress_every > 0 and running and now - last_progress >= progress_every:
                 last_progress = now
@@ -245,7 +258,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
                     ts = last_time(os.path.join(job.outdir, "monitors.csv"))
                     el = now - job.t0
                     eta = fmt_duration(el * (t_end - ts) / (ts - job.ts0)) if math.isfinite(ts) and ts > job.ts0 else "--"
-                    parts.append(f"run {job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s (ETA {eta})")
+                    parts.append(f"run {job.paper.name} t = {fmt(ts, '.3f', '--')}/{t_end:g} s (ETA {eta})")
                 print(f"  [{fmt_duration(now - t_start)}] " + ", ".join(parts), flush=True)
     except KeyboardInterrupt:
         for job in running:
@@ -256,7 +269,7 @@ def run_jobs(jobs, n_parallel, t_end, progress_every):
             except subprocess.TimeoutExpired:
                 job.proc.kill()
                 job.proc.wait()
-        print(f"\n{PROG}: interrupted; stopped run(s) {', '.join(str(j.paper.run) for j in running)}",
+        print(f"\n{PROG}: interrupted; stopped run(s) {', '.join(j.paper.name for j in running)}",
               file=sys.stderr)
         sys.exit(130)
     for job in pending:
@@ -345,7 +358,7 @@ def interface_error(run_prof, ref_prof, x_max=ERR_X_MAX):
 
 def compare(results, at):
     """Fill r.cells: saving and interface error versus the reference run, with the reason when n/a."""
-    by_run = {r.paper.run: r for r in results}
+    by_run = {r.paper.run: r for r in results if not r.paper.twin}
     for r in results:
         p = r.paper
         c = r.cells
@@ -361,7 +374,7 @@ def compare(results, at):
         c["ref"] = str(p.ref)
         paper_ref = PAPER[p.ref]
         c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / paper_ref.elapsed_s)
-        c["paper_saving"] = f"{c['paper_saving_v']:.0f}"
+        c["paper_saving"] = fmt(c["paper_saving_v"], ".0f", "-")
         c["paper_err"] = fmt(p.err_percent, ".2f", "-")
         c["saving_v"] = c["saving_steps_v"] = c["err_v"] = c["err_frac_v"] = math.nan
         c["saving_steps"] = "n/a"
@@ -444,7 +457,7 @@ def print_table(columns, rows, footer_rows=()):
     print("\n".join(text))
 
 
-def table(results, at, dx, t_end, threads_note):
+def table(results, at, dx, t_end, threads_note, twin_rel=None):
     cols = [
         ("", "run", ">"), ("", "mu_thr", ">"), ("", "mu0", ">"), ("", "status", "<"),
         ("wall time [s]", "mixsph", ">"), ("wall time [s]", "paper", ">"),
@@ -463,8 +476,8 @@ def table(results, at, dx, t_end, threads_note):
         if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - PAPER_T_END) > T_TOL:
             status += f", t={r.sim_time:.3g} s"
         rows.append([
-            str(p.run), p.label_thr, p.label_mu0, status,
-            fmt(r.wall, ".1f"), f"{p.elapsed_s:,.0f}",
+            p.name, p.label_thr, p.label_mu0, status,
+            fmt(r.wall, ".1f"), fmt(p.elapsed_s, ",.0f", "-"),
             c["ref"], c["saving"], c["saving_steps"], c["paper_saving"],
             c["err"], c["err_frac"], c["paper_err"],
             fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
@@ -492,6 +505,10 @@ def table(results, at, dx, t_end, threads_note):
           f"(paper: the plunging wave hits the left wall at ~{PAPER_T_IMPACT:g} s).")
     print("lost:          particles that left the case's domain and were taken out of the run (in this open tank:")
     print("               spray thrown above the domain's top); the walls' guard keeps particles from crossing a wall.")
+    if twin_rel is not None:
+        print(f"twin:          the reference run again with gravity x (1 + {twin_rel:g}), a perturbation far below any")
+        print("               physical or numerical error, compared with the run itself: how far two runs of one model")
+        print("               drift apart by t = 0.5 s in this splashing flow, the floor under the interface errors.")
     print("Run 7:         mu1 rheology, mu1 = 5 kPa s, given as mu_thr = 5 kPa s and mu0 = 1e12 Pa s (no limit).")
 
 
@@ -502,7 +519,7 @@ def write_csv(path, results, dx, t_end, at):
               "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
               "paper_err_percent",
               "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
-              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent", "lost_particles"]
+              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent", "lost_particles", "twin"]
 
     def v(x):
         if isinstance(x, float):
@@ -520,14 +537,14 @@ def write_csv(path, results, dx, t_end, at):
                 p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
                 at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
                 r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir,
-                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"], r.lost)])
+                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"], r.lost, int(p.twin))])
 
 
 # ---- figure ---------------------------------------------------------------------------------------
 
 
 def plot(path, results, at, dx):
-    runs = [r.paper.run for r in results]
+    runs = sorted({r.paper.run for r in results})
     sets = []
     if any(k in runs for k in (1, 3, 4)) and any(k in runs for k in (5, 6, 7)):
         sets = [("Runs 1-4 (paper Fig. 3: threshold viscosity)", [r for r in results if r.paper.run in TABLE1]),
@@ -539,8 +556,8 @@ def plot(path, results, at, dx):
     for ax, (title, rs) in zip(axes[0], sets):
         ax.axhline(0.067, color="0.7", lw=0.8, ls=":", label="initial bed (0.067 m)")
         for r in rs:
-            color = f"C{r.paper.run - 1}"
-            name = f"Run {r.paper.run}"
+            color = "0.45" if r.paper.twin else f"C{r.paper.run - 1}"
+            name = f"Run {r.paper.name}"
             drew = False
             for prof, style in ((r.interface, "-"), (r.free_surface, "--")):
                 if prof is None:
@@ -627,6 +644,9 @@ def main():
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                     help="an override passed to every run after the run's own (repeatable), "
                     "e.g. numerics.fixed_bed_speed=0.0125")
+    ap.add_argument("--twin", type=float, metavar="REL",
+                    help="also run each selected reference run (2, 4) again with gravity x (1 + REL), e.g. 1e-6, "
+                    "into run<k>_dx<D>_twin, and compare it with itself: the floor under the interface errors")
     ap.add_argument("--sphera", action="store_true",
                     help="run with the numerical options of SPHERA's own input for this test ("
                     + ", ".join(f"{k}={num(v)}" for k, v in SPHERA_OPTIONS) + "), before any --set")
@@ -641,6 +661,10 @@ def main():
         fail("--threads must be at least 1")
     if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
         fail("--t-end must be a positive number of seconds")
+    if args.twin is not None and not (0 < abs(args.twin) < 1e-3):
+        fail("--twin REL: a relative change of gravity between 0 and 1e-3 in size, e.g. 1e-6")
+    if args.twin is not None and not any(k in (2, 4) for k in runs):
+        fail("--twin: no reference run (2 or 4) among --runs")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
     try:
@@ -682,13 +706,20 @@ def main():
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
 
+    g = case_json.get("gravity")
+    if args.twin is not None and not isinstance(g, (int, float)):
+        fail(f"{show(case)}: no numeric 'gravity' to perturb for --twin")
+    plan = [(PAPER[k], extra) for k in runs]
+    if args.twin is not None:
+        plan += [(dataclasses.replace(PAPER[k], twin=True, ref=k, elapsed_s=math.nan, err_percent=math.nan),
+                  extra + [("gravity", g * (1.0 + args.twin))]) for k in runs if k in (2, 4)]
     jobs = []
-    for k in runs:
-        p = PAPER[k]
-        d = os.path.join(out, f"run{k}_dx{args.dx:g}")
+    for p, sets in plan:
+        k = p.run
+        d = os.path.join(out, f"run{k}_dx{args.dx:g}" + ("_twin" if p.twin else ""))
         cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(args.dx)}",
                "--set", f"media.sediment.mu_thr={num(p.mu_thr)}", "--set", f"media.sediment.mu0={num(p.mu0)}"]
-        for key, val in extra:
+        for key, val in sets:
             cmd += ["--set", f"{key}={num(val)}"]
         if args.t_end is not None:
             cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
@@ -697,13 +728,13 @@ def main():
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
         stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
                  "case_sha256": case_sha, "threads": threads, "command": cmd}
-        if extra:   # absent without --set and --sphera, as in the stamps of earlier runs
-            stamp["sets"] = [list(s) for s in extra]
+        if sets:   # absent without --set and --sphera, as in the stamps of earlier runs
+            stamp["sets"] = [list(s) for s in sets]
         jobs.append(Job(p, d, cmd, stamp, threads))
 
     to_run = []
     for job in jobs:
-        if args.reuse and not mt.plan_reuse(job, f"run {job.paper.run}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
+        if args.reuse and not mt.plan_reuse(job, f"run {job.paper.name}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
                                             threads, args.checkpoint_every):
             continue
         to_run.append(job)
@@ -724,7 +755,7 @@ def main():
         threads_note += f", up to {jobs_n} runs at once (wall times share the machine)"
     threads_note += "".join(f"; with {k}={num(v)}" for k, v in extra)
     print()
-    table(results, args.at, args.dx, t_end, threads_note)
+    table(results, args.at, args.dx, t_end, threads_note, args.twin)
     if len(used_threads) > 1:
         warn("the runs used different thread counts: the savings compare unlike wall times")
 
@@ -737,7 +768,7 @@ def main():
     print(f"plot:  {show(png_path)}")
     if failed:
         fail("mixsph failed for run(s) " + "; ".join(
-            f"{j.paper.run}: {j.message} (log {show(os.path.join(j.outdir, 'mixsph.log'))})" for j in failed), code=1)
+            f"{j.paper.name}: {j.message} (log {show(os.path.join(j.outdir, 'mixsph.log'))})" for j in failed), code=1)
 
 
 if __name__ == "__main__":

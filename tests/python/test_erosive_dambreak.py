@@ -232,3 +232,37 @@ def test_sphera_option_passes_spheras_own_settings_to_every_run(tmp_path):
         assert all(f"{k}={mt.num(v)}" in cmd for k, v in mod.SPHERA_OPTIONS)
         assert cmd.index("numerics.pressure_smoothing=0.1") > cmd.index(f"numerics.pressure_smoothing="
                                                                          f"{mt.num(mod.SPHERA_OPTIONS[0][1])}")
+
+
+def test_twin_reruns_the_reference_with_perturbed_gravity(tmp_path):
+    # --twin REL runs each selected reference run again with gravity x (1 + REL) into
+    # run<k>_dx<D>_twin and compares it with the run itself (its row's reference is the run).
+    # Run 2 at dx 0.02 to t = 0.01 s; a --twin without a reference run or out of range is refused.
+    import csv
+    import json
+    import subprocess
+    from tool_helpers import ENV
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        import pytest
+        pytest.skip("build/mixsph not built")
+    tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph,
+            "--dx", "0.02", "--t-end", "0.01", "--threads", "1", "--progress", "0"]
+    for opts, message in ((["--runs", "6", "--twin", "1e-6"], "--twin: no reference run (2 or 4) among --runs"),
+                          (["--runs", "2", "--twin", "0.1"], "--twin REL: a relative change of gravity")):
+        bad = tmp_path / "bad"
+        r = subprocess.run(tool + opts + ["--out", str(bad)], capture_output=True, text=True, env=ENV, timeout=120)
+        assert r.returncode == 2 and message in r.stderr, r.stderr
+        assert not bad.exists()
+    r = subprocess.run(tool + ["--runs", "2", "--twin", "1e-6", "--out", str(tmp_path / "out")],
+                       capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    with open(tmp_path / "out" / "erosive_table.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [(row["run"], row["twin"], row["ref_run"]) for row in rows] == [("2", "0", "4"), ("2", "1", "2")]
+    assert rows[1]["outdir"].endswith("run2_dx0.02_twin") and rows[1]["status"] == "ok"
+    with open(tmp_path / "out" / "run2_dx0.02_twin" / ed.STAMP) as f:
+        stamp = json.load(f)
+    with open(os.path.join(ROOT, "cases", "erosive_dambreak.json")) as f:
+        g = json.load(f)["gravity"]
+    assert stamp["sets"] == [["gravity", g * (1 + 1e-6)]]
