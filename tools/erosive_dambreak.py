@@ -688,6 +688,10 @@ def main():
     media = list(case_json.get("media", {})) if isinstance(case_json.get("media"), dict) else []
     if "sediment" not in media:
         fail(f"{show(case)}: no medium 'sediment' (the interface is the top of it)")
+    g = case_json.get("gravity")
+    g = next((v for k, v in reversed(extra) if k == "gravity"), g)   # a --set gravity=... counts
+    if args.twin is not None and not isinstance(g, (int, float)):
+        fail(f"{show(case)}: no numeric 'gravity' to perturb for --twin")
     sediment = media.index("sediment")   # the library numbers the media in the case file's order
     prof_times = [float(t) for t in case_json.get("monitors", {}).get("interface", {}).get("times", [])]
     if not any(abs(t - args.at) < 1e-9 for t in prof_times):
@@ -706,9 +710,6 @@ def main():
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
 
-    g = case_json.get("gravity")
-    if args.twin is not None and not isinstance(g, (int, float)):
-        fail(f"{show(case)}: no numeric 'gravity' to perturb for --twin")
     plan = [(PAPER[k], extra) for k in runs]
     if args.twin is not None:
         plan += [(dataclasses.replace(PAPER[k], twin=True, ref=k, elapsed_s=math.nan, err_percent=math.nan),
