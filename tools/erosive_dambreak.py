@@ -122,6 +122,7 @@ PAPER = {
     6: PaperRun(6, 20e3, 5e3, 7089, 5.7, 2, "20", "5"),
     7: PaperRun(7, 5e3, 1e12, 7098, math.nan, 2, "mu1=5", "off"),
 }
+REFERENCE_RUNS = sorted({p.ref for p in PAPER.values() if p.ref})   # [2, 4]: what --twin repeats
 PAPER_DX = 0.005           # [m] the paper's resolution
 PAPER_T_END = 0.5          # [s] the paper's runs (and its comparison time)
 PAPER_BEDLOAD_RISE = 0.3   # [m] max rise of the bed-load layer at the left wall (converged runs)
@@ -663,7 +664,7 @@ def main():
         fail("--t-end must be a positive number of seconds")
     if args.twin is not None and not (0 < abs(args.twin) < 1e-3):
         fail("--twin REL: a relative change of gravity between 0 and 1e-3 in size, e.g. 1e-6")
-    if args.twin is not None and not any(k in (2, 4) for k in runs):
+    if args.twin is not None and not any(k in REFERENCE_RUNS for k in runs):
         fail("--twin: no reference run (2 or 4) among --runs")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
@@ -713,7 +714,7 @@ def main():
     plan = [(PAPER[k], extra) for k in runs]
     if args.twin is not None:
         plan += [(dataclasses.replace(PAPER[k], twin=True, ref=k, elapsed_s=math.nan, err_percent=math.nan),
-                  extra + [("gravity", g * (1.0 + args.twin))]) for k in runs if k in (2, 4)]
+                  extra + [("gravity", g * (1.0 + args.twin))]) for k in runs if k in REFERENCE_RUNS]
     jobs = []
     for p, sets in plan:
         k = p.run
