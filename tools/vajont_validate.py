@@ -4,7 +4,7 @@ compare them with Manenti et al. (2018), Section 3.2, Tables 3-5 and Figs 7-10.
 
     python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--out out/vajont]
                                     [--reuse] [--checkpoint-every S] [--t-end T] [--plot-runs 1,2,4]
-                                    [--mixsph build/mixsph]
+                                    [--mixsph build/mixsph] [--twin REL]
                                     [--case cases/vajont_padua.json] [--set KEY=VALUE]...
 
 Runs are done one after the other (each with --threads N, default all cores). Run k is
@@ -28,6 +28,12 @@ unfinished one (killed, stopped, cut off with its session) from the checkpoint i
 writes OUT/V<k>_dx<D>/checkpoint.h5 every ``--checkpoint-every`` seconds of wall time (default
 600), so the paper's dx = 0.005, hours per run, can be done in pieces. Elapsed times are the
 runs' ``run_wall_time_s`` (over all their pieces).
+
+``--twin REL`` (e.g. 1e-6; V1 among --runs) also runs V1 again with gravity multiplied by
+(1 + REL) into OUT/V1_dx<D>_twin, the row "V1 twin": a change far below any physical or numerical
+error, so how far its maximum run-up ends from V1's is the floor under the differences between
+runs at that spacing (how much the splashing run-up tongue amplifies a perturbation of round-off
+size). A difference V2 - V1 or V4 - V1 no larger than that floor decides no ordering.
 
 Run-up (the case's monitor ``run_up``, lib/src/monitors.c): the highest z of a water particle
 centre over the opposite slope (x in [0.75, 1.81] m) among the water particles that have at least
@@ -66,6 +72,7 @@ import signal
 import subprocess
 import sys
 import time
+import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -106,6 +113,11 @@ class PaperRun:
     t_run_up: float       # [s]
     Z: float              # [m a.m.s.l.]
     d_eta: float          # [%]
+    twin: bool = False    # --twin: V1 again with gravity x (1 + REL), compared with V1
+
+    @property
+    def label(self):
+        return f"V{self.run} twin" if self.twin else f"V{self.run}"
 
 
 PAPER = {
@@ -163,7 +175,7 @@ def run_job(job, t_end, progress_every):
         fail(f"cannot start {job.cmd[0]}: {e}")
     with log:
         how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
-        print(f"V{job.paper.run}: {how}, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
+        print(f"{job.paper.label}: {how}, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
         last = t0
         try:
             while proc.poll() is None:
@@ -174,7 +186,7 @@ def run_job(job, t_end, progress_every):
                     ts = last_time(os.path.join(job.outdir, "monitors.csv"))
                     el = now - t0
                     eta = el * (t_end - ts) / (ts - ts0) if math.isfinite(ts) and ts > ts0 else math.nan
-                    print(f"  [{fmt_duration(el)}] V{job.paper.run} t = {fmt(ts, '.3f', '--')}/{t_end:g} s "
+                    print(f"  [{fmt_duration(el)}] {job.paper.label} t = {fmt(ts, '.3f', '--')}/{t_end:g} s "
                           f"(ETA {fmt_duration(eta)})", flush=True)
         except KeyboardInterrupt:
             proc.terminate()
@@ -183,18 +195,18 @@ def run_job(job, t_end, progress_every):
             except subprocess.TimeoutExpired:
                 proc.kill()
                 proc.wait()
-            print(f"\n{PROG}: interrupted; stopped V{job.paper.run}", file=sys.stderr)
+            print(f"\n{PROG}: interrupted; stopped {job.paper.label}", file=sys.stderr)
             sys.exit(130)
     rc = proc.returncode
     el = time.monotonic() - t0
     if rc == 0:
         job.source = "ran"
-        print(f"V{job.paper.run}: done in {fmt_duration(el)}", flush=True)
+        print(f"{job.paper.label}: done in {fmt_duration(el)}", flush=True)
     else:
         what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
         job.source = "FAILED"
         job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else f"killed by signal {-rc}"
-        print(f"V{job.paper.run}: FAILED after {fmt_duration(el)}: {job.message}; "
+        print(f"{job.paper.label}: FAILED after {fmt_duration(el)}: {job.message}; "
               f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
         for line in tail(os.path.join(job.outdir, "mixsph.log")):
             print(f"    | {line}", flush=True)
@@ -381,11 +393,11 @@ def rows_of(results):
         if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 1.6) > T_TOL:
             status += f", t={r.sim_time:.3g} s"
         rows.append([
-            f"V{p.run}", p.change, status, fmt(r.dx, "g"), str(r.particles) if r.particles else "n/a",
-            str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), f"{p.elapsed_s:,.0f}",
-            fmt(r.run_up, ".3f"), f"{p.run_up:.3f}", fmt(r.t_run_up, ".2f"), f"{p.t_run_up:.2f}",
-            fmt(r.Z, ".1f"), f"{p.Z:.1f}", fmt(r.d_eta, ".1f"), f"{p.d_eta:g}",
-            fmt(r.lost, ".0f"), fmt(r.mass_drift, ".1e"),
+            p.label, p.change, status, fmt(r.dx, "g"), str(r.particles) if r.particles else "n/a",
+            str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), "-" if p.twin else f"{p.elapsed_s:,.0f}",
+            fmt(r.run_up, ".3f"), "-" if p.twin else f"{p.run_up:.3f}", fmt(r.t_run_up, ".2f"),
+            "-" if p.twin else f"{p.t_run_up:.2f}", fmt(r.Z, ".1f"), "-" if p.twin else f"{p.Z:.1f}",
+            fmt(r.d_eta, ".1f"), "-" if p.twin else f"{p.d_eta:g}", fmt(r.lost, ".0f"), fmt(r.mass_drift, ".1e"),
         ])
     rows.append(["exp.", "test No. 48", "", "", "", "", "", "", f"{EXP_RUN_UP:.3f}", "", "", "",
                  f"{EXP_Z:.1f}", "", "", "", "", ""])
@@ -406,28 +418,40 @@ def print_table(rows):
 ORDER_TOL = 0.001  # [m] run-up differences below this are no ordering (paper's: 15 and 17 mm)
 
 
+def twin_floor(results):
+    """|run-up of V1 twin - run-up of V1| [m], when both finished (else nan): the floor under
+    the differences between runs (--twin)."""
+    ok = {r.paper.twin: r for r in results if r.ok and r.paper.run == 1 and math.isfinite(r.run_up)}
+    return abs(ok[True].run_up - ok[False].run_up) if len(ok) == 2 else math.nan
+
+
 def ordering(results):
     """The paper's ordering: V2 (lower phi) above V1, V4 (saturated) below V1. Each check is
-    (what, verdict, detail), verdict True (holds), False (does not) or None (the two run-ups
-    differ by less than ORDER_TOL: neither)."""
-    by = {r.paper.run: r for r in results if r.ok and math.isfinite(r.run_up)}
+    (what, verdict, detail), verdict True (holds), False (does not) or None (undecided: the two
+    run-ups differ by less than ORDER_TOL, or, with a V1 twin, by no more than the twin's floor)."""
+    by = {r.paper.run: r for r in results if r.ok and math.isfinite(r.run_up) and not r.paper.twin}
+    floor = twin_floor(results)
+    note = f"; twin floor {floor * 1000:.1f} mm" if math.isfinite(floor) else ""
     out = []
 
     def verdict(d, sign):
-        return None if abs(d) < ORDER_TOL else d * sign > 0
+        return None if abs(d) < ORDER_TOL or abs(d) <= floor else d * sign > 0   # (nan <= : False)
 
     if 1 in by and 2 in by:
         d = by[2].run_up - by[1].run_up
-        out.append(("lower phi (V2) raises the run-up", verdict(d, +1), f"V2 - V1 = {d * 1000:+.1f} mm (paper +15 mm)"))
+        out.append(("lower phi (V2) raises the run-up", verdict(d, +1),
+                    f"V2 - V1 = {d * 1000:+.1f} mm (paper +15 mm){note}"))
     if 1 in by and 4 in by:
         d = by[4].run_up - by[1].run_up
-        out.append(("saturation (V4) lowers the run-up", verdict(d, -1), f"V4 - V1 = {d * 1000:+.1f} mm (paper -17 mm)"))
+        out.append(("saturation (V4) lowers the run-up", verdict(d, -1),
+                    f"V4 - V1 = {d * 1000:+.1f} mm (paper -17 mm){note}"))
     return out
 
 
 def verdict_text(holds):
     if holds is None:
-        return f"undecided, the run-ups differ by less than {ORDER_TOL * 1000:g} mm"
+        return (f"undecided, the run-ups differ by less than {ORDER_TOL * 1000:g} mm or by no more than the "
+                "V1 twin's floor")
     return "holds" if holds else "does NOT hold"
 
 
@@ -437,7 +461,7 @@ def write_csv(path, results):
               "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
               "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
               "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "crossed_walls",
-              "outdir"]
+              "outdir", "twin"]
 
     def v(x):
         if isinstance(x, float):
@@ -453,7 +477,7 @@ def write_csv(path, results):
                 f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
                 r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
                 r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.drho,
-                r.drho_t, r.drho99, r.crossed, r.outdir)])
+                r.drho_t, r.drho99, r.crossed, r.outdir, int(p.twin))])
 
 
 def write_md(path, results, header_lines, checks):
@@ -564,8 +588,8 @@ def draw_snapshot(fig, ax, r, t_want, label, granular):
 
 
 def plot(path, results, plot_runs, granular):
-    shown = [r for r in results if r.paper.run in plot_runs and r.profiles]
-    first = next((r for r in results if r.paper.run in plot_runs and r.ok), None)
+    shown = [r for r in results if r.paper.run in plot_runs and r.profiles and not r.paper.twin]
+    first = next((r for r in results if r.paper.run in plot_runs and r.ok and not r.paper.twin), None)
     n = len(shown) + (2 if first else 0)
     if n == 0:
         return False
@@ -631,6 +655,9 @@ def main():
     ap.add_argument("--sphera", action="store_true",
                     help="run with the numerical options of SPHERA's own input for this test ("
                     + ", ".join(f"{k}={num(v)}" for k, v in SPHERA_OPTIONS) + "), before any --set")
+    ap.add_argument("--twin", type=float, metavar="REL",
+                    help="also run V1 again with gravity x (1 + REL), e.g. 1e-6, into V1_dx<D>_twin, and compare "
+                    "it with V1: the floor under the differences between runs")
     ap.add_argument("--progress", type=float, default=60.0,
                     help="print the simulated time every this many seconds (default 60, 0: never)")
     args = ap.parse_args()
@@ -645,6 +672,10 @@ def main():
         fail("--t-end must be a positive number of seconds")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
+    if args.twin is not None and not (0 < abs(args.twin) < 1e-3):
+        fail("--twin REL: a relative change of gravity between 0 and 1e-3 in size, e.g. 1e-6")
+    if args.twin is not None and 1 not in runs:
+        fail("--twin: V1, the run it repeats, is not among --runs")
     try:
         extra = (list(SPHERA_OPTIONS) if args.sphera else []) + mt.parse_sets(args.sets,
                                                                                "parameters.tension_cutoff=1")
@@ -661,6 +692,10 @@ def main():
     except (OSError, ValueError) as e:
         fail(f"{show(case)}: cannot read the case: {e}")
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
+    g = case_json.get("gravity")
+    g = next((v for k, v in reversed(extra) if k == "gravity"), g)   # a --set gravity=... counts
+    if args.twin is not None and not (isinstance(g, (int, float)) and not isinstance(g, bool)):
+        fail(f"{show(case)}: no numeric 'gravity' to perturb for --twin")
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:
@@ -669,13 +704,19 @@ def main():
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
 
+    plan = [(PAPER[k], extra) for k in runs]
+    if args.twin is not None:
+        nan = math.nan
+        plan.append((dataclasses.replace(PAPER[1], twin=True, change=f"V1, gravity x (1 + {args.twin:g})",
+                                         elapsed_s=nan, run_up=nan, t_run_up=nan, Z=nan, d_eta=nan),
+                     extra + [("gravity", g * (1.0 + args.twin))]))
     jobs = []
-    for k in runs:
-        p = PAPER[k]
+    for p, more in plan:
+        k = p.run
         dx = round(args.dx * p.dx_ratio, 12)
-        d = os.path.join(out, f"V{k}_dx{dx:g}")
+        d = os.path.join(out, f"V{k}_dx{dx:g}" + ("_twin" if p.twin else ""))
         cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(dx)}"]
-        sets = list(p.sets) + extra
+        sets = list(p.sets) + more
         for key, val in sets:
             cmd += ["--set", f"{key}={num(val)}"]
         if args.t_end is not None:
@@ -683,14 +724,14 @@ def main():
         cmd += ["--threads", str(threads), "--quiet"]
         if args.checkpoint_every > 0:
             cmd += ["--checkpoint-every", num(args.checkpoint_every)]
-        stamp = {"run": k, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
+        stamp = {"run": k, "twin": p.twin, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
                  "case_sha256": case_sha, "threads": threads, "command": cmd}
         jobs.append(Job(p, dx, d, cmd, stamp))
 
     signal.signal(signal.SIGTERM, on_sigterm)
     failed = []
     for job in jobs:
-        if args.reuse and not mt.plan_reuse(job, f"V{job.paper.run}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
+        if args.reuse and not mt.plan_reuse(job, job.paper.label, STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
                                             threads, args.checkpoint_every):
             continue
         rc = run_job(job, t_end, args.progress)
@@ -727,8 +768,16 @@ def main():
     print("lost: particles that left the domain; mass drift: max |M(t) - M(0)| / M(0) of the fluid and granular "
           "particles.")
     print()
+    by_run = {r.paper.run: r for r in results if r.ok and not r.paper.twin}
     for r in results:
-        if r.ok:
+        if r.ok and r.paper.twin:
+            v1 = by_run.get(1)
+            diff = (f"{(r.run_up - v1.run_up) * 1000:+.1f} mm and {r.t_run_up - v1.t_run_up:+.3f} s from V1's"
+                    if v1 else "V1 not finished")
+            print(f"{r.paper.label}: max run-up {fmt(r.run_up, '.3f')} m at t = {fmt(r.t_run_up, '.3f')} s, "
+                  f"{diff} (the floor under the differences between runs at dx = {r.dx:g} m); wall time "
+                  f"{fmt(r.wall, '.0f')} s on {r.threads} thread(s)")
+        elif r.ok:
             p = r.paper
             print(f"V{p.run}: max run-up {fmt(r.run_up, '.3f')} m at t = {fmt(r.t_run_up, '.3f')} s, "
                   f"Z = {fmt(r.Z, '.1f')} m a.m.s.l., d_eta = {fmt(r.d_eta, '.1f')} % at dx = {r.dx:g} m "
@@ -745,7 +794,7 @@ def main():
         if r.status in ("not run", "missing", "no summary"):
             continue
         crossed = str(r.crossed) if r.crossed >= 0 else "n/a (no snapshots)"
-        print(f"  V{r.paper.run}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, particles below the bed "
+        print(f"  {r.paper.label}: status {r.status}, lost particles {fmt(r.lost, '.0f')}, particles below the bed "
               f"or behind the plate (most in a snapshot) {crossed}, mass drift "
               f"{fmt(r.mass_drift, '.1e')}, wall-crossing corrections {fmt(r.wall_corr, '.0f')}, "
               f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, max |rho/rho0 - 1| over the "
@@ -765,7 +814,7 @@ def main():
     print(f"table: {show(csv_path)}, {show(md_path)}")
     print(f"plot:  {show(png_path)}" if drew else "plot:  none (no profiles of the plotted runs)")
     if failed:
-        fail("mixsph failed for " + "; ".join(f"V{j.paper.run}: {j.message}" for j in failed), code=1)
+        fail("mixsph failed for " + "; ".join(f"{j.paper.label}: {j.message}" for j in failed), code=1)
 
 
 if __name__ == "__main__":

@@ -134,6 +134,15 @@ def test_ordering_verdicts():
     assert [c[1] for c in checks] == [None, None]
     assert "undecided" in vv.verdict_text(None) and vv.verdict_text(False) == "does NOT hold"
     assert vv.ordering([result(1, 0.712)]) == []
+    # with a V1 twin (--twin), a difference no larger than |twin - V1| decides nothing: here the
+    # floor is 4 mm, V2 - V1 = +15 mm holds, V4 - V1 = -3 mm is undecided
+    twin = result(1, 0.716)
+    twin.paper = vv.dataclasses.replace(vv.PAPER[1], twin=True)
+    assert vv.twin_floor([result(1, 0.712), twin]) == pytest.approx(0.004)
+    checks = vv.ordering([result(1, 0.712), result(2, 0.727), result(4, 0.709), twin])
+    assert [c[1] for c in checks] == [True, None]
+    assert "twin floor 4.0 mm" in checks[1][2]
+    assert math.isnan(vv.twin_floor([result(1, 0.712)]))
 
 
 def test_set_reaches_every_run(tmp_path):
@@ -207,3 +216,34 @@ def test_run_wall_time_of_summaries():
     assert math.isnan(mt.run_wall_time(summ)) and math.isnan(mt.run_particle_steps_per_s(summ))
     summ["run_wall_time_s"] = 25.0
     assert mt.run_particle_steps_per_s(summ) == 2.0
+
+
+def test_twin_reruns_v1_with_perturbed_gravity(tmp_path):
+    # --twin REL runs V1 again with gravity x (1 + REL) into V1_dx<D>_twin (row "V1 twin", CSV
+    # column twin = 1); refused (exit 2, nothing created) out of range or without V1 among --runs.
+    # Runs build/mixsph for 0.01 s of V1 at dx 0.03, twice.
+    import csv
+    import subprocess
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        pytest.skip("build/mixsph not built")
+    tool = [sys.executable, os.path.join(ROOT, "tools", "vajont_validate.py"), "--mixsph", mixsph,
+            "--dx", "0.03", "--t-end", "0.01", "--threads", "1", "--progress", "0"]
+    for opts, message in ((["--runs", "2", "--twin", "1e-6"], "--twin: V1, the run it repeats, is not among --runs"),
+                          (["--runs", "1", "--twin", "0.1"], "--twin REL: a relative change of gravity")):
+        bad = tmp_path / "bad"
+        r = subprocess.run(tool + opts + ["--out", str(bad)], capture_output=True, text=True, timeout=120)
+        assert r.returncode == 2 and message in r.stderr, r.stderr
+        assert not bad.exists()
+    out = tmp_path / "out"
+    r = subprocess.run(tool + ["--runs", "1", "--twin", "1e-6", "--out", str(out)], capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "V1 twin: max run-up" in r.stdout
+    with open(out / "vajont_table.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert [(row["run"], row["twin"], row["status"]) for row in rows] == [("V1", "0", "ok"), ("V1", "1", "ok")]
+    assert rows[1]["outdir"].endswith("V1_dx0.03_twin")
+    with open(out / "V1_dx0.03_twin" / vv.STAMP) as f:
+        stamp = json.load(f)
+    assert stamp["sets"] == [["gravity", case_json()["gravity"] * (1 + 1e-6)]]
