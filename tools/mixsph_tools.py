@@ -268,6 +268,19 @@ def parse_sets(texts, example):
     return out
 
 
+def twin_gravity(case_json, sets, rel, case_name):
+    """The gravity of a --twin REL run: the case's ``gravity`` (or the last --set gravity=... of
+    ``sets``) x (1 + REL). Raises ToolError when REL is not a relative change between 0 and 1e-3
+    in size or the case has no numeric gravity."""
+    if not (isinstance(rel, (int, float)) and 0 < abs(rel) < 1e-3):
+        raise ToolError("--twin REL: a relative change of gravity between 0 and 1e-3 in size, e.g. 1e-6")
+    g = case_json.get("gravity")
+    g = next((v for k, v in reversed(sets) if k == "gravity"), g)   # a --set gravity=... counts
+    if not isinstance(g, (int, float)) or isinstance(g, bool):
+        raise ToolError(f"{case_name}: no numeric 'gravity' to perturb for --twin")
+    return g * (1.0 + rel)
+
+
 def num(v):
     """A number for the command line: 0.01 -> '0.01', 20700.0 -> '20700', 1e12 -> '1000000000000'."""
     v = float(v)

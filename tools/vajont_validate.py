@@ -672,8 +672,6 @@ def main():
         fail("--t-end must be a positive number of seconds")
     if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
         fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
-    if args.twin is not None and not (0 < abs(args.twin) < 1e-3):
-        fail("--twin REL: a relative change of gravity between 0 and 1e-3 in size, e.g. 1e-6")
     if args.twin is not None and 1 not in runs:
         fail("--twin: V1, the run it repeats, is not among --runs")
     try:
@@ -692,10 +690,10 @@ def main():
     except (OSError, ValueError) as e:
         fail(f"{show(case)}: cannot read the case: {e}")
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
-    g = case_json.get("gravity")
-    g = next((v for k, v in reversed(extra) if k == "gravity"), g)   # a --set gravity=... counts
-    if args.twin is not None and not (isinstance(g, (int, float)) and not isinstance(g, bool)):
-        fail(f"{show(case)}: no numeric 'gravity' to perturb for --twin")
+    try:
+        g_twin = mt.twin_gravity(case_json, extra, args.twin, show(case)) if args.twin is not None else None
+    except mt.ToolError as e:
+        fail(str(e))
     try:
         cores = len(os.sched_getaffinity(0))
     except AttributeError:
@@ -709,7 +707,7 @@ def main():
         nan = math.nan
         plan.append((dataclasses.replace(PAPER[1], twin=True, change=f"V1, gravity x (1 + {args.twin:g})",
                                          elapsed_s=nan, run_up=nan, t_run_up=nan, Z=nan, d_eta=nan),
-                     extra + [("gravity", g * (1.0 + args.twin))]))
+                     extra + [("gravity", g_twin)]))
     jobs = []
     for p, more in plan:
         k = p.run

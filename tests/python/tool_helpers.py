@@ -13,6 +13,26 @@ import mixsph_tools as mt  # noqa: E402
 ENV = dict(os.environ, OMP_WAIT_POLICY="passive")   # the tests share the cores
 
 
+def script_command(script, *opts):
+    """[python, tools/<script>, --mixsph build/mixsph, *opts]; skips the test when build/mixsph
+    is not built."""
+    import pytest
+    mixsph = os.path.join(ROOT, "build", "mixsph")
+    if not os.access(mixsph, os.X_OK):
+        pytest.skip("build/mixsph not built")
+    return [sys.executable, os.path.join(ROOT, "tools", script), "--mixsph", mixsph, *opts]
+
+
+def assert_refused(tool, cases, out, timeout=120):
+    """Each (options, message) of ``cases``: the script ``tool`` + options + --out ``out``
+    exits 2 with the message on stderr and creates nothing at ``out``."""
+    for opts, message in cases:
+        r = subprocess.run(tool + opts + ["--out", str(out)], capture_output=True, text=True, env=ENV,
+                           timeout=timeout)
+        assert r.returncode == 2 and message in r.stderr, r.stderr
+        assert not os.path.exists(out)
+
+
 def cut_off(cmd, run_dir, t_min, timeout=240):
     """Start a script (cmd) and kill it and its mixsph with SIGKILL, as the end of a session does,
     once run_dir holds a checkpoint and monitors.csv has reached t_min. Returns the run's
