@@ -65,6 +65,7 @@ modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 51
 
 import argparse
 import csv
+import dataclasses
 import json
 import math
 import os
@@ -72,7 +73,6 @@ import signal
 import subprocess
 import sys
 import time
-import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
