@@ -392,12 +392,13 @@ def rows_of(results):
         status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
         if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 1.6) > T_TOL:
             status += f", t={r.sim_time:.3g} s"
+        paper = fmt if not p.twin else (lambda v, spec: "-")   # a twin has no paper values
         rows.append([
             p.label, p.change, status, fmt(r.dx, "g"), str(r.particles) if r.particles else "n/a",
-            str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), "-" if p.twin else f"{p.elapsed_s:,.0f}",
-            fmt(r.run_up, ".3f"), "-" if p.twin else f"{p.run_up:.3f}", fmt(r.t_run_up, ".2f"),
-            "-" if p.twin else f"{p.t_run_up:.2f}", fmt(r.Z, ".1f"), "-" if p.twin else f"{p.Z:.1f}",
-            fmt(r.d_eta, ".1f"), "-" if p.twin else f"{p.d_eta:g}", fmt(r.lost, ".0f"), fmt(r.mass_drift, ".1e"),
+            str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), paper(p.elapsed_s, ",.0f"),
+            fmt(r.run_up, ".3f"), paper(p.run_up, ".3f"), fmt(r.t_run_up, ".2f"), paper(p.t_run_up, ".2f"),
+            fmt(r.Z, ".1f"), paper(p.Z, ".1f"), fmt(r.d_eta, ".1f"), paper(p.d_eta, "g"),
+            fmt(r.lost, ".0f"), fmt(r.mass_drift, ".1e"),
         ])
     rows.append(["exp.", "test No. 48", "", "", "", "", "", "", f"{EXP_RUN_UP:.3f}", "", "", "",
                  f"{EXP_Z:.1f}", "", "", "", "", ""])
