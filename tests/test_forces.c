@@ -334,6 +334,127 @@ static void test_momentum_conservation(void **state)
     free(az0);
 }
 
+
+/* The switches of the Monaghan term (numerics.av_mixed, numerics.av_separating: SPHERA applies
+ * it to every pair of particles, separating ones too): each combination against the formula,
+ * with alpha c h of the pair the larger of the two particles' (forces.c). */
+static void test_monaghan_switches(void **state)
+{
+    mixsph_sim *s = *state;
+    struct particles *P = &s->P;
+    const struct kernel *K = &s->K;
+    const double eta2 = 0.01 * s->h * s->h;
+    const double F0 = kernel_f(K, 0.0);
+    const size_t n = P->n;
+    double *mu = malloc(n * sizeof *mu);
+    assert_non_null(mu);
+    memcpy(mu, P->mu, n * sizeof *mu);
+    double alpha[CASE_MAX_MEDIA];
+    for (size_t k = 0; k < s->cfg.n_media; k++) alpha[k] = s->cfg.media[k].alpha_m;
+    select_terms(s, TERM_MONAGHAN, alpha, mu);
+    size_t on[4] = {0}, off[4] = {0};
+    for (int mode = 0; mode < 4; mode++) {
+        const int mixed = mode & 1, separating = (mode >> 1) & 1;
+        s->cfg.av_mixed = mixed;
+        s->cfg.av_separating = separating;
+        for (size_t i = 0; i < n; i++) {
+            if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+            for (size_t j = 0; j < n; j++) {
+                if (j == i || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= K->r2max) continue;
+                const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j], r2 = rx * rx + rz * rz;
+                const double F = kernel_f(K, sqrt(r2));
+                const double ux = P->vx[i] - P->vx[j], uz = P->vz[i] - P->vz[j], vr = ux * rx + uz * rz;
+                const double rhoi = P->rho[i], rhoj = P->rho[j], mj = P->m[j];
+                const struct medium *mdi = &s->cfg.media[P->medium[i]], *mdj = &s->cfg.media[P->medium[j]];
+                const double avc = fmax(mdi->alpha_m * mdi->c, mdj->alpha_m * mdj->c) * s->h;
+                const int acts = (vr < 0.0 || separating) && (P->medium[i] == P->medium[j] || mixed);
+                double ax, az, dr;
+                forces_pair_for_test(s, i, j, &ax, &az, &dr);
+                const double fa = acts ? mj * avc * vr / (r2 + eta2) / (0.5 * (rhoi + rhoj)) * F : 0.0;
+                /* reference: Monaghan's Pi_ij with the pair's switches; tolerance as in
+                 * test_pair_terms (the mean of 1/rho for 1/rho_bar) */
+                const double tol = 1e-12 + (rhoi - rhoj) * (rhoi - rhoj) / (4.0 * rhoi * rhoj);
+                const double scale = mj * avc * fabs(vr) / (r2 + eta2) / (0.5 * (rhoi + rhoj)) * fabs(F0);
+                assert_true(hypot(ax - fa * rx, az - fa * rz) <= tol * scale * sqrt(r2));
+                /* dissipative whenever it acts: the force opposes the relative velocity's
+                 * component along x_ij */
+                if (acts && fa != 0.0) assert_true((ax * rx + az * rz) * vr < 0.0);
+                acts ? on[mode]++ : off[mode]++;
+            }
+        }
+    }
+    s->cfg.av_mixed = 0;
+    s->cfg.av_separating = 0;
+    select_terms(s, TERM_PRESSURE | TERM_MONAGHAN | TERM_MORRIS_MIXED, alpha, mu);
+    free(mu);
+    /* every mode met pairs where the term acts, and all but the all-pairs mode pairs where it
+     * does not */
+    for (int mode = 0; mode < 4; mode++) assert_true(on[mode] > 1000);
+    assert_true(off[0] > off[1] && off[1] > 0 && off[2] > 0 && off[3] == 0);
+}
+
+/* A fluid layer sliding along a wall (numerics.av_wall): with the Monaghan term between fluid
+ * and wall particles (the default) the wall drags the layer, since a particle approaches the
+ * wall particles ahead of it; without it, the fluid-wall pair forces carry no tangential part
+ * (no laminar viscosity, pressures 0). */
+static const char *const SLIDE_CASE =
+    "{\n"
+    "  \"name\": \"wall_slide\",\n"
+    "  \"gravity\": 0.0,\n"
+    "  \"numerics\": { \"dx\": 0.01, \"t_end\": 0.1 },\n"
+    "  \"media\": { \"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 30.0, \"mu\": 0.0, \"alpha_m\": 0.1 } },\n"
+    "  \"bodies\": { \"layer\": { \"medium\": \"water\", \"polygon\": [[0.0, 0.0], [0.3, 0.0], [0.3, 0.05], [0.0, 0.05]] } },\n"
+    "  \"walls\": { \"bed\": { \"polyline\": [[-0.2, 0.0], [0.5, 0.0]], \"fluid_side\": \"left\" } }\n"
+    "}\n";
+
+static void test_monaghan_at_walls(void **state)
+{
+    (void)state;
+    mixsph_sim *s = NULL;
+    char err[512];
+    assert_int_equal(mixsph_sim_create_from_text(SLIDE_CASE, "wall_slide.json", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    struct particles *P = &s->P;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+        P->vx[i] = P->uvx[i] = 1.0; /* sliding along the wall, +x */
+        P->vz[i] = P->uvz[i] = 0.0;
+        P->rho[i] = s->cfg.media[0].rho0; /* p = 0 */
+    }
+    integrate_eos(s);
+    for (int av_wall = 1; av_wall >= 0; av_wall--) {
+        s->cfg.av_wall = av_wall;
+        double drag = 0.0, mass = 0.0;
+        size_t pairs = 0;
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->state[i] != MIXSPH_STATE_MOBILE || P->x[i] < 0.05 || P->x[i] > 0.25) continue; /* away from the ends */
+            for (size_t j = 0; j < P->n; j++) {
+                if (P->state[j] != MIXSPH_STATE_WALL || dist2(P, i, j) >= s->K.r2max) continue;
+                double ax, az, dr;
+                forces_pair_for_test(s, i, j, &ax, &az, &dr);
+                if (!av_wall) {
+                    /* reference: no term acts (no pressure, no viscosity, no Monaghan term);
+                     * tolerance: exactly 0 */
+                    assert_true(ax == 0.0 && az == 0.0);
+                } else {
+                    const double vr = (P->vx[i] - P->vx[j]) * (P->x[i] - P->x[j]) + (P->vz[i] - P->vz[j]) * (P->z[i] - P->z[j]);
+                    /* approaching wall particles resist, receding ones do not */
+                    if (vr >= 0.0) assert_true(ax == 0.0 && az == 0.0);
+                    else assert_true(ax < 0.0);
+                }
+                drag += P->m[i] * ax;
+                pairs++;
+            }
+            mass += P->m[i];
+        }
+        print_message("av_wall = %d: %zu fluid-wall pairs, mean tangential acceleration %.4g m/s2\n", av_wall, pairs,
+                      drag / mass);
+        assert_true(pairs > 100);
+        if (av_wall) assert_true(drag < 0.0); /* a net drag against the sliding */
+        else assert_true(drag == 0.0);
+    }
+    mixsph_sim_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -341,6 +462,8 @@ int main(void)
         cmocka_unit_test(test_pair_symmetry),
         cmocka_unit_test(test_pair_terms),
         cmocka_unit_test(test_momentum_conservation),
+        cmocka_unit_test(test_monaghan_switches),
+        cmocka_unit_test(test_monaghan_at_walls),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -246,10 +246,12 @@ static int find_motion(const struct case_def *c, const char *name)
 
 /* ---- sections ----------------------------------------------------------------------------- */
 
+static mixsph_status get_bool(struct reader *r, const cJSON *obj, const char *path, const char *key, int *out);
+
 static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct case_def *c)
 {
     static const char *const keys[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "t_end", "wall_layers", "background_pressure", "kernel", "pressure_smoothing",
-                                        "fixed_bed_speed", NULL};
+                                        "fixed_bed_speed", "av_wall", "av_mixed", "av_separating", NULL};
     const cJSON *n;
     TRY(get_obj(r, root, "", "numerics", 1, &n));
     TRY(check_keys(r, n, "numerics", keys));
@@ -274,6 +276,12 @@ static mixsph_status read_numerics(struct reader *r, const cJSON *root, struct c
     TRY(get_num(r, n, "numerics", "pressure_smoothing", 0, 0.0, 0, 1.0, &c->pressure_smoothing));
     c->fixed_bed_speed = -1.0;
     TRY(get_num(r, n, "numerics", "fixed_bed_speed", 0, -1.0, 0, 100.0, &c->fixed_bed_speed));
+    c->av_wall = 1;
+    c->av_mixed = 0;
+    c->av_separating = 0;
+    TRY(get_bool(r, n, "numerics", "av_wall", &c->av_wall));
+    TRY(get_bool(r, n, "numerics", "av_mixed", &c->av_mixed));
+    TRY(get_bool(r, n, "numerics", "av_separating", &c->av_separating));
     c->wall_layers = (int)layers;
     if ((double)c->wall_layers != layers) return FAIL(r, "%s: numerics.wall_layers: expected an integer", r->origin);
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
@@ -312,7 +320,7 @@ static mixsph_status read_sound_speed(struct reader *r, const cJSON *it, const c
 static mixsph_status read_granular(struct reader *r, const cJSON *it, const char *path, struct case_def *c, struct medium *md)
 {
     static const char *const keys[] = {"type", "rho", "K", "c", "porosity", "phi", "d50", "saturated", "pore_fluid",
-                                       "mu_thr", "mu0", "mu1", "tension_cutoff", "hold_fixed", NULL};
+                                       "mu_thr", "mu0", "mu1", "tension_cutoff", "hold_fixed", "alpha_m", NULL};
     TRY(check_keys(r, it, path, keys));
     md->kind = MEDIUM_GRANULAR;
     TRY(get_num(r, it, path, "rho", 1, 0.0, 1, 1e5, &md->rho_grain));
@@ -362,6 +370,7 @@ static mixsph_status read_granular(struct reader *r, const cJSON *it, const char
     TRY(get_bool(r, it, path, "hold_fixed", &md->hold_fixed));
     md->mu = 0.0;
     md->alpha_m = 0.0;
+    TRY(get_num(r, it, path, "alpha_m", 0, 0.0, 0, 10.0, &md->alpha_m));
     return MIXSPH_OK;
 }
 

@@ -22,7 +22,7 @@ struct medium {
     double rho0;       /* reference density [kg/m3]; granular: the mixture density (5) */
     double c;          /* sound speed [m/s]; granular: sqrt(K_s / rho_s) */
     double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
-    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (fluids only) */
+    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (granular: 0 unless given) */
     /* granular media (MODEL.md sections 5-6) */
     double rho_grain;  /* density of the grains rho_s [kg/m3] */
     double porosity;   /* n = eps_f at the packing limit [-] */
@@ -125,6 +125,9 @@ struct case_def {
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
     double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
                                  bed; < 0: off (the default) */
+    int av_wall;              /* artificial viscosity between fluid and wall particles (default 1) */
+    int av_mixed;             /* ... between particles of different media (default 0: same medium only) */
+    int av_separating;        /* ... also on separating pairs (default 0: approaching pairs only) */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */

@@ -61,6 +61,9 @@
 /* Per-step constants of the pair loops. */
 struct pair_ctx {
     double inv_h, f_fac, eta2, r2max, a_d, g;
+    double av_wall;  /* 1: artificial viscosity between fluid and wall particles, 0: not */
+    double av_mixed; /* 1: ... between particles of different media too, 0: same medium only */
+    double av_cap;   /* u_ij.x_ij is capped at this: 0 (approaching pairs only) or +inf (all pairs) */
     int wendland;
     double *fk;           /* the kernel-factor cache (see forces_continuity), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
@@ -74,6 +77,9 @@ static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
     X->r2max = s->K.r2max;
     X->a_d = s->K.a_d;
     X->g = s->cfg.g;
+    X->av_wall = s->cfg.av_wall ? 1.0 : 0.0;
+    X->av_mixed = s->cfg.av_mixed ? 1.0 : 0.0;
+    X->av_cap = s->cfg.av_separating ? INFINITY : 0.0;
     X->wendland = s->K.type == KERNEL_WENDLAND_C2;
     X->fk = NULL;
     X->fk_off = NULL;
@@ -274,10 +280,12 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
             /* pressure */
             double fr = -vv * (pi + p[j]);
-            /* artificial viscosity: approaching pairs of one fluid medium, or fluid and wall */
+            /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
+             * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
+             * avc is 0 for a medium without it */
             double vdotr = (vxi - vx[j]) * rx + (vzi - vz[j]) * rz;
-            vdotr = vdotr < 0.0 ? vdotr : 0.0;
-            const double same = (tag[j] == ti ? 1.0 : 0.0) + walli + wallj > 0.0 ? 1.0 : 0.0;
+            vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
+            const double same = (tag[j] == ti ? 1.0 : 0.0) + Xl.av_mixed * (1.0 - walli - wallj) + Xl.av_wall * (walli + wallj) > 0.0 ? 1.0 : 0.0;
             const double avc_ij = avci > avc[j] ? avci : avc[j];
             /* m_i m_j (1/rho_i + 1/rho_j) / 2 = m_i (m_j / rho_i + V_j) / 2 */
             fr += same * (1.0 - walli * wallj) * avc_ij * mi * (m[j] * irhoi + vol[j]) * vdotr * inv_r2e * 0.5;

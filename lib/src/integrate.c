@@ -67,7 +67,7 @@ void integrate_eos(mixsph_sim *s)
         P->p[i] = p;
         P->inv_rho[i] = 1.0 / P->rho[i];
         P->vol[i] = P->m[i] * P->inv_rho[i];
-        P->avc[i] = m->kind == MEDIUM_FLUID ? m->alpha_m * m->c * s->h : 0.0;
+        P->avc[i] = m->alpha_m * m->c * s->h;
     }
 }
 
