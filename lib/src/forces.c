@@ -2,7 +2,7 @@
  *
  *   d rho_i/dt = rho_i sum_j V_j (u_i - u_j) . grad_i W_ij
  *   d u_i/dt   = -1/rho_i sum_j V_j (p_i + p_j) grad_i W_ij          (= -sum m_j (p_i+p_j)/(rho_i rho_j) gradW)
- *                - sum_j m_j Pi_ij grad_i W_ij                         (Monaghan, same fluid medium only)
+ *                - sum_j m_j Pi_ij grad_i W_ij                         (Monaghan: see below)
  *                + 1/rho_i sum_j V_j 2 mu_ij F r^2/(r^2 + eta^2) (u_i - u_j)   (Morris et al. 1997)
  *                + g
  * with V_j = m_j / rho_j, grad_i W_ij = F(r) (x_i - x_j) (kernel.h), eta^2 = 0.01 h^2,
@@ -10,7 +10,12 @@
  * the explicit viscous step of a mobile grain next to a fixed one at mu_thr stays governed by
  * the grain's own viscosity, and water slides past grains with the water's viscosity), and
  * Pi_ij = -alpha c h min(u_ij . x_ij, 0) / (r^2 + eta^2) (1/rho_i + 1/rho_j)/2 (the mean of the
- * inverse densities: symmetric, like the usual inverse of the mean, and free of divisions).
+ * inverse densities: symmetric, like the usual inverse of the mean, and free of divisions), with
+ * alpha c h the larger of the two particles' (0 for a medium without alpha_m). By default it acts
+ * between particles of one medium (MODEL.md: water-water) and between a particle and walls;
+ * numerics.av_wall = 0 drops the wall pairs, av_mixed = 1 adds pairs of different media and
+ * av_separating = 1 drops the min(., 0), all three as SPHERA does (its viscomon routine: every
+ * pair, separating ones too; at its semi-analytic walls only the wall-normal velocity).
  * Wall particles enter with V = dx^2, their extrapolated pressure (walls.c), the kernel mean
  * density of the fluid near them, the fluid's own viscosity (mu_wall = 0 plus the fluid's) and
  * their no-slip mirror velocity in the viscous term.
