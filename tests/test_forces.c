@@ -157,6 +157,27 @@ static void test_pair_symmetry(void **state)
     assert_true(pairs > 5000 && cross > 200);
 }
 
+/* Geometry and kinematics of the pair (i, j) of two distinct mobile particles within the support:
+ * returns 0 for any other pair. */
+struct pair_geom {
+    double rx, rz, r2, F, ux, uz, vr;
+};
+
+static int pair_geom(const mixsph_sim *s, size_t i, size_t j, struct pair_geom *g)
+{
+    const struct particles *P = &s->P;
+    if (j == i || P->state[i] != MIXSPH_STATE_MOBILE || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= s->K.r2max)
+        return 0;
+    g->rx = P->x[i] - P->x[j];
+    g->rz = P->z[i] - P->z[j];
+    g->r2 = g->rx * g->rx + g->rz * g->rz;
+    g->F = kernel_f(&s->K, sqrt(g->r2));
+    g->ux = P->vx[i] - P->vx[j];
+    g->uz = P->vz[i] - P->vz[j];
+    g->vr = g->ux * g->rx + g->uz * g->rz;
+    return 1;
+}
+
 /* Which term(s) of (3) are switched on. */
 enum { TERM_PRESSURE = 1, TERM_MONAGHAN = 2, TERM_MORRIS = 4, TERM_MORRIS_MIXED = 8 };
 
@@ -195,12 +216,10 @@ static void test_pair_terms(void **state)
     for (int term = TERM_PRESSURE; term <= TERM_MORRIS_MIXED; term <<= 1) {
         select_terms(s, term, alpha, mu);
         for (size_t i = 0; i < n; i++) {
-            if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
             for (size_t j = 0; j < n; j++) {
-                if (j == i || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= K->r2max) continue;
-                const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j], r2 = rx * rx + rz * rz;
-                const double F = kernel_f(K, sqrt(r2));
-                const double ux = P->vx[i] - P->vx[j], uz = P->vz[i] - P->vz[j], vr = ux * rx + uz * rz;
+                struct pair_geom g;
+                if (!pair_geom(s, i, j, &g)) continue;
+                const double rx = g.rx, rz = g.rz, r2 = g.r2, F = g.F, ux = g.ux, uz = g.uz, vr = g.vr;
                 const double rhoi = P->rho[i], rhoj = P->rho[j], mj = P->m[j];
                 double ax, az, dr;
                 forces_pair_for_test(s, i, j, &ax, &az, &dr);
@@ -358,12 +377,10 @@ static void test_monaghan_switches(void **state)
         s->cfg.av_mixed = mixed;
         s->cfg.av_separating = separating;
         for (size_t i = 0; i < n; i++) {
-            if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
             for (size_t j = 0; j < n; j++) {
-                if (j == i || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= K->r2max) continue;
-                const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j], r2 = rx * rx + rz * rz;
-                const double F = kernel_f(K, sqrt(r2));
-                const double ux = P->vx[i] - P->vx[j], uz = P->vz[i] - P->vz[j], vr = ux * rx + uz * rz;
+                struct pair_geom g;
+                if (!pair_geom(s, i, j, &g)) continue;
+                const double rx = g.rx, rz = g.rz, r2 = g.r2, F = g.F, vr = g.vr;
                 const double rhoi = P->rho[i], rhoj = P->rho[j], mj = P->m[j];
                 const struct medium *mdi = &s->cfg.media[P->medium[i]], *mdj = &s->cfg.media[P->medium[j]];
                 const double avc = fmax(mdi->alpha_m * mdi->c, mdj->alpha_m * mdj->c) * s->h;
