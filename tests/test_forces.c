@@ -470,6 +470,16 @@ static void test_monaghan_at_walls(void **state)
         else assert_true(drag == 0.0);
     }
     mixsph_sim_destroy(s);
+    /* a switch that is not a Boolean is refused, naming the key */
+    char text[2048];
+    const char *at = strstr(SLIDE_CASE, "\"t_end\": 0.1");
+    assert_non_null(at);
+    snprintf(text, sizeof text, "%.*s\"av_wall\": \"no\", %s", (int)(at - SLIDE_CASE), SLIDE_CASE, at);
+    s = NULL;
+    assert_int_equal(mixsph_sim_create_from_text(text, "wall_slide.json", NULL, 0, &s, err, sizeof err), MIXSPH_ERR_CASE);
+    assert_null(s);
+    print_message("refused: %s\n", err);
+    assert_non_null(strstr(err, "numerics.av_wall"));
 }
 
 int main(void)

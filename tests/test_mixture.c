@@ -509,6 +509,10 @@ static void test_hold_fixed(void **state)
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
                  "\"mu_thr\": 320e3, \"hold_fixed\": \"yes\" }",
                  "media.sand.hold_fixed");
+    /* the grains' Monaghan coefficient (numerics.av_mixed, test_forces.c): 0-10 */
+    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
+                 "\"mu_thr\": 320e3, \"alpha_m\": -0.1 }",
+                 "media.sand.alpha_m");
 }
 
 /* ---- (e) fixed bed (numerics.fixed_bed_speed, SPHERA's rule) ------------------------------- */
