@@ -92,7 +92,7 @@ static const char *const out_names[N_OUTS] = {"run_up",         "landslide_front
                                               "lost_particles", "fixed_particles", "run_up_Z", "water_kinetic_energy"};
 
 /* Boolean parameters: passed to the case as 0/1 overrides of `key` when the host sets them. */
-enum { B_SATURATED, B_TENSION_CUTOFF, N_BOOL_PARAMS };
+enum { B_SATURATED, B_TENSION_CUTOFF, B_AV_WALL, N_BOOL_PARAMS };
 static const struct {
     fmi2ValueReference vr;
     const char *name, *key;
@@ -100,6 +100,7 @@ static const struct {
 } bool_params[N_BOOL_PARAMS] = {
     {VR_saturated, "saturated", "parameters.saturated", START_saturated},
     {VR_tension_cutoff, "tension_cutoff", "parameters.tension_cutoff", START_tension_cutoff},
+    {VR_av_wall, "av_wall", "numerics.av_wall", START_av_wall},
 };
 
 /* The Boolean parameter of value reference vr, or -1. */

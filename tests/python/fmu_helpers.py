@@ -33,6 +33,7 @@ CASE_KEYS = {
     "output_interval": ["output.monitor_interval"],
     "tension_cutoff": ["parameters.tension_cutoff"],
     "pressure_smoothing": ["numerics.pressure_smoothing"],
+    "av_wall": ["numerics.av_wall"],
 }
 
 ENV = {"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}

@@ -33,7 +33,7 @@ def test_validate_fmu_finds_no_problem():
     names = {v.name: v for v in md.modelVariables}
     for p in ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "dx", "plate_duration_scale",
               "plate_stroke_scale", "porosity", "grain_density", "output_interval", "case_file", "tension_cutoff",
-              "pressure_smoothing"]:
+              "pressure_smoothing", "av_wall"]:
         assert names[p].causality == "parameter", p
     for o in H.OUT_REAL + H.OUT_INT:
         assert names[o].causality == "output" and names[o].start is None, o
@@ -122,6 +122,17 @@ def test_tension_cutoff_parameter_matches_the_executable(fmu_run_phi35, tmp_path
     res = simulate_fmu(H.fmu_path(), start_values={**RUN, "tension_cutoff": True}, stop_time=STOP,
                        output_interval=0.02)
     cli = H.run_mixsph({**RUN, "tension_cutoff": True}, tmp_path / "cli")["outputs"]["run_up"]
+    assert res["max_run_up"][-1] == cli["max"]
+    assert res["max_run_up"][-1] != fmu_run_phi35["max_run_up"][-1]
+
+
+def test_av_wall_parameter_matches_the_executable(fmu_run_phi35, tmp_path):
+    # the Boolean parameter (default true) reaches the case as numerics.av_wall = 0 when set
+    # false: the FMU's run is the executable's with that override (identical with one thread),
+    # and not the default run
+    from fmpy import simulate_fmu
+    res = simulate_fmu(H.fmu_path(), start_values={**RUN, "av_wall": False}, stop_time=STOP, output_interval=0.02)
+    cli = H.run_mixsph({**RUN, "av_wall": False}, tmp_path / "cli")["outputs"]["run_up"]
     assert res["max_run_up"][-1] == cli["max"]
     assert res["max_run_up"][-1] != fmu_run_phi35["max_run_up"][-1]
 
