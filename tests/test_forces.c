@@ -197,6 +197,17 @@ static void select_terms(mixsph_sim *s, int terms, const double *alpha, const do
     }
 }
 
+/* The inputs select_terms overwrites: the particles' viscosities (returned, to free) and the
+ * media's alpha_M (into alpha). */
+static double *save_terms(const mixsph_sim *s, double *alpha)
+{
+    double *mu = malloc(s->P.n * sizeof *mu);
+    assert_non_null(mu);
+    memcpy(mu, s->P.mu, s->P.n * sizeof *mu);
+    for (size_t k = 0; k < s->cfg.n_media; k++) alpha[k] = s->cfg.media[k].alpha_m;
+    return mu;
+}
+
 /* Each term of (3) against its formula and sign, switched on one at a time. */
 static void test_pair_terms(void **state)
 {
@@ -206,11 +217,8 @@ static void test_pair_terms(void **state)
     const double eta2 = 0.01 * s->h * s->h;
     const double F0 = kernel_f(K, 0.0); /* the kernel's largest |F| */
     const size_t n = P->n;
-    double *mu = malloc(n * sizeof *mu);
-    assert_non_null(mu);
-    memcpy(mu, P->mu, n * sizeof *mu);
     double alpha[CASE_MAX_MEDIA];
-    for (size_t k = 0; k < s->cfg.n_media; k++) alpha[k] = s->cfg.media[k].alpha_m;
+    double *mu = save_terms(s, alpha);
     size_t checked = 0, approaching = 0, compressed = 0;
     size_t mixed = 0;
     for (int term = TERM_PRESSURE; term <= TERM_MORRIS_MIXED; term <<= 1) {
@@ -365,11 +373,8 @@ static void test_monaghan_switches(void **state)
     const double eta2 = 0.01 * s->h * s->h;
     const double F0 = kernel_f(K, 0.0);
     const size_t n = P->n;
-    double *mu = malloc(n * sizeof *mu);
-    assert_non_null(mu);
-    memcpy(mu, P->mu, n * sizeof *mu);
     double alpha[CASE_MAX_MEDIA];
-    for (size_t k = 0; k < s->cfg.n_media; k++) alpha[k] = s->cfg.media[k].alpha_m;
+    double *mu = save_terms(s, alpha);
     select_terms(s, TERM_MONAGHAN, alpha, mu);
     size_t on[4] = {0}, off[4] = {0};
     for (int mode = 0; mode < 4; mode++) {
