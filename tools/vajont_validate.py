@@ -242,6 +242,8 @@ class Result:
     drho_t: float = math.nan          # its time [s]
     drho99: float = math.nan          # max over the snapshots of the 99th percentile of |rho / rho0 - 1|
     crossed: int = -1                 # most particles found below the bed or behind the plate in a snapshot
+    tension: float = math.nan         # largest fraction of the grains with a negative pressure in a snapshot
+    tension_t: float = math.nan       # its time [s]
     profiles: dict = field(default_factory=dict)   # name -> mt.Profile at the max run-up
 
     @property
@@ -300,6 +302,33 @@ def density_variation(outdir, rho0):
     return best, t_best, p99
 
 
+def granular_media(case_json):
+    """Indices (the case's order) of its granular media."""
+    return [k for k, m in enumerate(case_json.get("media", {}).values())
+            if isinstance(m, dict) and m.get("type") == "granular"]
+
+
+def grains_in_tension(outdir, granular):
+    """(largest fraction, over the snapshots after t = 0, of the grains (the particles of the
+    media indices in granular, mobile or fixed) whose pressure is negative, its time). Their
+    effective stress, max(p - p_w, 0), is then zero and so is their frictional viscosity (10):
+    a grain in tension flows with the pore fluid's viscosity alone."""
+    best, t_best = math.nan, math.nan
+    if not granular:
+        return best, t_best
+    for t, path in mt.list_snapshots(outdir):
+        if not t > 0:
+            continue
+        _, snap = mt.read_snapshot(path)
+        grain = (snap["state"] <= mt.STATE_FIXED) & np.isin(snap["medium"].astype(int), granular)
+        if not grain.any():
+            continue
+        f = float(np.mean(snap["p"][grain] < 0.0))
+        if not math.isfinite(best) or f > best:
+            best, t_best = f, t
+    return best, t_best
+
+
 CROSS_TOL = 1e-6  # [m] the CSV snapshots' 7 significant digits move a position by up to ~5e-7 m
 
 
@@ -327,7 +356,7 @@ def crossed_walls(outdir, bed, plate_index, dx):
     return worst
 
 
-def load_result(job, rho0=None, walls=None):
+def load_result(job, rho0=None, walls=None, granular=()):
     r = Result(job.paper, job.dx, job.outdir, job.source)
     if job.source == "not run":
         r.status = "not run"
@@ -366,6 +395,7 @@ def load_result(job, rho0=None, walls=None):
                 r.vmax_stop = float(np.nanmax(v[sel]))
     if rho0 is not None:
         r.drho, r.drho_t, r.drho99 = density_variation(job.outdir, rho0)
+    r.tension, r.tension_t = grains_in_tension(job.outdir, list(granular))
     if walls is not None:
         r.crossed = crossed_walls(job.outdir, walls[0], walls[1], job.dx)
     for name in PROFILE_NAMES:
@@ -462,7 +492,7 @@ def write_csv(path, results):
               "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
               "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
               "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "crossed_walls",
-              "outdir", "twin"]
+              "grains_in_tension", "grains_in_tension_t_s", "outdir", "twin"]
 
     def v(x):
         if isinstance(x, float):
@@ -478,7 +508,7 @@ def write_csv(path, results):
                 f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
                 r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
                 r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.drho,
-                r.drho_t, r.drho99, r.crossed, r.outdir, int(p.twin))])
+                r.drho_t, r.drho99, r.crossed, r.tension, r.tension_t, r.outdir, int(p.twin))])
 
 
 def write_md(path, results, header_lines, checks):
@@ -747,7 +777,9 @@ def main():
         bed = wall_defs.get("bed", {}).get("polyline")
         bed = np.array(bed, dtype=float) if bed else None
         plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
-        results = [load_result(job, reference_densities(case_json, job.stamp["sets"]), (bed, plate)) for job in jobs]
+        granular = granular_media(case_json)
+        results = [load_result(job, reference_densities(case_json, job.stamp["sets"]), (bed, plate), granular)
+                   for job in jobs]
     except mt.ToolError as e:
         fail(str(e))
     used_threads = sorted({r.threads for r in results if r.ok})
@@ -798,7 +830,8 @@ def main():
               f"{fmt(r.mass_drift, '.1e')}, wall-crossing corrections {fmt(r.wall_corr, '.0f')}, "
               f"max speed over t = 0.7-0.9 s {fmt(r.vmax_stop, '.2f')} m/s, max |rho/rho0 - 1| over the "
               f"snapshots {fmt(100 * r.drho, '.2f')} % (t = {fmt(r.drho_t, '.1f')} s; 99th percentile <= "
-              f"{fmt(100 * r.drho99, '.2f')} %), landslide front max "
+              f"{fmt(100 * r.drho99, '.2f')} %), grains with p < 0 (most in a snapshot) "
+              f"{fmt(100 * r.tension, '.1f')} % (t = {fmt(r.tension_t, '.1f')} s), landslide front max "
               f"{fmt(r.front_max, '.3f')} m")
 
     csv_path = os.path.join(out, "vajont_table.csv")
@@ -806,8 +839,7 @@ def main():
     png_path = os.path.join(out, "vajont_profiles.png")
     write_csv(csv_path, results)
     write_md(md_path, results, [head], checks)
-    media = case_json.get("media", {})
-    granular = [k for k, m in enumerate(media.values()) if isinstance(m, dict) and m.get("type") == "granular"]
+    granular = granular_media(case_json)
     drew = plot(png_path, results, plot_runs, granular)
     print()
     print(f"table: {show(csv_path)}, {show(md_path)}")

@@ -71,7 +71,7 @@ def write_run(d):
                     "at the maximum of run_up so far\nx,z_top\n0.5,nan\n0.7," + str(z) + "\n")
     with open(os.path.join(d, "snap_0000.csv"), "w") as f:
         f.write("# t = 0.8 s\nid,x,z,vx,vz,rho,p,mu,medium,state\n"
-                "0,0.8,0.5,0.1,0,1010,0,0.001,0,0\n1,0.5,0.4,0,0,1722.5,0,5000,1,1\n"
+                "0,0.8,0.5,0.1,0,1010,-20,0.001,0,0\n1,0.5,0.4,0,0,1722.5,-50,5000,1,1\n"
                 "2,0.6,0.3,0,0,2072.5,0,5000,2,0\n3,0,0,0,0,1000,0,0,0,2\n")
 
 
@@ -79,11 +79,13 @@ def test_load_result_and_outputs(tmp_path):
     d = str(tmp_path / "V4_dx0.02")
     write_run(d)
     job = vv.Job(vv.PAPER[4], 0.02, d, [], {}, source="reused")
-    r = vv.load_result(job, vv.reference_densities(case_json(), vv.PAPER[4].sets))
+    r = vv.load_result(job, vv.reference_densities(case_json(), vv.PAPER[4].sets), None,
+                       vv.granular_media(case_json()))
     assert r.ok and r.particles == 3 and r.steps == 100
     assert r.run_up == 0.72 and r.t_run_up == 1.2 and r.Z == 872.8 and r.d_eta == 5.9
     assert r.lost == 0 and r.mass_drift == 0.0 and r.vmax_stop == 1.2
     assert r.drho == pytest.approx(0.01) and r.drho_t == 0.8        # the water particle at 1010
+    assert r.tension == 0.5 and r.tension_t == 0.8   # one of the two grains below p = 0 (the water does not count)
     top = vv.landslide_top(r)
     assert np.isnan(top[1][0]) and top[1][1] == 0.6
     rows = vv.rows_of([r])
