@@ -40,6 +40,30 @@ def test_validate_fmu_finds_no_problem():
     assert names["push_velocity"].causality == "input"
 
 
+def _case_value(case, key):
+    """The value of a dotted case key, a "$name" resolved through the case's parameters."""
+    node = case
+    for part in key.split("."):
+        node = node[part]
+    if isinstance(node, str) and node.startswith("$"):
+        node = case["parameters"][node[1:]]
+    return float(node)
+
+
+def test_parameter_starts_are_the_bundled_case_values():
+    # a parameter the host leaves alone keeps the case file's value, so its declared start must
+    # be that value, or a tool reading the starts shows a run that is not the one made
+    import json
+    from fmpy import read_model_description
+    names = {v.name: v for v in read_model_description(H.fmu_path()).modelVariables}
+    case = json.loads(H.CASE.read_text())
+    for name, keys in H.CASE_KEYS.items():
+        start = names[name].start
+        start = float(start in (True, "true", "1", 1)) if names[name].type == "Boolean" else float(start)
+        for key in keys:
+            assert start == _case_value(case, key), f"{name}: start {start} but {key} = {_case_value(case, key)}"
+
+
 def test_zip_layout():
     import zipfile
     with zipfile.ZipFile(H.fmu_path()) as z:
