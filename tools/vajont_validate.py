@@ -281,14 +281,18 @@ def reference_densities(case_json, sets):
     return np.array(rho)
 
 
-def density_variation(outdir, rho0):
-    """(max |rho / rho0 - 1| of the mobile particles over all snapshots, its time, the largest
-    99th percentile of |rho / rho0 - 1| over the snapshots)."""
+def read_snapshots(outdir):
+    """[(t, snapshot)] of every snapshot in outdir, in time order, read once for all the checks."""
+    return [(t, mt.read_snapshot(path)[1]) for t, path in mt.list_snapshots(outdir)]
+
+
+def density_variation(snaps, rho0):
+    """(max |rho / rho0 - 1| of the mobile particles over the snapshots [(t, snapshot)], its
+    time, the largest 99th percentile of |rho / rho0 - 1| over the snapshots)."""
     best, t_best, p99 = math.nan, math.nan, math.nan
     if rho0.size == 0 or not np.all(np.isfinite(rho0)):
         return best, t_best, p99
-    for t, path in mt.list_snapshots(outdir):
-        _, snap = mt.read_snapshot(path)
+    for t, snap in snaps:
         live = snap["state"] <= mt.STATE_FIXED
         med = snap["medium"][live].astype(int)
         if med.size == 0 or med.max() >= rho0.size:
@@ -308,18 +312,17 @@ def granular_media(case_json):
             if isinstance(m, dict) and m.get("type") == "granular"]
 
 
-def grains_in_tension(outdir, granular):
-    """(largest fraction, over the snapshots after t = 0, of the grains (the particles of the
+def grains_in_tension(snaps, granular):
+    """(largest fraction, over the snapshots [(t, snapshot)] after t = 0, of the grains (the particles of the
     media indices in granular, mobile or fixed) whose pressure is negative, its time). Their
     effective stress, max(p - p_w, 0), is then zero and so is their frictional viscosity (10):
     a grain in tension flows with the pore fluid's viscosity alone."""
     best, t_best = math.nan, math.nan
     if not granular:
         return best, t_best
-    for t, path in mt.list_snapshots(outdir):
+    for t, snap in snaps:
         if not t > 0:
             continue
-        _, snap = mt.read_snapshot(path)
         grain = (snap["state"] <= mt.STATE_FIXED) & np.isin(snap["medium"].astype(int), granular)
         if not grain.any():
             continue
@@ -332,15 +335,15 @@ def grains_in_tension(outdir, granular):
 CROSS_TOL = 1e-6  # [m] the CSV snapshots' 7 significant digits move a position by up to ~5e-7 m
 
 
-def crossed_walls(outdir, bed, plate_index, dx):
+def crossed_walls(outdir, bed, plate_index, dx, snaps=None):
     """Most fluid and granular particles, over the snapshots, whose centre lies below the bed
     polyline (0 <= x <= its end) or behind the plate's face (x < face, within its z span; the face
     is half a spacing ahead of the plate's first layer of wall particles), by more than CROSS_TOL
     (a particle the crossing guard put back sits 0.1 dx in front of the wall; one on the line
-    may read as below it after the CSV's rounding). -1 without snapshots."""
+    may read as below it after the CSV's rounding). -1 without snapshots. snaps: the snapshots
+    as read_snapshots(outdir) gives them, when already read."""
     worst = -1
-    for _, path in mt.list_snapshots(outdir):
-        _, snap = mt.read_snapshot(path)
+    for _, snap in (read_snapshots(outdir) if snaps is None else snaps):
         live = snap["state"] <= mt.STATE_FIXED
         x, z = snap["x"][live], snap["z"][live]
         n = 0
@@ -393,11 +396,12 @@ def load_result(job, rho0=None, walls=None, granular=()):
             sel = (mon["t"] >= PLATE_STOP - 0.1) & (mon["t"] <= PLATE_STOP + 0.1)
             if sel.any():
                 r.vmax_stop = float(np.nanmax(v[sel]))
+    snaps = read_snapshots(job.outdir)
     if rho0 is not None:
-        r.drho, r.drho_t, r.drho99 = density_variation(job.outdir, rho0)
-    r.tension, r.tension_t = grains_in_tension(job.outdir, list(granular))
+        r.drho, r.drho_t, r.drho99 = density_variation(snaps, rho0)
+    r.tension, r.tension_t = grains_in_tension(snaps, list(granular))
     if walls is not None:
-        r.crossed = crossed_walls(job.outdir, walls[0], walls[1], job.dx)
+        r.crossed = crossed_walls(job.outdir, walls[0], walls[1], job.dx, snaps)
     for name in PROFILE_NAMES:
         path = os.path.join(job.outdir, f"profile_{name}_atmax.csv")
         if os.path.isfile(path):
