@@ -438,7 +438,7 @@ static mixsph_status read_bodies(struct reader *r, const cJSON *root, struct cas
 
 static mixsph_status read_motions(struct reader *r, const cJSON *root, struct case_def *c)
 {
-    static const char *const keys[] = {"t", "vx", "vz", "speed_scale", "time_scale", NULL};
+    static const char *const keys[] = {"t", "vx", "vz", "speed_scale", "time_scale", "stroke_scale", NULL};
     const cJSON *m;
     TRY(get_obj(r, root, "", "motions", 0, &m));
     if (!m) return MIXSPH_OK;
@@ -462,6 +462,15 @@ static mixsph_status read_motions(struct reader *r, const cJSON *root, struct ca
         mo->time_scale = 1.0;
         TRY(get_num(r, it, path, "speed_scale", 0, 0.0, 0, 1e3, &mo->speed_scale));
         TRY(get_num(r, it, path, "time_scale", 0, 0.0, 1, 1e3, &mo->time_scale));
+        /* stroke_scale scales the displacement: with the duration stretched by time_scale, the
+         * velocities scale by stroke_scale / time_scale */
+        if (cJSON_GetObjectItemCaseSensitive(it, "stroke_scale")) {
+            if (cJSON_GetObjectItemCaseSensitive(it, "speed_scale"))
+                return FAIL(r, "%s: %s: give speed_scale or stroke_scale, not both", r->origin, path);
+            double stroke = 1.0;
+            TRY(get_num(r, it, path, "stroke_scale", 1, 0.0, 1, 1e3, &stroke));
+            mo->speed_scale = stroke / mo->time_scale;
+        }
     }
     return MIXSPH_OK;
 }
