@@ -15,7 +15,7 @@
 
 #include "eos.h"
 #include "mixsph.h"
-#include "sim.h"
+#include "sim_passes.h"
 
 /* Two fluids side by side (a cross-medium interface), no gravity, one wall 0.8 m below:
  * far beyond the support 2h = 0.026 m, so every interaction is fluid-fluid. */
@@ -48,7 +48,7 @@ static double uniform(double a, double b)
 
 /* The box with every fluid particle displaced by up to 0.3 dx and given random velocity,
  * density (hence pressure, through the EOS), mass and viscosity; the cell list rebuilt.
- * White box: the primary fields are written here, and integrate_eos derives the per-step ones
+ * White box: the primary fields are written here, and integrate_pressure_and_derived derives the per-step ones
  * (p, V = m / rho and whatever else the pair loops cache); fields only particles_push sets
  * are written here too: inv_m = 1/m, and uvx, uvz (the velocity the viscous term sees: a fluid
  * particle's own velocity). */
@@ -74,11 +74,11 @@ static int setup(void **state)
         P->inv_m[i] = 1.0 / P->m[i];
         P->mu[i] = uniform(0.0, 0.1);
     }
-    if (integrate_rebuild(s) != MIXSPH_OK) { /* cells and neighbour ranges of the moved particles */
+    if (integrate_rebuild_lists(s) != MIXSPH_OK) { /* cells and neighbour ranges of the moved particles */
         mixsph_sim_destroy(s);
         return -1;
     }
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
     *state = s;
     return 0;
 }
@@ -127,13 +127,13 @@ static void test_pair_symmetry(void **state)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
         double ax, az, dr;
-        forces_pair_for_test(s, i, i, &ax, &az, &dr);
+        sim_pair_terms(s, i, i, &ax, &az, &dr);
         assert_true(ax == 0.0 && az == 0.0 && dr == 0.0); /* no self-interaction */
         for (size_t j = 0; j < P->n; j++) {
             if (j == i || P->state[j] != MIXSPH_STATE_MOBILE) continue;
             double axij, azij, drij, axji, azji, drji;
-            forces_pair_for_test(s, i, j, &axij, &azij, &drij);
-            forces_pair_for_test(s, j, i, &axji, &azji, &drji);
+            sim_pair_terms(s, i, j, &axij, &azij, &drij);
+            sim_pair_terms(s, j, i, &axji, &azji, &drji);
             if (dist2(P, i, j) >= s->K.r2max) {
                 /* outside the support: nothing (reference: compact support of W) */
                 assert_true(axij == 0.0 && azij == 0.0 && drij == 0.0);
@@ -181,13 +181,13 @@ static int pair_geom(const mixsph_sim *s, size_t i, size_t j, struct pair_geom *
 /* Which term(s) of (3) are switched on. */
 enum { TERM_PRESSURE = 1, TERM_MONAGHAN = 2, TERM_MORRIS = 4, TERM_MORRIS_MIXED = 8 };
 
-/* Switch terms off through the inputs: alpha_M of the media (then integrate_eos refreshes the
+/* Switch terms off through the inputs: alpha_M of the media (then integrate_pressure_and_derived refreshes the
  * per-particle fields and the pressures from the densities), p and mu of the particles. */
 static void select_terms(mixsph_sim *s, int terms, const double *alpha, const double *mu)
 {
     struct particles *P = &s->P;
     for (size_t k = 0; k < s->cfg.n_media; k++) s->cfg.media[k].alpha_m = terms & TERM_MONAGHAN ? alpha[k] : 0.0;
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
         if (!(terms & TERM_PRESSURE)) P->p[i] = 0.0;
@@ -230,7 +230,7 @@ static void test_pair_terms(void **state)
                 const double rx = g.rx, rz = g.rz, r2 = g.r2, F = g.F, ux = g.ux, uz = g.uz, vr = g.vr;
                 const double rhoi = P->rho[i], rhoj = P->rho[j], mj = P->m[j];
                 double ax, az, dr;
-                forces_pair_for_test(s, i, j, &ax, &az, &dr);
+                sim_pair_terms(s, i, j, &ax, &az, &dr);
                 checked++;
                 if (term == TERM_PRESSURE) {
                     /* a_ij = -m_j (p_i + p_j) / (rho_i rho_j) grad_i W_ij (eq. 3); the pressures
@@ -304,7 +304,7 @@ static void test_pair_terms(void **state)
     assert_true(checked > 20000 && approaching > 1000 && compressed > 1000 && mixed > 5000);
 }
 
-/* The loops over all pairs: forces_continuity and forces_compute give each particle the sum of
+/* The loops over all pairs: the density and momentum passes give each particle the sum of
  * its pair terms (against a brute-force sum of forces_pair_for_test over all particles) and the
  * count of its same-medium neighbours, and the total momentum change sum_i m_i a_i vanishes
  * (no gravity, no wall within reach). */
@@ -312,8 +312,8 @@ static void test_momentum_conservation(void **state)
 {
     mixsph_sim *s = *state;
     struct particles *P = &s->P;
-    assert_int_equal(forces_continuity(s), 0);
-    assert_int_equal(forces_compute(s), 0);
+    assert_int_equal(sim_density_pass(s), 0);
+    assert_int_equal(sim_momentum_pass(s), 0);
     double sx = 0.0, sz = 0.0, sabs = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
@@ -321,7 +321,7 @@ static void test_momentum_conservation(void **state)
         unsigned nn = 0;
         for (size_t j = 0; j < P->n; j++) {
             double ax, az, dr;
-            forces_pair_for_test(s, i, j, &ax, &az, &dr);
+            sim_pair_terms(s, i, j, &ax, &az, &dr);
             bx += ax;
             bz += az;
             babs += hypot(ax, az);
@@ -353,8 +353,8 @@ static void test_momentum_conservation(void **state)
     assert_non_null(az0);
     memcpy(ax0, P->ax, P->n * sizeof *ax0);
     memcpy(az0, P->az, P->n * sizeof *az0);
-    assert_int_equal(s->fk_valid, 0); /* used once */
-    assert_int_equal(forces_compute(s), 0);
+    assert_int_equal(forces_cache_pending(s->forces), 0); /* used once */
+    assert_int_equal(sim_momentum_pass(s), 0);
     assert_memory_equal(ax0, P->ax, P->n * sizeof *ax0);
     assert_memory_equal(az0, P->az, P->n * sizeof *az0);
     free(ax0);
@@ -391,7 +391,7 @@ static void test_monaghan_switches(void **state)
                 const double avc = fmax(mdi->alpha_m * mdi->c, mdj->alpha_m * mdj->c) * s->h;
                 const int acts = (vr < 0.0 || separating) && (P->medium[i] == P->medium[j] || mixed);
                 double ax, az, dr;
-                forces_pair_for_test(s, i, j, &ax, &az, &dr);
+                sim_pair_terms(s, i, j, &ax, &az, &dr);
                 const double fa = acts ? mj * avc * vr / (r2 + eta2) / (0.5 * (rhoi + rhoj)) * F : 0.0;
                 /* reference: Monaghan's Pi_ij with the pair's switches; tolerance as in
                  * test_pair_terms (the mean of 1/rho for 1/rho_bar) */
@@ -442,7 +442,7 @@ static void test_monaghan_at_walls(void **state)
         P->vz[i] = P->uvz[i] = 0.0;
         P->rho[i] = s->cfg.media[0].rho0; /* p = 0 */
     }
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
     for (int av_wall = 1; av_wall >= 0; av_wall--) {
         s->cfg.av_wall = av_wall;
         double drag = 0.0, mass = 0.0;
@@ -452,7 +452,7 @@ static void test_monaghan_at_walls(void **state)
             for (size_t j = 0; j < P->n; j++) {
                 if (P->state[j] != MIXSPH_STATE_WALL || dist2(P, i, j) >= s->K.r2max) continue;
                 double ax, az, dr;
-                forces_pair_for_test(s, i, j, &ax, &az, &dr);
+                sim_pair_terms(s, i, j, &ax, &az, &dr);
                 if (!av_wall) {
                     /* reference: no term acts (no pressure, no viscosity, no Monaghan term);
                      * tolerance: exactly 0 */

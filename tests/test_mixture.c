@@ -22,7 +22,7 @@
 #include <cmocka.h>
 
 #include "kernel.h"
-#include "sim.h"
+#include "sim_passes.h"
 
 #define G_ACC 9.81   /* [m/s2] */
 #define DX 0.01      /* [m] */
@@ -196,7 +196,7 @@ static void test_parse_errors(void **state)
 /* ---- (b) regimes and transitions ----------------------------------------------------------- */
 
 /* u = (G z, 0) on every particle (walls' viscous velocity included), then the continuity pass
- * and the mixture update, from the pressure of the grains' own density (integrate_eos). */
+ * and the mixture update, from the pressure of the grains' own density (integrate_pressure_and_derived). */
 static void impose_shear(mixsph_sim *s, double G)
 {
     struct particles *P = &s->P;
@@ -204,13 +204,13 @@ static void impose_shear(mixsph_sim *s, double G)
         P->vx[i] = P->uvx[i] = G * P->z[i];
         P->vz[i] = P->uvz[i] = 0.0;
     }
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
 }
 
 static void update(mixsph_sim *s)
 {
-    assert_int_equal(forces_continuity(s), 0);
-    mixture_update(s);
+    assert_int_equal(sim_density_pass(s), 0);
+    sim_mixture_update(s);
 }
 
 struct counts {
@@ -432,7 +432,7 @@ static void check_tension(const char *media, int cutoff)
     assert_int_equal(m->tension_cutoff, cutoff);
     for (size_t i = 0; i < P->n; i++)
         if (is_grain(s, i)) P->rho[i] = m->rho0 * (P->z[i] < 0.05 ? 0.99 : 1.01);
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
     long stretched = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
@@ -546,7 +546,7 @@ static void slide_top(mixsph_sim *s)
         P->vz[i] = P->uvz[i] = 0.0;
         if (is_grain(s, i)) P->state[i] = u > 0.0 && P->x[i] < 0.1 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
     }
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
 }
 
 /* The same bed with and without the fixed bed. Expected by brute force from the rule: in each

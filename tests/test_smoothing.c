@@ -20,7 +20,7 @@
 
 #include "kernel.h"
 #include "mixsph.h"
-#include "sim.h"
+#include "sim_passes.h"
 
 #define DX 0.01
 #define G_ACC 9.81
@@ -110,7 +110,7 @@ static double *smooth_checked(mixsph_sim *s)
     assert_non_null(before);
     memcpy(before, P->p, P->n * sizeof *before);
     double *want = brute_force(s, F_STEP / c);
-    forces_smooth_pressure(s);
+    sim_smooth_pressure(s);
     double worst = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) {
@@ -165,7 +165,7 @@ static void test_checkerboard_damped(void **state)
         const long ix = lround(P->x[i] / DX - 0.5), iz = lround(P->z[i] / DX - 0.5);
         P->rho[i] += ((ix + iz) % 2 ? -A : A) / (c * c);
     }
-    integrate_eos(s);
+    integrate_pressure_and_derived(s);
     double sw = 0.0, sa = 0.0;
     for (int a = -3; a <= 3; a++)
         for (int b = -3; b <= 3; b++) {

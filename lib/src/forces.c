@@ -46,7 +46,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "sim.h"
+#include "forces.h"
+
+#include <stdint.h>
+
+#include "mixsph.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(MIXSPH_NO_CLONES) && \
     !defined(__SANITIZE_ADDRESS__)
@@ -63,48 +67,69 @@
  * to FORCES_CHUNK - 1 elements past a range (particles.c keeps that padding initialised). */
 #define FORCES_CHUNK 8
 
-/* Per-step constants of the pair loops. */
+struct forces {
+    double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
+    size_t *fk_off;           /* particle i's lanes start at fk + fk_off[i] */
+    size_t fk_cap, fk_off_cap;
+    int fk_valid;             /* fk holds this step's factors (set by the density pass, used once) */
+    /* scratch sums of the passes, one per particle (+ FORCES_CHUNK of padding) */
+    double *nbr_count;        /* density pass: same-medium neighbours within 2h */
+    double *smooth_sum;       /* smoothing: sum_j B_ij W_ij V_j */
+    double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
+    size_t scratch_cap;
+};
+
+/* PHASE A (temporary, removed in the next commit): the smoothing's old W rounding. */
+static inline double PHASE_A_SMOOTH_W(const struct kernel *k, double q, const int wendland)
+{
+    const double a_d = k->a_d;
+    double w;
+    if (wendland) {
+        double s1 = 1.0 - 0.5 * q;
+        s1 = s1 > 0.0 ? s1 : 0.0;
+        w = a_d * s1 * s1 * s1 * s1 * (2.0 * q + 1.0);
+    } else {
+        double t = 2.0 - q;
+        t = t > 0.0 ? t : 0.0;
+        w = q < 1.0 ? a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q) : 0.25 * a_d * t * t * t;
+    }
+    return w;
+}
+
+/* Constants of one pass of the pair loops. */
 struct pair_ctx {
-    double inv_h, f_fac, eta2, r2max, a_d, g;
+    struct kernel K;
+    double eta2, g;
     double av_wall;  /* 1: artificial viscosity between fluid and wall particles, 0: not */
     double av_mixed; /* 1: ... between particles of different media too, 0: same medium only */
     double av_cap;   /* u_ij.x_ij is capped at this: 0 (approaching pairs only) or +inf (all pairs) */
     int wendland;
-    double *fk;           /* the kernel-factor cache (see forces_continuity), or NULL */
+    double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
+    double *count;        /* scratch sums written by the band walks (see struct forces) */
+    double *sum, *weight;
 };
 
-static void pair_ctx_init(const mixsph_sim *s, struct pair_ctx *X)
+static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
 {
-    X->inv_h = 1.0 / s->K.h;
-    X->f_fac = s->K.f_fac;
-    X->eta2 = 0.01 * s->h * s->h;
-    X->r2max = s->K.r2max;
-    X->a_d = s->K.a_d;
-    X->g = s->cfg.g;
-    X->av_wall = s->cfg.av_wall ? 1.0 : 0.0;
-    X->av_mixed = s->cfg.av_mixed ? 1.0 : 0.0;
-    X->av_cap = s->cfg.av_separating ? INFINITY : 0.0;
-    X->wendland = s->K.type == KERNEL_WENDLAND_C2;
+    const struct forces_params *fp = &S->params;
+    X->K = fp->K;
+    X->eta2 = fp->eta2;
+    X->g = fp->g;
+    X->av_wall = fp->av_wall ? 1.0 : 0.0;
+    X->av_mixed = fp->av_mixed ? 1.0 : 0.0;
+    X->av_cap = fp->av_separating ? INFINITY : 0.0;
+    X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
     X->fk = NULL;
     X->fk_off = NULL;
+    X->count = X->sum = X->weight = NULL;
 }
 
-/* F(r) of kernel.h without branches: 0 beyond 2h. `wendland` is a compile-time constant in each
+/* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
  * inlined copy (the band functions dispatch on the kernel once, outside the loops). */
 FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendland)
 {
-    const double q = sqrt(r2) * X->inv_h;
-    if (wendland) {
-        double sq = 1.0 - 0.5 * q;
-        sq = sq > 0.0 ? sq : 0.0;
-        return X->f_fac * sq * sq * sq;
-    }
-    double t = 2.0 - q;
-    t = t > 0.0 ? t : 0.0;
-    const double inner = -3.0 + 2.25 * q;
-    const double outer = -0.75 * t * t / (q > 1.0 ? q : 1.0);
-    return X->f_fac * (q < 1.0 ? inner : outer);
+    return kernel_f_q(&X->K, kernel_q(&X->K, r2), wendland);
 }
 
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
@@ -125,7 +150,7 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * and same-medium neighbour counts. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                     const uint32_t *restrict rng, int nr, double *di, double *ni,
-                                    double *restrict fk, const int wendland, const int store)
+                                    double *restrict count, double *restrict fk, const int wendland, const int store)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
@@ -145,7 +170,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             const double r2 = rx * rx + rz * rz;
             const double F = pair_f(&Xl, r2, wendland) * in;
             const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * F;
-            const double c = (r2 < Xl.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
+            const double c = (r2 < Xl.K.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
             if (store) fk[k] = F;
             acc[k] += vol[j] * uf;
             cnt[k] += c;
@@ -153,7 +178,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             cj[k] = c;
         }
         chunk_add(P->drho, jb, m, dj);
-        chunk_add(P->ax, jb, m, cj); /* ax holds neighbour counts in this pass */
+        chunk_add(count, jb, m, cj);
         if (store) fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -167,13 +192,14 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
  * B_ij = p_j - p_i + (rho_i + rho_j)/2 g (z_j - z_i) (the difference from the hydrostatic
  * extrapolation of p_j to z_i, so a hydrostatic field is left unchanged; B_ji = -B_ij):
  * a_i += B_ij W_ij V_j, u_i += W_ij V_j and a_j -= B_ij W_ij V_i, u_j += W_ij V_i. */
-FORCES_INLINE void smooth_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                const uint32_t *restrict rng, int nr, double g, double *ai, double *ui, const int wendland)
+FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
+                                const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
+                                double *restrict sum, double *restrict weight, const int wendland)
 {
     const double xi = P->x[i], zi = P->z[i], pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict p = P->p, *restrict rho = P->rho;
     const double *restrict vol = P->vol, *restrict tag = P->tag;
-    const double a_d = X->a_d, inv_h = X->inv_h;
+    const struct pair_ctx Xl = *X;
     double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
     for (int r = 0; r < nr; r++)
     for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
@@ -183,17 +209,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, struct particles *rest
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double rx = xi - x[j], rz = zi - z[j];
-            const double q = sqrt(rx * rx + rz * rz) * inv_h;
-            double w;
-            if (wendland) {
-                double s1 = 1.0 - 0.5 * q;
-                s1 = s1 > 0.0 ? s1 : 0.0;
-                w = a_d * s1 * s1 * s1 * s1 * (2.0 * q + 1.0);
-            } else {
-                double t = 2.0 - q;
-                t = t > 0.0 ? t : 0.0;
-                w = q < 1.0 ? a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q) : 0.25 * a_d * t * t * t;
-            }
+            double w = PHASE_A_SMOOTH_W(&Xl.K, sqrt(rx * rx + rz * rz) * Xl.K.inv_h, wendland);
             w *= FORCES_LANE_IN(k, m) * (tag[j] < 0.0 ? 0.0 : 1.0);
             const double b = (p[j] - pi - 0.5 * (rhoi + rho[j]) * g * rz) * w;
             sa[k] += b * vol[j];
@@ -201,8 +217,8 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, struct particles *rest
             aj[k] = -b * voli;
             uj[k] = w * voli;
         }
-        chunk_add(P->ax, jb, m, aj);
-        chunk_add(P->az, jb, m, uj);
+        chunk_add(sum, jb, m, aj);
+        chunk_add(weight, jb, m, uj);
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *ai += sa[k];
@@ -323,26 +339,27 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0;
-        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, store ? X->fk + X->fk_off[i] : NULL, wendland, store);
+        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, X->count, store ? X->fk + X->fk_off[i] : NULL, wendland,
+                         store);
         P->drho[i] += di;
-        P->ax[i] += ni;
+        X->count[i] += ni;
     }
 }
 
 FORCES_CLONES
 static void gradient_particle(const struct pair_ctx *X, const struct gather *G, const struct particles *restrict P,
-                              struct kinematics *restrict K, size_t i)
+                              struct velocity_gradient *restrict out, size_t i)
 {
     double acc[7] = {0};
     if (X->wendland) gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 1);
     else gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 0);
-    K->gux[i] = acc[0];
-    K->guz[i] = acc[1];
-    K->gwx[i] = acc[2];
-    K->gwz[i] = acc[3];
-    K->lxx[i] = acc[4];
-    K->lxz[i] = acc[5];
-    K->lzz[i] = acc[6];
+    out->dudx[i] = acc[0];
+    out->dudz[i] = acc[1];
+    out->dwdx[i] = acc[2];
+    out->dwdz[i] = acc[3];
+    out->lxx[i] = acc[4];
+    out->lxz[i] = acc[5];
+    out->lzz[i] = acc[6];
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
@@ -363,10 +380,10 @@ static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, s
     for (size_t i = b0; i < b1; i++) {
         if (P->tag[i] < 0.0) continue; /* walls neither smooth nor are smoothed */
         double a = 0.0, u = 0.0;
-        if (X->wendland) smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, 1);
-        else smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, 0);
-        P->ax[i] += a;
-        P->az[i] += u;
+        if (X->wendland) smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, X->sum, X->weight, 1);
+        else smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, X->sum, X->weight, 0);
+        X->sum[i] += a;
+        X->weight[i] += u;
     }
 }
 
@@ -393,114 +410,151 @@ static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB,
     FORCES_DISPATCH(momentum_walk, X, NB, P, b0, b1);
 }
 
-/* The kernel-factor cache: the continuity pass stores F(r_ij) of every lane it evaluates (masked
+struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
+
+void forces_free(struct forces *F)
+{
+    if (!F) return;
+    free(F->fk);
+    free(F->fk_off);
+    free(F->nbr_count);
+    free(F->smooth_sum);
+    free(F->smooth_weight);
+    free(F);
+}
+
+int forces_cache_pending(const struct forces *F) { return F->fk_valid; }
+
+void forces_forget_cache(struct forces *F) { F->fk_valid = 0; }
+
+/* The kernel-factor cache: the density pass stores F(r_ij) of every lane it evaluates (masked
  * lanes 0), and the momentum pass of the same step, at the same positions and over the same
  * ranges, reads it instead of evaluating the kernel again (a square root and, for the cubic
  * spline, a division per lane): the same numbers, so results are unchanged. Lanes of particle i
  * start at fk_off[i], FORCES_CHUNK per chunk of each of its two ranges. Returns -1 if the cache
  * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
-static int fcache_layout(mixsph_sim *s, size_t n)
+static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n)
 {
-    if (s->fk_off_cap < n + 1) {
-        size_t *o = realloc(s->fk_off, (n + 1) * sizeof *o);
+    if (F->fk_off_cap < n + 1) {
+        size_t *o = realloc(F->fk_off, (n + 1) * sizeof *o);
         if (!o) return -1;
-        s->fk_off = o;
-        s->fk_off_cap = n + 1;
+        F->fk_off = o;
+        F->fk_off_cap = n + 1;
     }
-    const uint32_t *rng = s->NB.rng;
+    const uint32_t *rng = NB->rng;
     size_t total = 0;
     for (size_t i = 0; i < n; i++) {
-        s->fk_off[i] = total;
+        F->fk_off[i] = total;
         for (int r = 0; r < 2; r++) {
             const size_t len = rng[4 * i + 2 * r + 1] - rng[4 * i + 2 * r];
             total += (len + FORCES_CHUNK - 1) / FORCES_CHUNK * FORCES_CHUNK;
         }
     }
-    s->fk_off[n] = total;
-    if (s->fk_cap < total) {
+    F->fk_off[n] = total;
+    if (F->fk_cap < total) {
         const size_t cap = total + total / 4 + FORCES_CHUNK;
-        free(s->fk);
-        s->fk = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
-        s->fk_cap = s->fk ? cap : 0;
-        if (!s->fk) return -1;
+        free(F->fk);
+        F->fk = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
+        F->fk_cap = F->fk ? cap : 0;
+        if (!F->fk) return -1;
     }
+    return 0;
+}
+
+/* Room for n particles' scratch sums (zeroed padding past the end for the chunked loops). */
+static int scratch_reserve(struct forces *F, size_t n)
+{
+    if (F->scratch_cap >= n) return 0;
+    const size_t cap = n + n / 4 + 64;
+    double **a[3] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight};
+    for (int k = 0; k < 3; k++) {
+        double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
+        if (!q) return -1;
+        memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
+        *a[k] = q;
+    }
+    F->scratch_cap = cap;
     return 0;
 }
 
 typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, struct particles *restrict, size_t, size_t);
 
 /* Run `fn` over all bands of FORCES_BAND_ROWS cell rows: even bands in parallel, then odd. */
-static void for_bands(mixsph_sim *s, band_fn fn, const struct pair_ctx *X)
+static void for_bands(const struct pair_system *S, band_fn fn, const struct pair_ctx *X)
 {
-    const struct cells *C = &s->C;
+    const struct cells *C = S->C;
     const long nb = (C->nz + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
-    struct particles *P = &s->P;
-#pragma omp parallel num_threads(SIM_THREADS(s))
+    struct particles *P = S->P;
+#pragma omp parallel num_threads(S->n_threads)
     for (int phase = 0; phase < 2; phase++) {
 #pragma omp for schedule(dynamic, 1)
         for (long b = phase; b < nb; b += 2) {
             const long r0 = b * FORCES_BAND_ROWS;
             const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;
-            fn(X, &s->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
+            fn(X, S->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
         }
     }
 }
 
-/* Density rate and neighbour counts of every particle, from the current positions and
- * velocities, and (with granular media) the velocity gradient and its correction matrix.
- * Returns 1 if a non-finite value appeared at a mobile particle. */
-int forces_continuity(mixsph_sim *s)
+static size_t active_count(const struct pair_system *S) { return S->C->start[S->C->ncell]; }
+
+int forces_density_rate(struct forces *F, const struct pair_system *S)
 {
-    struct particles *P = &s->P;
+    struct particles *P = S->P;
     struct pair_ctx X;
-    pair_ctx_init(s, &X);
-    const size_t n = s->C.start[s->C.ncell];
+    pair_ctx_init(S, &X);
+    const size_t n = active_count(S);
+    if (scratch_reserve(F, n) != 0) return -1;
     memset(P->drho, 0, n * sizeof(double));
-    memset(P->ax, 0, n * sizeof(double));
-    s->fk_valid = fcache_layout(s, n) == 0;
-    if (s->fk_valid) {
-        X.fk = s->fk;
-        X.fk_off = s->fk_off;
+    memset(F->nbr_count, 0, n * sizeof(double));
+    X.count = F->nbr_count;
+    F->fk_valid = fcache_layout(F, S->NB, n) == 0;
+    if (F->fk_valid) {
+        X.fk = F->fk;
+        X.fk_off = F->fk_off;
     }
-    for_bands(s, continuity_band, &X);
-    if (s->has_granular) {
-        const struct medium *M = s->cfg.media;
-        struct kinematics *K = &s->kin;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-        for (size_t i = 0; i < n; i++)
-            if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
-                gradient_particle(&X, &s->G, P, K, i);
-    }
+    for_bands(S, continuity_band, &X);
     int bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
+    const double *count = F->nbr_count;
+#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
         P->drho[i] *= P->rho[i];
-        P->nneigh[i] = (uint16_t)(P->ax[i] < 65535.0 ? P->ax[i] : 65535.0);
-        P->ax[i] = 0.0;
+        P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
         bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
     }
     return bad;
 }
 
-/* Acceleration of every particle (gravity included). Returns 1 if a non-finite value appeared
- * at a mobile particle. */
-int forces_compute(mixsph_sim *s)
+void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out)
 {
-    struct particles *P = &s->P;
+    const struct particles *P = S->P;
+    const struct medium *M = S->media;
     struct pair_ctx X;
-    pair_ctx_init(s, &X);
-    const size_t n = s->C.start[s->C.ncell];
+    pair_ctx_init(S, &X);
+    const size_t n = active_count(S);
+#pragma omp parallel for schedule(static) num_threads(S->n_threads)
+    for (size_t i = 0; i < n; i++)
+        if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
+            gradient_particle(&X, S->G, P, out, i);
+}
+
+int forces_momentum(struct forces *F, const struct pair_system *S)
+{
+    struct particles *P = S->P;
+    struct pair_ctx X;
+    pair_ctx_init(S, &X);
+    const size_t n = active_count(S);
     memset(P->ax, 0, n * sizeof(double));
     memset(P->az, 0, n * sizeof(double));
-    if (s->fk_valid) { /* the continuity pass of this step filled it, at these positions */
-        X.fk = s->fk;
-        X.fk_off = s->fk_off;
+    if (F->fk_valid) { /* the density pass of this step filled it, at these positions */
+        X.fk = F->fk;
+        X.fk_off = F->fk_off;
     }
-    s->fk_valid = 0;
-    for_bands(s, momentum_band, &X);
-    const double g = s->cfg.g;
+    F->fk_valid = 0;
+    for_bands(S, momentum_band, &X);
+    const double g = X.g;
     int bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(SIM_THREADS(s))
+#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
         P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
         P->az[i] = P->az[i] * P->inv_m[i] - g;
@@ -509,54 +563,60 @@ int forces_compute(mixsph_sim *s)
     return bad;
 }
 
-/* Test hook: the acceleration (without gravity) and the density rate particle j gives i,
- * evaluated by the same pair code (on a scratch copy of the rate arrays). */
-void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho)
+void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho)
 {
     struct pair_ctx X;
-    pair_ctx_init(s, &X);
-    struct particles *P = &s->P;
-    const double save[4] = {P->ax[j], P->az[j], P->drho[j], P->ax[i]};
+    pair_ctx_init(S, &X);
+    struct particles *P = S->P;
+    const double save[3] = {P->ax[j], P->az[j], P->drho[j]};
     double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
+    double *count = calloc(j + 1 + FORCES_CHUNK, sizeof(double)); /* the range's neighbour counts */
+    if (!count) {
+        *ax = *az = *drho = NAN;
+        return;
+    }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
     momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, X.wendland, 0);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
     P->az[j] = save[1];
-    continuity_range(&X, P, i, pair, 1, &di, &ni, NULL, X.wendland, 0);
+    continuity_range(&X, P, i, pair, 1, &di, &ni, count, NULL, X.wendland, 0);
     *drho = P->rho[i] * di;
-    P->ax[j] = save[0];
     P->drho[j] = save[2];
-    P->ax[i] = save[3];
+    free(count);
 }
 
 /* The partial pressure smoothing of SPHERA (numerics.pressure_smoothing = theta_P > 0; Di Monaco
  * et al. 2011), after the equation of state: every non-wall particle's pressure relaxes toward
  * the kernel mean of its non-wall neighbours' pressures, hydrostatically extrapolated to it,
  *   p_i += theta_P c_i dt / h * sum_j B_ij W_ij V_j / sum_j W_ij V_j,
- * and its density follows (rho_i += dp_i / c_i^2), so the next continuity step starts from the
+ * and its density follows (rho_i += dp_i / c_i^2), so the next density step starts from the
  * smoothed state. Masses are untouched. A damping of the acoustic noise of weakly compressible
- * SPH (like delta-SPH's density diffusion); not in MODEL.md, an option (off by default). */
-void forces_smooth_pressure(mixsph_sim *s)
+ * SPH (like delta-SPH's density diffusion); an option, off by default. */
+int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double theta_dt_over_h)
 {
-    struct particles *P = &s->P;
+    struct particles *P = S->P;
     struct pair_ctx X;
-    pair_ctx_init(s, &X);
-    const size_t n = s->C.start[s->C.ncell];
-    memset(P->ax, 0, n * sizeof(double));
-    memset(P->az, 0, n * sizeof(double));
-    for_bands(s, smooth_band, &X);
-    const double f = s->cfg.pressure_smoothing * s->dt / s->h;
-    const struct medium *M = s->cfg.media;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    pair_ctx_init(S, &X);
+    const size_t n = active_count(S);
+    if (scratch_reserve(F, n) != 0) return -1;
+    memset(F->smooth_sum, 0, n * sizeof(double));
+    memset(F->smooth_weight, 0, n * sizeof(double));
+    X.sum = F->smooth_sum;
+    X.weight = F->smooth_weight;
+    for_bands(S, smooth_band, &X);
+    const double *sum = F->smooth_sum, *weight = F->smooth_weight;
+    const struct medium *M = S->media;
+#pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || !(P->az[i] > 0.0)) continue;
+        if (P->state[i] > MIXSPH_STATE_FIXED || !(weight[i] > 0.0)) continue;
         const double c = M[P->medium[i]].c;
-        const double dp = f * c * P->ax[i] / P->az[i];
+        const double dp = theta_dt_over_h * c * sum[i] / weight[i];
         P->p[i] += dp;
         P->rho[i] += dp / (c * c);
         P->inv_rho[i] = 1.0 / P->rho[i];
         P->vol[i] = P->m[i] * P->inv_rho[i];
     }
+    return 0;
 }

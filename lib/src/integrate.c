@@ -19,9 +19,13 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "integrate.h"
+
 #include "eos.h"
-#include "sim.h"
 #include "status.h"
+
+/* Distance [dx] at which a particle that would cross a wall is put back on its side. */
+#define INTEGRATE_CLIP_GAP 0.1
 
 /* (4): dt = min over particles of CFL_vis 2 h^2 / nu_i and CFL 2 h / (c_max + |u_i|).
  * A fixed grain enters the viscous bound with min(mu0, mu_thr), the largest viscosity it can
@@ -53,7 +57,7 @@ double integrate_time_step(const mixsph_sim *s)
     return dt;
 }
 
-void integrate_eos(mixsph_sim *s)
+void integrate_pressure_and_derived(mixsph_sim *s)
 {
     struct particles *P = &s->P;
     const struct medium *M = s->cfg.media;
@@ -71,20 +75,19 @@ void integrate_eos(mixsph_sim *s)
     }
 }
 
-/* Sort by cell (marking particles that left the domain lost) and rebuild the neighbour lists. */
-mixsph_status integrate_rebuild(mixsph_sim *s)
+mixsph_status integrate_rebuild_lists(mixsph_sim *s)
 {
     const long lost = cells_build(&s->C, &s->P);
     if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
     s->n_lost += lost;
     if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
-    return integrate_gather(s);
+    return integrate_build_gather_lists(s);
 }
 
-/* Gather lists from the current pair lists' build: grains gather over all their neighbours (the
- * velocity gradient), wall particles over the non-wall ones (their pressure). */
-mixsph_status integrate_gather(mixsph_sim *s)
+/* Grains gather over all their neighbours (the velocity gradient), wall particles over the
+ * non-wall ones (their pressure). */
+mixsph_status integrate_build_gather_lists(mixsph_sim *s)
 {
     const struct particles *P = &s->P;
     const size_t n = s->C.start[s->C.ncell];
@@ -112,11 +115,63 @@ mixsph_status integrate_gather(mixsph_sim *s)
             for (size_t w = 0; w < s->cfg.n_walls && !close; w++) {
                 double d;
                 int at_end;
-                walls_signed_distance(s, w, P->x[i], P->z[i], &d, &at_end);
+                walls_signed_distance(&s->cfg, s->walls, w, P->x[i], P->z[i], &d, &at_end);
                 close = !(fabs(d) > reach); /* NaN counts as close */
             }
         near[i] = (uint8_t)close;
     }
+    return MIXSPH_OK;
+}
+
+struct pair_system sim_pair_system(mixsph_sim *s)
+{
+    struct pair_system S;
+    S.P = &s->P;
+    S.C = &s->C;
+    S.NB = &s->NB;
+    S.G = &s->G;
+    S.media = s->cfg.media;
+    S.params.K = s->K;
+    S.params.eta2 = 0.01 * s->h * s->h;
+    S.params.g = s->cfg.g;
+    S.params.av_wall = s->cfg.av_wall;
+    S.params.av_mixed = s->cfg.av_mixed;
+    S.params.av_separating = s->cfg.av_separating;
+    S.n_threads = SIM_THREADS(s);
+    return S;
+}
+
+static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.ncell]; }
+
+/* The density pass and, with granular media, the grains' velocity gradient. Returns 1 if a
+ * non-finite rate appeared at a mobile particle, -1 when out of memory. */
+static int density_rates(mixsph_sim *s, const struct pair_system *S)
+{
+    const int bad = forces_density_rate(s->forces, S);
+    if (bad >= 0 && s->mixture) forces_velocity_gradient(S, mixture_gradient(s->mixture));
+    return bad;
+}
+
+/* After the densities are updated: pressures (smoothed with numerics.pressure_smoothing), the
+ * grains' regimes, the walls' extrapolated state. Returns -1 when out of memory. */
+static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth)
+{
+    integrate_pressure_and_derived(s);
+    if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
+    if (s->mixture) s->n_fixed = mixture_update(s->mixture, &s->K, &s->G, &s->P, active_particles(s), S->n_threads);
+    walls_extrapolate_fluid(&s->cfg, s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
+    return 0;
+}
+
+mixsph_status integrate_initial_rates(mixsph_sim *s)
+{
+    const struct pair_system S = sim_pair_system(s);
+    const int bad = density_rates(s, &S);
+    if (bad < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
+    pressures_and_regimes(s, &S, 0);
+    if (forces_momentum(s->forces, &S)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
+    s->dt = integrate_time_step(s);
     return MIXSPH_OK;
 }
 
@@ -132,7 +187,8 @@ mixsph_status integrate_step(mixsph_sim *s)
         ox_old[w] = s->walls[w].ox;
         oz_old[w] = s->walls[w].oz;
     }
-    walls_move(s, s->t, dt);
+    walls_move(&s->cfg, s->walls, P, s->t, dt);
+    const double gap = INTEGRATE_CLIP_GAP * s->dx;
     long clips = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clips) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
@@ -144,7 +200,7 @@ mixsph_status integrate_step(mixsph_sim *s)
         if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
             const double x0 = P->x[i], z0 = P->z[i];
             double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
-            if (s->near_wall[i]) walls_clip(s, ox_old, oz_old, x0, z0, &x1, &z1, &vx, &vz, &clips);
+            if (s->near_wall[i]) walls_clip(&s->cfg, s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
             P->x[i] = x1;
             P->z[i] = z1;
         }
@@ -159,21 +215,21 @@ mixsph_status integrate_step(mixsph_sim *s)
     int outside = 0;
     const double shift2 = neighbours_max_shift2(&s->NB, &s->C, P, s->C.start[s->C.ncell], &outside, SIM_THREADS(s));
     if (outside || 4.0 * shift2 >= s->NB.skin * s->NB.skin) {
-        const mixsph_status st = integrate_rebuild(s);
+        const mixsph_status st = integrate_rebuild_lists(s);
         if (st != MIXSPH_OK) return st;
     }
-    int bad_rho = forces_continuity(s);
+    const struct pair_system S = sim_pair_system(s);
+    int bad_rho = density_rates(s, &S);
+    if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
 #pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         P->rho[i] += dt * P->drho[i];
         bad_rho |= !(P->rho[i] > 0.0);
     }
-    integrate_eos(s);
-    if (s->cfg.pressure_smoothing > 0.0) forces_smooth_pressure(s);
-    if (s->has_granular) mixture_update(s);
-    walls_pressure(s);
-    if (forces_compute(s) || bad_rho) {
+    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    if (forces_momentum(s->forces, &S) || bad_rho) {
         for (size_t i = 0; i < P->n; i++)
             if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,

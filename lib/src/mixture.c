@@ -35,144 +35,173 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "mixture.h"
+
 #include "eos.h"
+#include "mixsph.h"
 #include "rheology.h"
-#include "sim.h"
-#include "status.h"
 
 #define MIXTURE_DET_MIN 0.05 /* below this det L the correction is not applied */
 
-mixsph_status mixture_alloc(mixsph_sim *s)
+/* PHASE A (temporary, removed in the next commit): the old kernel_w rounding. */
+static inline double PHASE_A_KERNEL_W(const struct kernel *k, double r)
 {
-    struct kinematics *K = &s->kin;
-    const size_t n = s->P.n + 1;
-    double **f[7] = {&K->gux, &K->guz, &K->gwx, &K->gwz, &K->lxx, &K->lxz, &K->lzz};
-    for (int k = 0; k < 7; k++) {
-        *f[k] = calloc(n, sizeof(double));
-        if (!*f[k]) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (strain rates)");
+    const double q = r / k->h;
+    if (q >= 2.0) return 0.0;
+    if (k->type == KERNEL_WENDLAND_C2) {
+        const double s = 1.0 - 0.5 * q;
+        const double s2 = s * s;
+        return k->a_d * s2 * s2 * (2.0 * q + 1.0);
     }
-    K->nbins = (size_t)ceil((s->domain[1] - s->domain[0]) / s->dx) + 1;
-    K->ztop = calloc(K->nbins, sizeof(double));
-    if (!K->ztop) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (pore pressure bins)");
-    K->nbed = (size_t)ceil((s->domain[1] - s->domain[0]) / (2.0 * s->h)) + 1;
-    K->bed_z = calloc(K->nbed, sizeof(double));
-    K->bed_ref = calloc(K->nbed, sizeof(long));
-    if (!K->bed_z || !K->bed_ref) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (fixed bed columns)");
-    return MIXSPH_OK;
+    if (q < 1.0) return k->a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
+    const double t = 2.0 - q;
+    return 0.25 * k->a_d * t * t * t;
 }
 
-void mixture_free(mixsph_sim *s)
+struct mixture {
+    const struct case_def *cfg;
+    double x_min, dx, h;
+    struct velocity_gradient grad; /* per particle, filled by the pair loops within a step */
+    /* pore pressure: per column dx wide, the top of the saturated granular column [m] */
+    double *ztop;
+    size_t nbins;
+    /* numerics.fixed_bed_speed >= 0 (SPHERA's fixed bed): per column 2h wide, the highest
+     * granular particle no faster than that speed (bed_ref, -1 for none) and its z [m] */
+    double *bed_z;
+    long *bed_ref;
+    size_t nbed;
+};
+
+struct mixture *mixture_create(const struct case_def *cfg, size_t cap, double x_min, double x_max, double dx, double h)
 {
-    struct kinematics *K = &s->kin;
-    free(K->gux);
-    free(K->guz);
-    free(K->gwx);
-    free(K->gwz);
-    free(K->lxx);
-    free(K->lxz);
-    free(K->lzz);
-    free(K->ztop);
-    free(K->bed_z);
-    free(K->bed_ref);
+    struct mixture *M = calloc(1, sizeof *M);
+    if (!M) return NULL;
+    M->cfg = cfg;
+    M->x_min = x_min;
+    M->dx = dx;
+    M->h = h;
+    struct velocity_gradient *G = &M->grad;
+    double **f[7] = {&G->dudx, &G->dudz, &G->dwdx, &G->dwdz, &G->lxx, &G->lxz, &G->lzz};
+    int ok = 1;
+    for (int k = 0; k < 7; k++) ok &= (*f[k] = calloc(cap + 1, sizeof(double))) != NULL;
+    M->nbins = (size_t)ceil((x_max - x_min) / dx) + 1;
+    M->ztop = calloc(M->nbins, sizeof(double));
+    M->nbed = (size_t)ceil((x_max - x_min) / (2.0 * h)) + 1;
+    M->bed_z = calloc(M->nbed, sizeof(double));
+    M->bed_ref = calloc(M->nbed, sizeof(long));
+    if (!ok || !M->ztop || !M->bed_z || !M->bed_ref) {
+        mixture_free(M);
+        return NULL;
+    }
+    return M;
 }
+
+void mixture_free(struct mixture *M)
+{
+    if (!M) return;
+    struct velocity_gradient *G = &M->grad;
+    double *f[7] = {G->dudx, G->dudz, G->dwdx, G->dwdz, G->lxx, G->lxz, G->lzz};
+    for (int k = 0; k < 7; k++) free(f[k]);
+    free(M->ztop);
+    free(M->bed_z);
+    free(M->bed_ref);
+    free(M);
+}
+
+struct velocity_gradient *mixture_gradient(struct mixture *M) { return &M->grad; }
 
 /* Column of x among n columns of the given width from the domain's x_min (clamped to the ends). */
-static size_t column_of(const mixsph_sim *s, double x, double width, size_t n)
+static size_t column_of(const struct mixture *M, double x, double width, size_t n)
 {
-    double b = floor((x - s->domain[0]) / width);
+    double b = floor((x - M->x_min) / width);
     if (b < 0) b = 0;
     if (b > (double)(n - 1)) b = (double)(n - 1);
     return (size_t)b;
 }
 
 /* Pore-pressure bin of x: columns dx wide. */
-static size_t bin_of(const mixsph_sim *s, double x)
+static size_t bin_of(const struct mixture *M, double x)
 {
-    return column_of(s, x, s->dx, s->kin.nbins);
+    return column_of(M, x, M->dx, M->nbins);
 }
 
 /* Top of the saturated granular column in every bin. */
-static void saturated_tops(mixsph_sim *s)
+static void saturated_tops(struct mixture *M, const struct particles *P)
 {
-    struct kinematics *K = &s->kin;
-    const struct particles *P = &s->P;
-    for (size_t b = 0; b < K->nbins; b++) K->ztop[b] = -INFINITY;
+    for (size_t b = 0; b < M->nbins; b++) M->ztop[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const struct medium *m = &s->cfg.media[P->medium[i]];
+        const struct medium *m = &M->cfg->media[P->medium[i]];
         if (m->kind != MEDIUM_GRANULAR || !m->saturated) continue;
-        const size_t b = bin_of(s, P->x[i]);
-        const double top = P->z[i] + 0.5 * s->dx;
-        if (top > K->ztop[b]) K->ztop[b] = top;
+        const size_t b = bin_of(M, P->x[i]);
+        const double top = P->z[i] + 0.5 * M->dx;
+        if (top > M->ztop[b]) M->ztop[b] = top;
     }
 }
 
 /* Fixed-bed column of x: columns 2h wide. */
-static size_t bed_column(const mixsph_sim *s, double x)
+static size_t bed_column(const struct mixture *M, double x)
 {
-    return column_of(s, x, 2.0 * s->h, s->kin.nbed);
+    return column_of(M, x, 2.0 * M->h, M->nbed);
 }
 
 /* Top of the fixed bed in every column: the highest granular particle no faster than
  * fixed_bed_speed (a grain fixed at the last decision counts as at rest); ties go to the first
  * in memory order, so the choice does not depend on the threads. */
-static void fixed_bed_tops(mixsph_sim *s, size_t n)
+static void fixed_bed_tops(struct mixture *M, const struct particles *P, size_t n)
 {
-    struct kinematics *K = &s->kin;
-    const struct particles *P = &s->P;
-    const double v2 = s->cfg.fixed_bed_speed * s->cfg.fixed_bed_speed;
-    for (size_t b = 0; b < K->nbed; b++) {
-        K->bed_z[b] = -INFINITY;
-        K->bed_ref[b] = -1;
+    const struct case_def *cfg = M->cfg;
+    const double v2 = cfg->fixed_bed_speed * cfg->fixed_bed_speed;
+    for (size_t b = 0; b < M->nbed; b++) {
+        M->bed_z[b] = -INFINITY;
+        M->bed_ref[b] = -1;
     }
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || s->cfg.media[P->medium[i]].kind != MEDIUM_GRANULAR) continue;
+        if (P->state[i] > MIXSPH_STATE_FIXED || cfg->media[P->medium[i]].kind != MEDIUM_GRANULAR) continue;
         if (P->state[i] == MIXSPH_STATE_MOBILE && P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i] > v2) continue;
-        const size_t b = bed_column(s, P->x[i]);
-        if (P->z[i] > K->bed_z[b]) {
-            K->bed_z[b] = P->z[i];
-            K->bed_ref[b] = (long)i;
+        const size_t b = bed_column(M, P->x[i]);
+        if (P->z[i] > M->bed_z[b]) {
+            M->bed_z[b] = P->z[i];
+            M->bed_ref[b] = (long)i;
         }
     }
 }
 
 /* Whether grain i lies more than 2h below the top of its column's fixed bed. */
-static int frozen(const mixsph_sim *s, size_t i)
+static int frozen(const struct mixture *M, const struct particles *P, size_t i)
 {
-    return s->P.z[i] < s->kin.bed_z[bed_column(s, s->P.x[i])] - 2.0 * s->h;
+    return P->z[i] < M->bed_z[bed_column(M, P->x[i])] - 2.0 * M->h;
 }
 
 /* Pore pressure of a saturated grain at (x, z). */
-static double pore_pressure(const mixsph_sim *s, const struct medium *m, double x, double z)
+static double pore_pressure(const struct mixture *M, const struct medium *m, double x, double z)
 {
-    const struct kinematics *K = &s->kin;
-    const size_t b = bin_of(s, x);
-    const double top = K->ztop[b];
+    const size_t b = bin_of(M, x);
+    const double top = M->ztop[b];
     if (!(top > z)) return 0.0;
-    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < K->nbins ? b + 2 : K->nbins - 1;
+    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < M->nbins ? b + 2 : M->nbins - 1;
     double slope = 0.0;
-    if (br > bl && isfinite(K->ztop[bl]) && isfinite(K->ztop[br]))
-        slope = (K->ztop[br] - K->ztop[bl]) / ((double)(br - bl) * s->dx);
+    if (br > bl && isfinite(M->ztop[bl]) && isfinite(M->ztop[br]))
+        slope = (M->ztop[br] - M->ztop[bl]) / ((double)(br - bl) * M->dx);
     const double cos2 = 1.0 / (1.0 + slope * slope);
-    return m->rho_f * s->cfg.g * (top - z) * cos2;
+    return m->rho_f * M->cfg->g * (top - z) * cos2;
 }
 
-void mixture_update(mixsph_sim *s)
+long mixture_update(struct mixture *M, const struct kernel *KW, const struct gather *G, struct particles *P, size_t n,
+                    int n_threads)
 {
-    struct particles *P = &s->P;
-    const struct kinematics *K = &s->kin;
-    const struct cells *C = &s->C;
-    const size_t n = C->start[C->ncell];
-    saturated_tops(s);
-    const int fixed_bed = s->cfg.fixed_bed_speed >= 0.0;
-    if (fixed_bed) fixed_bed_tops(s, n);
+    const struct case_def *cfg = M->cfg;
+    const struct velocity_gradient *K = &M->grad;
+    saturated_tops(M, P);
+    const int fixed_bed = cfg->fixed_bed_speed >= 0.0;
+    if (fixed_bed) fixed_bed_tops(M, P, n);
     long fixed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : fixed) num_threads(SIM_THREADS(s))
+#pragma omp parallel for schedule(static) reduction(+ : fixed) num_threads(n_threads)
     for (size_t i = 0; i < n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const struct medium *m = &s->cfg.media[P->medium[i]];
+        const struct medium *m = &cfg->media[P->medium[i]];
         if (m->kind != MEDIUM_GRANULAR) continue;
-        double dudx = K->gux[i], dudz = K->guz[i], dwdx = K->gwx[i], dwdz = K->gwz[i];
+        double dudx = K->dudx[i], dudz = K->dudz[i], dwdx = K->dwdx[i], dwdz = K->dwdz[i];
         const double det = K->lxx[i] * K->lzz[i] - K->lxz[i] * K->lxz[i];
         if (det > MIXTURE_DET_MIN) {
             const double a = K->lzz[i] / det, b = -K->lxz[i] / det, d = K->lxx[i] / det; /* L^-1 = [a b; b d] */
@@ -184,12 +213,12 @@ void mixture_update(mixsph_sim *s)
             dwdz = wz;
         }
         const double sii = rheology_sqrt_ii(dudx, dudz, dwdx, dwdz);
-        const double pw = m->saturated ? pore_pressure(s, m, P->x[i], P->z[i]) : 0.0;
-        const double sigma = rheology_effective_stress(P->p[i] - s->cfg.p_background, pw);
+        const double pw = m->saturated ? pore_pressure(M, m, P->x[i], P->z[i]) : 0.0;
+        const double sigma = rheology_effective_stress(P->p[i] - cfg->p_background, pw);
         const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
         double mu;
         int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
-        if (fixed_bed && frozen(s, i)) {
+        if (fixed_bed && frozen(M, P, i)) {
             fix = 1;
             mu = m->mu_thr;
         }
@@ -202,46 +231,45 @@ void mixture_update(mixsph_sim *s)
         }
         P->mu[i] = mu;
     }
-    s->n_fixed = fixed;
-    if (fixed == 0) return;
+    if (fixed == 0) return 0;
     /* pressure of the fixed grains from the mobile grains around them */
-    const struct kernel *KW = &s->K;
-    const double g = s->cfg.g;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    const double g = cfg->g;
+#pragma omp parallel for schedule(static) num_threads(n_threads)
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(s, i))) continue;
+        if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
         const double xi = P->x[i], zi = P->z[i];
         double sw = 0.0, sp = 0.0;
         for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
-            for (size_t j = s->G.rng[6 * i + k]; j < s->G.rng[6 * i + k + 1]; j++) {
-            if (P->state[j] != MIXSPH_STATE_MOBILE || s->cfg.media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
+            for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
+            if (P->state[j] != MIXSPH_STATE_MOBILE || cfg->media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
             const double rx = xi - P->x[j], rz = zi - P->z[j];
             const double r2 = rx * rx + rz * rz;
             if (r2 >= KW->r2max) continue;
-            const double w = kernel_w(KW, sqrt(r2));
+            const double w = PHASE_A_KERNEL_W(KW, sqrt(r2));
             sw += w;
             sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
         }
         if (sw > 0.0) {
-            const double pb = s->cfg.p_background;
+            const double pb = cfg->p_background;
             const double p = sp / sw;
-            P->p[i] = s->cfg.media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
+            P->p[i] = cfg->media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
         }
     }
-    if (!fixed_bed) return;
+    if (!fixed_bed) return fixed;
     /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
      * final: the top is never frozen, and its extrapolation above is done) */
-    const double pb = s->cfg.p_background;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    const double pb = cfg->p_background;
+#pragma omp parallel for schedule(static) num_threads(n_threads)
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(s, i)) continue;
-        const size_t top = (size_t)K->bed_ref[bed_column(s, P->x[i])];
-        const struct medium *m = &s->cfg.media[P->medium[i]];
-        double p = P->p[top] + s->cfg.media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+        if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
+        const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
+        const struct medium *m = &cfg->media[P->medium[i]];
+        double p = P->p[top] + cfg->media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
         if (m->tension_cutoff && p < pb) p = pb;
         P->p[i] = p;
         P->rho[i] = eos_density(p - pb, m->rho0, m->c);
         P->inv_rho[i] = 1.0 / P->rho[i];
         P->vol[i] = P->m[i] * P->inv_rho[i];
     }
+    return fixed;
 }

@@ -63,6 +63,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "monitors.h"
 #include "sim.h"
 #include "status.h"
 

@@ -10,6 +10,9 @@
 #include <sys/stat.h>
 
 #include "eos.h"
+#include "geometry.h"
+#include "integrate.h"
+#include "monitors.h"
 #include "output.h"
 #include "status.h"
 
@@ -33,7 +36,7 @@ static int site_blocked(const mixsph_sim *s, double x, double z)
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         int at_end = 0;
         double d;
-        walls_signed_distance(s, w, x, z, &d, &at_end);
+        walls_signed_distance(&s->cfg, s->walls, w, x, z, &d, &at_end);
         if (!at_end && d < 0.5 * s->dx * (1.0 - 1e-9)) return 1;
     }
     return 0;
@@ -170,22 +173,17 @@ static mixsph_status sim_init(mixsph_sim *s)
     s->K = kernel_make_type(s->h, s->cfg.kernel);
     s->c_max = 0.0;
     for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
-    for (size_t w = 0; w < s->cfg.n_walls; w++) {
-        const int mo = s->cfg.walls[w].motion;
-        if (mo < 0) continue;
-        case_motion_velocity(&s->cfg.motions[mo], 0.0, &s->walls[w].vx, &s->walls[w].vz);
-        case_motion_acceleration(&s->cfg.motions[mo], 0.0, &s->walls[w].ax, &s->walls[w].az);
-    }
+    walls_start(&s->cfg, s->walls);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
-    if ((st = walls_generate(s)) != MIXSPH_OK) return st;
-    for (size_t i = s->n_fluid; i < s->P.n; i++) {
-        const struct wall_state *ws = &s->walls[s->P.medium[i]];
-        s->P.vx[i] = s->P.uvx[i] = ws->vx;
-        s->P.vz[i] = s->P.uvz[i] = ws->vz;
-    }
+    const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->P);
+    if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
+    s->n_wall = (size_t)n_wall;
     set_domain(s);
-    for (size_t k = 0; k < s->cfg.n_media; k++) s->has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
-    if (s->has_granular && (st = mixture_alloc(s)) != MIXSPH_OK) return st;
+    int has_granular = 0;
+    for (size_t k = 0; k < s->cfg.n_media; k++) has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
+    if (has_granular && !(s->mixture = mixture_create(&s->cfg, s->P.n, s->domain[0], s->domain[1], s->dx, s->h)))
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (granular phase)");
+    if (!(s->forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
     for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */
         if (!(s->P.x[i] >= dom[0] && s->P.x[i] < dom[1] && s->P.z[i] >= dom[2] && s->P.z[i] < dom[3]))
@@ -204,13 +202,8 @@ static mixsph_status sim_init(mixsph_sim *s)
                             s->P.x[i], s->P.z[i]);
     if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
-    if ((st = integrate_gather(s)) != MIXSPH_OK) return st;
-    if (forces_continuity(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
-    integrate_eos(s);
-    if (s->has_granular) mixture_update(s);
-    walls_pressure(s);
-    if (forces_compute(s)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
-    s->dt = integrate_time_step(s);
+    if ((st = integrate_build_gather_lists(s)) != MIXSPH_OK) return st;
+    if ((st = integrate_initial_rates(s)) != MIXSPH_OK) return st;
     monitors_init(s);
     s->next_sample = 0.0;
     s->next_snapshot = 0.0;
@@ -281,14 +274,13 @@ void mixsph_sim_destroy(mixsph_sim *s)
     if (!s) return;
     if (s->monitor_csv) fclose(s->monitor_csv);
     output_close(s);
-    if (s->has_granular) mixture_free(s);
+    mixture_free(s->mixture);
+    forces_free(s->forces);
     particles_free(&s->P);
     cells_free(&s->C);
     neighbours_free(&s->NB);
     neighbours_gather_free(&s->G);
     free(s->near_wall);
-    free(s->fk);
-    free(s->fk_off);
     case_free(&s->cfg);
     for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
     free(s->ov_key);

@@ -1,5 +1,8 @@
 /* sim.h - the simulation object (internal definition of the opaque mixsph_sim). It owns all
- * state: the case, the particles, the cell list, the walls' motion, the outputs and files. */
+ * state: the case, the particles, the cell list and neighbour ranges, the walls' motion, the
+ * modules' private state (forces, mixture), the outputs and files. The physics modules
+ * (forces, walls, mixture) do not see it: they take the parts they need; the time stepping
+ * (integrate.c), the outputs (monitors.c, output.c) and the state (state.c) work on it. */
 #ifndef MIXSPH_SIM_H
 #define MIXSPH_SIM_H
 #include <stdint.h>
@@ -7,10 +10,13 @@
 
 #include "case.h"
 #include "cells.h"
+#include "forces.h"
 #include "kernel.h"
 #include "mixsph.h"
+#include "mixture.h"
 #include "neighbours.h"
 #include "particles.h"
+#include "walls.h"
 
 #ifdef _OPENMP
 #include <omp.h>
@@ -25,27 +31,6 @@
 #endif
 
 #define SIM_MAX_OUTPUTS (8 + CASE_MAX_MONITORS)
-
-struct wall_state {
-    double ox, oz;   /* displacement of the wall since t = 0 [m] */
-    double vx, vz;   /* current velocity [m/s] */
-    double ax, az;   /* current acceleration [m/s2] */
-    int ext;         /* driven by an external velocity (ext_vx, ext_vz) instead of its motion law */
-    double ext_vx, ext_vz; /* [m/s] */
-};
-
-/* Per-step scratch of the granular strain rate (not permuted: filled and used within a step). */
-struct kinematics {
-    double *gux, *guz, *gwx, *gwz; /* uncorrected velocity gradient du/dx, du/dz, dw/dx, dw/dz [1/s] */
-    double *lxx, *lxz, *lzz;       /* correction matrix L (symmetric) [-] */
-    double *ztop;                  /* per x-bin of width dx: top of the saturated granular column [m] */
-    size_t nbins;
-    /* numerics.fixed_bed_speed >= 0 (SPHERA's fixed bed, mixture.c): per column 2h wide, the
-     * highest granular particle no faster than that speed (bed_ref, -1 for none) and its z [m] */
-    double *bed_z;
-    long *bed_ref;
-    size_t nbed;
-};
 
 struct mixsph_sim {
     struct case_def cfg;
@@ -63,13 +48,10 @@ struct mixsph_sim {
     struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
     struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
-    double *fk;                   /* kernel factors of the pair lanes, continuity -> momentum pass (forces.c) */
-    size_t *fk_off, fk_cap, fk_off_cap;
-    int fk_valid;                 /* fk holds this step's factors (set by the continuity pass, used once) */
+    struct forces *forces;        /* the pair loops' cache and scratch */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
-    int has_granular;             /* any granular medium: strain rates and regimes every step */
-    struct kinematics kin;
+    struct mixture *mixture;      /* granular phase; NULL without granular media */
     long n_fixed;                 /* granular particles held fixed after the last step */
 
     double t, dt;                 /* time, next time step [s] */
@@ -98,45 +80,11 @@ struct mixsph_sim {
     char err[1024];
 };
 
-/* state.c */
-int state_same_case(const mixsph_sim *s, const char *text, const char *const *keys, const double *values, size_t n_ov);
+/** What the pair loops of forces.h run over, from the simulation's current parts and options. */
+struct pair_system sim_pair_system(mixsph_sim *s);
 
-/* walls.c */
-mixsph_status walls_generate(mixsph_sim *s);
-void walls_signed_distance(const mixsph_sim *s, size_t w, double x, double z, double *d, int *at_end);
-void walls_move(mixsph_sim *s, double t_from, double dt);
-void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old, double x0, double z0,
-                double *x1, double *z1, double *vx, double *vz, long *clips);
-void walls_pressure(mixsph_sim *s);
-
-/* sim.c: monotonic wall clock [s] */
+/** Monotonic wall clock [s]. */
 double sim_clock_s(void);
-
-/* forces.c */
-int forces_compute(mixsph_sim *s);
-int forces_continuity(mixsph_sim *s);
-void forces_smooth_pressure(mixsph_sim *s);
-void forces_pair_for_test(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho);
-
-/* mixture.c */
-mixsph_status mixture_alloc(mixsph_sim *s);
-void mixture_free(mixsph_sim *s);
-void mixture_update(mixsph_sim *s);
-
-/* integrate.c */
-mixsph_status integrate_rebuild(mixsph_sim *s);
-mixsph_status integrate_gather(mixsph_sim *s);
-double integrate_time_step(const mixsph_sim *s);
-mixsph_status integrate_step(mixsph_sim *s);
-void integrate_eos(mixsph_sim *s);
-
-/* monitors.c */
-void monitors_init(mixsph_sim *s);
-double monitors_value(const mixsph_sim *s, size_t k);
-mixsph_status monitors_sample(mixsph_sim *s);
-mixsph_status monitors_profiles(mixsph_sim *s);
-mixsph_status monitors_open(mixsph_sim *s);
-mixsph_status monitors_snapshot(mixsph_sim *s);
 
 #define SIM_FAIL(s, st, ...) status_set((s)->err, sizeof (s)->err, (st), __VA_ARGS__)
 

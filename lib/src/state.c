@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "integrate.h"
 #include "sim.h"
 #include "status.h"
 
@@ -266,7 +267,7 @@ static mixsph_status read_source(struct reader *r, struct source *src, char *err
     return MIXSPH_OK;
 }
 
-int state_same_case(const mixsph_sim *s, const char *text, const char *const *keys, const double *values, size_t n_ov)
+static int state_same_case(const mixsph_sim *s, const char *text, const char *const *keys, const double *values, size_t n_ov)
 {
     if (!s->case_text || strcmp(s->case_text, text) != 0 || s->n_ov != n_ov) return 0;
     for (size_t k = 0; k < n_ov; k++)
@@ -277,11 +278,11 @@ int state_same_case(const mixsph_sim *s, const char *text, const char *const *ke
 /* Cells and neighbour lists from the build positions (the particles are in their build order). */
 static mixsph_status state_relist(mixsph_sim *s)
 {
-    s->fk_valid = 0;
+    forces_forget_cache(s->forces);
     if (cells_index(&s->C, &s->P, s->NB.x0, s->NB.z0) != 0 ||
         neighbours_relist(&s->NB, &s->C, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particles not in cell order (or out of memory)");
-    return integrate_gather(s);
+    return integrate_build_gather_lists(s);
 }
 
 /* Read the dynamic part into s (same case, checked by the caller). On a malformed stream s may

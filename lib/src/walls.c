@@ -15,25 +15,34 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "eos.h"
+#include "walls.h"
+
 #include "geometry.h"
-#include "sim.h"
-#include "status.h"
+#include "mixsph.h"
 
-#define WALLS_CLIP_GAP 0.1 /* distance [dx] at which a crossing particle is put back */
-
-void walls_signed_distance(const mixsph_sim *s, size_t w, double x, double z, double *d, int *at_end)
+void walls_signed_distance(const struct case_def *cfg, const struct wall_state *ws, size_t w, double x, double z,
+                           double *d, int *at_end)
 {
-    const struct wall *wl = &s->cfg.walls[w];
-    *d = geom_signed_distance(&wl->line, wl->side, x - s->walls[w].ox, z - s->walls[w].oz, at_end);
+    const struct wall *wl = &cfg->walls[w];
+    *d = geom_signed_distance(&wl->line, wl->side, x - ws[w].ox, z - ws[w].oz, at_end);
 }
 
-mixsph_status walls_generate(mixsph_sim *s)
+void walls_start(const struct case_def *cfg, struct wall_state *ws)
 {
-    const double dx = s->dx;
-    const double depth = s->cfg.wall_layers * dx;
-    for (size_t w = 0; w < s->cfg.n_walls; w++) {
-        const struct wall *wl = &s->cfg.walls[w];
+    for (size_t w = 0; w < cfg->n_walls; w++) {
+        const int mo = cfg->walls[w].motion;
+        if (mo < 0) continue;
+        case_motion_velocity(&cfg->motions[mo], 0.0, &ws[w].vx, &ws[w].vz);
+        case_motion_acceleration(&cfg->motions[mo], 0.0, &ws[w].ax, &ws[w].az);
+    }
+}
+
+long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, struct particles *P)
+{
+    const double depth = cfg->wall_layers * dx;
+    long added = 0;
+    for (size_t w = 0; w < cfg->n_walls; w++) {
+        const struct wall *wl = &cfg->walls[w];
         double xmin = INFINITY, xmax = -INFINITY, zmin = INFINITY, zmax = -INFINITY;
         for (size_t k = 0; k < wl->line.n; k++) {
             xmin = fmin(xmin, wl->line.x[k]);
@@ -52,34 +61,36 @@ mixsph_status walls_generate(mixsph_sim *s)
                 /* one particle per lattice site among fixed walls (a site behind two walls) */
                 int dup = 0;
                 for (size_t v = 0; v < w && !dup && wl->motion < 0; v++) {
-                    if (s->cfg.walls[v].motion >= 0) continue;
+                    if (cfg->walls[v].motion >= 0) continue;
                     int e2 = 0;
-                    const double d2 = geom_signed_distance(&s->cfg.walls[v].line, s->cfg.walls[v].side, x, z, &e2);
+                    const double d2 = geom_signed_distance(&cfg->walls[v].line, cfg->walls[v].side, x, z, &e2);
                     dup = !e2 && d2 < 0.0 && d2 >= -depth;
                 }
                 if (dup) continue;
-                const size_t j = particles_push(&s->P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
-                if (j == (size_t)-1) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
-                s->P.vol[j] = dx * dx;
-                s->P.m[j] = 0.0;
-                s->n_wall++;
+                const size_t j = particles_push(P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
+                if (j == (size_t)-1) return -1;
+                P->vol[j] = dx * dx;
+                P->m[j] = 0.0;
+                P->vx[j] = P->uvx[j] = ws[w].vx;
+                P->vz[j] = P->uvz[j] = ws[w].vz;
+                added++;
             }
         }
     }
-    return MIXSPH_OK;
+    return added;
 }
 
 /* Move the walls from t_from by dt: each moving wall translates by its velocity at mid-step
  * (exact for a law linear over the step), then takes the velocity and acceleration at t+dt. */
-void walls_move(mixsph_sim *s, double t_from, double dt)
+void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct particles *P, double t_from, double dt)
 {
     int moving = 0;
     double dxw[CASE_MAX_WALLS] = {0}, dzw[CASE_MAX_WALLS] = {0};
-    for (size_t w = 0; w < s->cfg.n_walls; w++) {
-        const int mo = s->cfg.walls[w].motion;
+    for (size_t w = 0; w < cfg->n_walls; w++) {
+        const int mo = cfg->walls[w].motion;
         if (mo < 0) continue;
-        const struct motion *m = &s->cfg.motions[mo];
-        struct wall_state *ws = &s->walls[w];
+        const struct motion *m = &cfg->motions[mo];
+        struct wall_state *ws = &wstate[w];
         double vx, vz;
         if (ws->ext) { /* external velocity (co-simulation input): constant over the step */
             vx = ws->vx = ws->ext_vx;
@@ -97,29 +108,25 @@ void walls_move(mixsph_sim *s, double t_from, double dt)
         moving = 1;
     }
     if (!moving) return;
-    struct particles *P = &s->P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
-        const size_t w = P->medium[i];
-        if (s->cfg.walls[w].motion < 0) continue;
+        const size_t w = particles_wall_index(P, i);
+        if (cfg->walls[w].motion < 0) continue;
         P->x[i] += dxw[w];
         P->z[i] += dzw[w];
-        P->vx[i] = s->walls[w].vx;
-        P->vz[i] = s->walls[w].vz;
+        P->vx[i] = wstate[w].vx;
+        P->vz[i] = wstate[w].vz;
     }
 }
 
-/* Keep a particle moving (x0,z0) -> (*x1,*z1) on the fluid side of every wall. ox_old/oz_old:
- * the walls' displacements at the start of the step (the walls are already moved). */
-void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old, double x0, double z0, double *x1,
-                double *z1, double *vx, double *vz, long *clips)
+void walls_clip(const struct case_def *cfg, const struct wall_state *wstate, const double *ox_old, const double *oz_old,
+                double gap, double x0, double z0, double *x1, double *z1, double *vx, double *vz, long *clips)
 {
-    const double gap = WALLS_CLIP_GAP * s->dx;
     for (int pass = 0; pass < 4; pass++) {
         int hit = 0;
-        for (size_t w = 0; w < s->cfg.n_walls && !hit; w++) {
-            const struct wall *wl = &s->cfg.walls[w];
-            const struct wall_state *ws = &s->walls[w];
+        for (size_t w = 0; w < cfg->n_walls && !hit; w++) {
+            const struct wall *wl = &cfg->walls[w];
+            const struct wall_state *ws = &wstate[w];
             /* the path in the frame of the wall */
             const double ax = x0 - ox_old[w], az = z0 - oz_old[w];
             const double bx = *x1 - ws->ox, bz = *z1 - ws->oz;
@@ -150,35 +157,16 @@ void walls_clip(const mixsph_sim *s, const double *ox_old, const double *oz_old,
     }
 }
 
-/* W(q) without branches (0 for q >= 2), for the vectorised gather below. */
-static inline double walls_w(double q, double a_d, int wendland)
+void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state *wstate, const struct kernel *K,
+                             const struct gather *G, double dx, struct particles *P, size_t n, int n_threads)
 {
-    if (wendland) {
-        double s = 1.0 - 0.5 * q;
-        s = s > 0.0 ? s : 0.0;
-        return a_d * s * s * s * s * (2.0 * q + 1.0);
-    }
-    double t = 2.0 - q;
-    t = t > 0.0 ? t : 0.0;
-    const double inner = 1.0 - 1.5 * q * q + 0.75 * q * q * q, outer = 0.25 * t * t * t;
-    return a_d * (q < 1.0 ? inner : outer);
-}
-
-/* Pressure and viscous velocity of wall particles from the surrounding fluid (Adami 2012). */
-void walls_pressure(mixsph_sim *s)
-{
-    struct particles *P = &s->P;
-    const struct cells *C = &s->C;
-    const struct gather *G = &s->G;
-    const struct kernel *K = &s->K;
-    const double g = s->cfg.g, vol = s->dx * s->dx, rho_default = s->cfg.media[0].rho0;
-    const double inv_h = 1.0 / K->h;
+    const double g = cfg->g, vol = dx * dx, rho_default = cfg->media[0].rho0;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
-    const size_t n = C->start[C->ncell];
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+#pragma omp parallel for schedule(static) num_threads(n_threads)
     for (size_t i = 0; i < n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
-        const struct wall_state *ws = &s->walls[P->medium[i]];
+        const size_t w = particles_wall_index(P, i);
+        const struct wall_state *ws = &wstate[w];
         /* g - a_w, with g = (0, -g) */
         const double gx = -ws->ax, gz = -g - ws->az;
         const double xi = P->x[i], zi = P->z[i];
@@ -186,14 +174,15 @@ void walls_pressure(mixsph_sim *s)
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) { /* the non-wall neighbours */
             const size_t j = G->list[k];
             const double rx = xi - P->x[j], rz = zi - P->z[j];
-            const double wgt = walls_w(sqrt(rx * rx + rz * rz) * inv_h, K->a_d, wendland);
+            const double q = kernel_q(K, rx * rx + rz * rz);
+            const double wgt = wendland ? kernel_w_q(K, q, 1) : kernel_w_q(K, q, 0);
             sw += wgt;
             sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
             svx += P->vx[j] * wgt;
             srho += P->rho[j] * wgt;
             svz += P->vz[j] * wgt;
         }
-        const int noslip = s->cfg.walls[P->medium[i]].slip == WALL_NO_SLIP;
+        const int noslip = cfg->walls[w].slip == WALL_NO_SLIP;
         if (sw > 0.0) {
             const double pw = sp / sw;
             P->p[i] = pw > 0.0 ? pw : 0.0;

@@ -1,0 +1,79 @@
+/* forces.h - the pair loops of the balance equations (docs/model.md sections 2 and 7): the
+ * density rate (continuity), the velocity gradient of the grains, the momentum rate, and
+ * SPHERA's partial pressure smoothing. They run over the particles sorted by cell and their
+ * neighbour ranges (neighbours.h); the threading and the kernel-factor cache are private to
+ * forces.c. A viscous solver or another momentum treatment plugs in here. */
+#ifndef MIXSPH_FORCES_H
+#define MIXSPH_FORCES_H
+#include <stddef.h>
+
+#include "case.h"
+#include "cells.h"
+#include "kernel.h"
+#include "neighbours.h"
+#include "particles.h"
+
+/* Constants of the pair terms. */
+struct forces_params {
+    struct kernel K;
+    double eta2;        /* eta^2 of the Morris and Monaghan terms [m2] */
+    double g;           /* gravity [m/s2] */
+    int av_wall;        /* artificial viscosity between particles and walls */
+    int av_mixed;       /* ... between particles of different media too */
+    int av_separating;  /* ... for separating pairs too */
+};
+
+/* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */
+struct pair_system {
+    struct particles *P;
+    const struct cells *C;
+    const struct neighbours *NB;
+    const struct gather *G;   /* gather ranges (the velocity gradient of grains) */
+    const struct medium *media;
+    struct forces_params params;
+    int n_threads;
+};
+
+/* Velocity gradient of the grains (uncorrected G = sum_j V_j (u_j - u_i) (x) grad W) and the
+ * correction matrix L = sum_j V_j (x_j - x_i) (x) grad W (symmetric), per particle; filled
+ * within a step for the granular particles only, not permuted. */
+struct velocity_gradient {
+    double *dudx, *dudz, *dwdx, *dwdz; /* [1/s] */
+    double *lxx, *lxz, *lzz;           /* [-] */
+};
+
+/* Module state: the kernel-factor cache that the density pass fills and the momentum pass of the
+ * same step reads, and the scratch sums of the passes. */
+struct forces;
+
+struct forces *forces_create(void);
+void forces_free(struct forces *F);
+
+/** Density rate drho of every particle and its count of same-medium neighbours (nneigh) from
+ *  the current positions and velocities. Returns 1 if a non-finite value appeared at a mobile
+ *  particle, -1 if a scratch array cannot be allocated, 0 otherwise. */
+int forces_density_rate(struct forces *F, const struct pair_system *S);
+
+/** Velocity gradient and correction matrix of every granular particle that is not a wall or
+ *  lost, over its gather ranges (walls enter with their no-slip velocity). */
+void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out);
+
+/** Acceleration (ax, az) of every particle, gravity included. Returns 1 if a non-finite value
+ *  appeared at a mobile particle, 0 otherwise. */
+int forces_momentum(struct forces *F, const struct pair_system *S);
+
+/** SPHERA's partial pressure smoothing with factor theta_P dt / h (docs/model.md section 3):
+ *  pressures and densities of the non-wall particles relax toward their neighbours'. Returns -1
+ *  if a scratch array cannot be allocated. */
+int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double theta_dt_over_h);
+
+/** Whether the cache holds factors the next momentum pass will use (tests). */
+int forces_cache_pending(const struct forces *F);
+/** Drop the cached factors (the particles were replaced, e.g. by a restored state). */
+void forces_forget_cache(struct forces *F);
+
+/** Test hook: the acceleration (without gravity) and the density rate particle j gives i,
+ *  evaluated by the same pair code. */
+void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho);
+
+#endif

@@ -1,0 +1,46 @@
+/* sim_passes.h - the single passes of a time step on a whole simulation, for white-box tests
+ * that set up particles by hand and call one pass at a time (integrate.c strings them together
+ * in a step). */
+#ifndef MIXSPH_TEST_SIM_PASSES_H
+#define MIXSPH_TEST_SIM_PASSES_H
+
+#include "integrate.h"
+#include "sim.h"
+
+/* Density pass (and the grains' velocity gradient). Returns forces_density_rate's value. */
+static inline int sim_density_pass(mixsph_sim *s)
+{
+    const struct pair_system S = sim_pair_system(s);
+    const int bad = forces_density_rate(s->forces, &S);
+    if (s->mixture) forces_velocity_gradient(&S, mixture_gradient(s->mixture));
+    return bad;
+}
+
+/* Momentum pass. Returns forces_momentum's value. */
+static inline int sim_momentum_pass(mixsph_sim *s)
+{
+    const struct pair_system S = sim_pair_system(s);
+    return forces_momentum(s->forces, &S);
+}
+
+/* Regimes of the grains. */
+static inline void sim_mixture_update(mixsph_sim *s)
+{
+    s->n_fixed = mixture_update(s->mixture, &s->K, &s->G, &s->P, s->C.start[s->C.ncell], SIM_THREADS(s));
+}
+
+/* SPHERA's pressure smoothing with the case's theta_P and the current dt. */
+static inline void sim_smooth_pressure(mixsph_sim *s)
+{
+    const struct pair_system S = sim_pair_system(s);
+    forces_smooth_pressure(s->forces, &S, s->cfg.pressure_smoothing * s->dt / s->h);
+}
+
+/* The acceleration (without gravity) and density rate particle j gives i. */
+static inline void sim_pair_terms(mixsph_sim *s, size_t i, size_t j, double *ax, double *az, double *drho)
+{
+    const struct pair_system S = sim_pair_system(s);
+    forces_pair_for_test(&S, i, j, ax, az, drho);
+}
+
+#endif
