@@ -1,4 +1,4 @@
-/* eos.h - linearised Tait equation of state p = c0^2 (rho - rho0) (MODEL.md section 3). */
+/* eos.h - linearised Tait equation of state p = c0^2 (rho - rho0) (docs/model.md section 3). */
 #ifndef MIXSPH_EOS_H
 #define MIXSPH_EOS_H
 

@@ -12,7 +12,7 @@
  * Pi_ij = -alpha c h min(u_ij . x_ij, 0) / (r^2 + eta^2) (1/rho_i + 1/rho_j)/2 (the mean of the
  * inverse densities: symmetric, like the usual inverse of the mean, and free of divisions), with
  * alpha c h the larger of the two particles' (0 for a medium without alpha_m). By default it acts
- * between particles of one medium (MODEL.md: water-water) and between a particle and walls;
+ * between particles of one medium (docs/model.md section 2: water-water) and between a particle and walls;
  * numerics.av_wall = 0 drops the wall pairs, av_mixed = 1 adds pairs of different media and
  * av_separating = 1 drops the min(., 0), all three as SPHERA does (its viscomon routine: every
  * pair, separating ones too; at its semi-analytic walls only the wall-normal velocity).
@@ -36,12 +36,12 @@
  * order, so every particle receives its contributions in the same order whatever the number of
  * threads: results are bit-identical for any thread count.
  *
- * Two passes per step: continuity (with the newest velocities) before the EOS, momentum after;
- * see integrate.c for why. Both run at the same positions over the same ranges, so the
- * continuity pass stores the kernel factor F of every lane and the momentum pass reads it
- * (fcache_layout below). With granular media the velocity gradient of each grain (for its
- * strain rate) is gathered right after the continuity pass, over its gather ranges (all its
- * neighbours, three contiguous ranges). */
+ * Two passes per step: the density rate (continuity, with the newest velocities) before the EOS,
+ * momentum after; see integrate.c for why. Both run at the same positions over the same ranges,
+ * so the density pass stores the kernel factor F of every lane and the momentum pass reads it
+ * (fcache_layout below). With granular media integrate.c has the velocity gradient of each grain
+ * (for its strain rate) gathered right after the density pass, over its gather ranges (all its
+ * neighbours, three contiguous ranges): forces_velocity_gradient. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -78,23 +78,6 @@ struct forces {
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
     size_t scratch_cap;
 };
-
-/* PHASE A (temporary, removed in the next commit): the smoothing's old W rounding. */
-static inline double PHASE_A_SMOOTH_W(const struct kernel *k, double q, const int wendland)
-{
-    const double a_d = k->a_d;
-    double w;
-    if (wendland) {
-        double s1 = 1.0 - 0.5 * q;
-        s1 = s1 > 0.0 ? s1 : 0.0;
-        w = a_d * s1 * s1 * s1 * s1 * (2.0 * q + 1.0);
-    } else {
-        double t = 2.0 - q;
-        t = t > 0.0 ? t : 0.0;
-        w = q < 1.0 ? a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q) : 0.25 * a_d * t * t * t;
-    }
-    return w;
-}
 
 /* Constants of one pass of the pair loops. */
 struct pair_ctx {
@@ -209,7 +192,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double rx = xi - x[j], rz = zi - z[j];
-            double w = PHASE_A_SMOOTH_W(&Xl.K, sqrt(rx * rx + rz * rz) * Xl.K.inv_h, wendland);
+            double w = kernel_w_q(&Xl.K, kernel_q(&Xl.K, rx * rx + rz * rz), wendland);
             w *= FORCES_LANE_IN(k, m) * (tag[j] < 0.0 ? 0.0 : 1.0);
             const double b = (p[j] - pi - 0.5 * (rhoi + rho[j]) * g * rz) * w;
             sa[k] += b * vol[j];
@@ -228,7 +211,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
 
 /* Velocity gradient of granular particle i, gathered over its nr ranges of candidates: the uncorrected
  * G = sum_j V_j (u_j - u_i) (x) grad_i W and the correction matrix
- * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (MODEL.md section 5). Walls enter
+ * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (docs/model.md section 5). Walls enter
  * with their no-slip velocity, so grains feel the shear of a wall. Only granular particles need
  * it, so it is a gather over them alone rather than part of the symmetric pass. */
 FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,

@@ -1,4 +1,4 @@
-/* integrate.c - time step criterion (4) and the second-order leapfrog (MODEL.md section 4), in
+/* integrate.c - time step criterion (4) and the second-order leapfrog (docs/model.md section 4), in
  * kick-drift-kick form with position and density at whole steps and velocity at half steps:
  *   v^{n+1/2} = v^n + dt/2 a^n
  *   x^{n+1}   = x^n + dt v^{n+1/2}                   (walls kept uncrossed; walls move)
@@ -8,7 +8,7 @@
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
  * Granular particles: after the continuity pass (which also gives their strain rate from
  * v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still gets
- * forces and the kicks, is not drifted and does not limit dt (MODEL.md section 6); with the
+ * forces and the kicks, is not drifted and does not limit dt (docs/model.md section 6); with the
  * medium option hold_fixed it gets no kicks either (SPHERA's momentum routine), so its velocity
  * stays 0. With numerics.pressure_smoothing > 0 the pressures are smoothed (forces.c) right
  * after the equation of state, before the regime decision reads them.
@@ -32,7 +32,7 @@
  * have once mobile, not with its mu_thr: that is the paper's saving (dt ~ 1/mu0, Table 2), and
  * a grain mobilised at the next step is then integrated stably from its first mobile step. It
  * also keeps the velocity a fixed grain picks up in one step (dt a) small, so grains whose forces
- * nearly balance stay fixed (MODEL.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
+ * nearly balance stay fixed (docs/model.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
 double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;

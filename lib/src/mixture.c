@@ -1,8 +1,9 @@
 /* mixture.c - the granular phase of the mixture model (Manenti et al. 2018, Section 2.1-2.2;
- * MODEL.md sections 5-6): strain rate, pore pressure, effective stress, the regime of every
+ * docs/model.md sections 5-6): strain rate, pore pressure, effective stress, the regime of every
  * granular particle (rheology.h) and the pressure of the grains held fixed.
  *
- * Called every step after the continuity pass, which has accumulated for every particle the
+ * Called every step after the density pass and the velocity-gradient pass (forces.h), which has
+ * gathered for every granular particle the
  * uncorrected velocity gradient G and the matrix L from the velocities that already felt the
  * last forces (v^{n+1/2}, see integrate.c). Then, for each granular particle:
  *   grad u = G L^-1                     (first-order correction; L ignored where det L < 0.05)
@@ -22,7 +23,7 @@
  * background pressure here and in the equation of state (integrate.c).
  *
  * Fixed bed (numerics.fixed_bed_speed = v_fb >= 0; off by default): SPHERA's rule for a granular
- * bed without an erosion criterion (its erosion_flag 1 with velocity_fixed_bed = v_fb; MODEL.md
+ * bed without an erosion criterion (its erosion_flag 1 with velocity_fixed_bed = v_fb; docs/model.md
  * section 6 calls it an optimisation, not part of the model). In every vertical column 2h wide
  * (from the domain's x_min) the highest granular particle no faster than v_fb is the top of the
  * fixed bed (a grain held fixed at the last regime decision counts as at rest); every grain of
@@ -42,21 +43,6 @@
 #include "rheology.h"
 
 #define MIXTURE_DET_MIN 0.05 /* below this det L the correction is not applied */
-
-/* PHASE A (temporary, removed in the next commit): the old kernel_w rounding. */
-static inline double PHASE_A_KERNEL_W(const struct kernel *k, double r)
-{
-    const double q = r / k->h;
-    if (q >= 2.0) return 0.0;
-    if (k->type == KERNEL_WENDLAND_C2) {
-        const double s = 1.0 - 0.5 * q;
-        const double s2 = s * s;
-        return k->a_d * s2 * s2 * (2.0 * q + 1.0);
-    }
-    if (q < 1.0) return k->a_d * (1.0 - 1.5 * q * q + 0.75 * q * q * q);
-    const double t = 2.0 - q;
-    return 0.25 * k->a_d * t * t * t;
-}
 
 struct mixture {
     const struct case_def *cfg;
@@ -245,7 +231,7 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
             const double rx = xi - P->x[j], rz = zi - P->z[j];
             const double r2 = rx * rx + rz * rz;
             if (r2 >= KW->r2max) continue;
-            const double w = PHASE_A_KERNEL_W(KW, sqrt(r2));
+            const double w = kernel_w(KW, sqrt(r2));
             sw += w;
             sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
         }

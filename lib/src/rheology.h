@@ -5,7 +5,7 @@
  *   mu_app     = eps_f mu_f + mu_fr                                     (12), packing limit
  *   sigma'     = max(p - max(p_w, 0), 0)
  *
- * and the three regimes of the paper's Fig. 1 (MODEL.md section 6):
+ * and the three regimes of the paper's Fig. 1 (docs/model.md section 6):
  *   mu_app >= mu_thr        -> elastic-plastic: held fixed, mu = mu_thr
  *   mu0 < mu_app < mu_thr   -> frictional, limited: mobile, mu = mu0
  *   mu_app <= mu0           -> frictional: mobile, mu = mu_app

@@ -1,4 +1,4 @@
-/* walls.c - walls from polylines (MODEL.md section 8).
+/* walls.c - walls from polylines (docs/model.md section 8).
  *
  * Treatment: layers of dummy wall particles behind each polyline, on the global lattice
  * (i + 1/2) dx, as deep as the kernel support; their pressure is extrapolated from the fluid
@@ -10,7 +10,7 @@
  * Moving walls (the Vajont plate) translate with a prescribed piecewise-linear velocity law.
  * On top of the pressure barrier, a geometric guarantee: a particle whose step would cross a
  * wall segment (in the wall's frame) is put back on the fluid side at 0.1 dx and loses its
- * velocity component into the wall; such corrections are counted (sim->n_clipped). */
+ * velocity component into the wall; such corrections are counted (the diagnostic wall_corrections). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
