@@ -6,9 +6,10 @@
  *   a^{n+1}   = A(x^{n+1}, rho^{n+1}, v^{n+1/2})     (EOS, wall pressure, momentum pass)
  *   v^{n+1}   = v^{n+1/2} + dt/2 a^{n+1}
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
- * Granular particles: after the continuity pass (which also gives their strain rate from
- * v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still gets
- * forces and the kicks, is not drifted and does not limit dt (docs/model.md section 6); with the
+ * Granular particles: after the density pass and the velocity-gradient pass (their strain rate
+ * from v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still
+ * gets forces and the kicks, is not drifted, and enters dt with the viscosity it will have once
+ * mobile (integrate_time_step; docs/model.md section 6); with the
  * medium option hold_fixed it gets no kicks either (SPHERA's momentum routine), so its velocity
  * stays 0. With numerics.pressure_smoothing > 0 the pressures are smoothed (forces.c) right
  * after the equation of state, before the regime decision reads them.

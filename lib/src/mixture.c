@@ -9,7 +9,7 @@
  *   grad u = G L^-1                     (first-order correction; L ignored where det L < 0.05)
  *   sqrt(II_D), p_w, sigma' = max(p - max(p_w, 0), 0), mu_app = eps_f mu_f + sigma' sin(phi) / (2 sqrt(II_D))
  *   regime: mu_app >= mu_thr -> FIXED (mu = mu_thr, velocity set to 0, not moved next step,
- *           left out of dt); mu0 < mu_app < mu_thr -> mu0; else mu_app.
+ *           in dt with min(mu0, mu_thr)); mu0 < mu_app < mu_thr -> mu0; else mu_app.
  * A fixed particle still receives forces and a velocity update every step (unless its medium
  * has hold_fixed, SPHERA's rule: then no acceleration, velocity exactly 0), so it is mobilised
  * again as soon as its neighbours shear it enough. The pore pressure of a saturated medium is
