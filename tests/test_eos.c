@@ -1,4 +1,4 @@
-/* test_eos.c - the linearised Tait equation of state of eos.h (MODEL.md section 3):
+/* test_eos.c - the linearised Tait equation of state of eos.h (docs/model.md section 3):
  *   p = c0^2 (rho - rho0), and its inverse. */
 #include <math.h>
 #include <setjmp.h>
@@ -10,7 +10,7 @@
 
 #include "eos.h"
 
-/* (rho0, c) pairs: the two media of CASES.md (water 1000 kg/m3, 36.1 m/s; saturated mixture
+/* (rho0, c) pairs: the two media of the erosive dam break (docs/validation/erosive_dambreak.md: water 1000 kg/m3, 36.1 m/s; saturated mixture
  * 1250 kg/m3, 36.1 m/s), the Vajont grains at 40 m/s and a small artificial one. */
 static const double media[][2] = {{1000.0, 36.1}, {1250.0, 36.1}, {2650.0, 40.0}, {1.5, 0.3}};
 #define N_MEDIA (sizeof media / sizeof media[0])
@@ -33,7 +33,7 @@ static void test_slope_is_c_squared(void **state)
     for (size_t k = 0; k < N_MEDIA; k++) {
         const double rho0 = media[k][0], c = media[k][1];
         for (int s = -5; s <= 5; s++) {
-            const double drho = 0.004 * s * rho0; /* +-2%: beyond the 1% of MODEL.md section 3 */
+            const double drho = 0.004 * s * rho0; /* +-2%: beyond the 1% of docs/model.md section 3 */
             const double p = eos_pressure(rho0 + drho, rho0, c);
             /* reference: c^2 drho (exact linear law); tolerance 1e-12 relative, round-off only
              * (rho0 + drho - rho0 loses up to eps rho0 / |drho| of drho) */

@@ -1,4 +1,4 @@
-/* test_forces.c - the pair loops of forces.c (eq. (3) of Manenti et al. 2018, MODEL.md
+/* test_forces.c - the pair loops of forces.c (eq. (3) of Manenti et al. 2018, docs/model.md
  * section 2): each pair term against its formula and sign, pair symmetry m_i a_ij = -m_j a_ji,
  * and conservation of momentum by the gather loop in a box of two fluids far from any wall,
  * without gravity, with random positions, velocities, densities, masses, pressures and
@@ -256,7 +256,7 @@ static void test_pair_terms(void **state)
                 } else if (term == TERM_MONAGHAN) {
                     /* -m_j Pi_ij grad_i W_ij, Pi_ij = -alpha c h u.r / ((r^2 + eta^2) rho_bar) for
                      * approaching pairs of one medium, 0 otherwise (Monaghan 1992, beta = 0;
-                     * MODEL.md: fluid pairs only, so 0 across the two media) */
+                     * docs/model.md section 2: fluid pairs only, so 0 across the two media) */
                     const struct medium *md = &s->cfg.media[P->medium[i]];
                     double fa = 0.0;
                     if (vr < 0.0 && P->medium[i] == P->medium[j]) {
@@ -281,7 +281,7 @@ static void test_pair_terms(void **state)
                     assert_true(ax * ux + az * uz <= 0.0);
                 } else {
                     /* different viscosities: the same term with mu_i + mu_j replaced by twice a
-                     * pairwise mean (MODEL.md section 7 leaves the mean open): the force is along
+                     * pairwise mean (docs/model.md section 7 leaves the mean open): the force is along
                      * -u_ij, and the mean lies between min(mu_i, mu_j) and max(mu_i, mu_j) */
                     const double unit = mj / (rhoi * rhoj) * F * r2 / (r2 + eta2); /* < 0 */
                     const double u2 = ux * ux + uz * uz;

@@ -1,4 +1,4 @@
-/* test_kernel.c - the Wendland C2 kernel of kernel.h (MODEL.md section 1):
+/* test_kernel.c - the Wendland C2 kernel of kernel.h (docs/model.md section 1):
  *   normalisation (continuous integral and lattice sum at h = 1.3 dx), first-order consistency
  *   of the SPH gradient on a lattice, compact support, F = W'(r)/r against a finite difference of
  *   W, continuity of F at the support edge and finiteness at r = 0. */
@@ -92,7 +92,7 @@ static void test_gradient_of_linear_field(void **state)
                   gz, gx30, gz30);
     /* reference (a, b); tolerance 3%: the lattice error of the uncorrected gradient at h = 1.3 dx
      * (the diagonal of sum_j V_j (x_j - x_i) (x) grad W is 0.974 there; the issue's 1e-3 needs
-     * more neighbours or the L_i^-1 correction of MODEL.md section 5) */
+     * more neighbours or the L_i^-1 correction of docs/model.md section 5) */
     assert_true(fabs(gx - a) < 3e-2 * fabs(a));
     assert_true(fabs(gz - b) < 3e-2 * fabs(b));
     /* reference (a, b); tolerance 1e-3 relative (issue), reached with h = 3 dx */

@@ -1,5 +1,5 @@
 /* test_mixture.c - the granular phase of the mixture model (Manenti et al. 2018, Section 2.1;
- * MODEL.md sections 5-6): case reading of granular media (case.c), the regime of every grain
+ * docs/model.md sections 5-6): case reading of granular media (case.c), the regime of every grain
  * and the fixed/mobile transitions both ways, the pressure of the fixed grains, the pore
  * pressure of a saturated bed (mixture.c), and the time step bound of fixed grains (integrate.c).
  *
@@ -423,7 +423,7 @@ static void test_pore_pressure(void **state)
 
 /* Grains stretched 1 % below and compressed 1 % above the mixture density: with the cut-off the
  * stretched ones get the background pressure (0 here) instead of c^2 (rho - rho0) < 0 (linear EOS,
- * MODEL.md section 3), the compressed ones keep c^2 (rho - rho0); without it both follow the EOS. */
+ * docs/model.md section 3), the compressed ones keep c^2 (rho - rho0); without it both follow the EOS. */
 static void check_tension(const char *media, int cutoff)
 {
     mixsph_sim *s = create_ok(media);
@@ -464,7 +464,7 @@ static void test_tension_cutoff(void **state)
 /* ---- (d) held fixed grains (option hold_fixed, SPHERA's momentum routine) ------------------ */
 
 /* The bed at rest, every grain FIXED: one whole step. A fixed grain is never drifted; without the
- * option it receives its forces and the two half kicks (MODEL.md section 6's reading), so the
+ * option it receives its forces and the two half kicks (docs/model.md section 6's reading), so the
  * grains still fixed after the step carry v = dt/2 a from the second kick (their forces do not
  * balance exactly at the free surface and the walls); with `hold_fixed` it gets no acceleration
  * (SPHERA zeroes the acceleration of a particle with mu = mu_thr), so v stays exactly 0. */

@@ -1,5 +1,5 @@
 /* test_rheology.c - the mixture viscosity law (rheology.h; Manenti et al. 2018, eqs. (10) and
- * (12), Fig. 1; MODEL.md sections 5-6), every branch:
+ * (12), Fig. 1; docs/model.md sections 5-6), every branch:
  *   rheology_regime:   mu_app >= mu_thr -> FIXED (mu_thr); mu0 < mu_app < mu_thr -> LIMITED (mu0);
  *                      mu_app <= mu0 -> FRICTIONAL (mu_app); mu0 >= mu_thr switches the limit off;
  *                      the mu1 rheology of Run 7 (mu_thr = mu1, mu0 = +inf);

@@ -201,7 +201,7 @@ static void test_outputs_at_start(void **state)
     const size_t front = (size_t)mixsph_sim_output_find(s, "front");
     const size_t mass = (size_t)mixsph_sim_output_find(s, "mass");
     /* mass: 10 columns of 15 particles of m = rho dx^2, rho = rho0 + p / c^2 from the hydrostatic
-     * pressure at the particle, p = rho0 g dx (k + 1/2) for the k-th from the top (MODEL.md
+     * pressure at the particle, p = rho0 g dx (k + 1/2) for the k-th from the top (docs/model.md
      * section 1): M = 10 rho0 dx^2 (15 + g dx sum_k (k + 1/2) / c^2) = 60.22072 kg/m;
      * tolerance: round-off */
     const double dx = 0.02, rho0 = 1000.0, g = 9.81, c = 20.0;

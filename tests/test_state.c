@@ -181,7 +181,7 @@ static void test_external_wall_velocity(void **state)
     assert_int_equal(mixsph_sim_release_wall_velocity(s, "plate"), MIXSPH_OK);
     const double x1 = plate_x(s), t1 = mixsph_sim_time(s);
     assert_int_equal(mixsph_sim_advance_to(s, 0.1), MIXSPH_OK);
-    /* the law's speed over [0.08, 0.1] s is 0.167-0.209 m/s (CASES.md table), over three times
+    /* the law's speed over [0.08, 0.1] s is 0.167-0.209 m/s (cases/vajont_padua.json), over three times
      * the drive of 0.05 m/s */
     assert_true(plate_x(s) - x1 > 0.15 * (mixsph_sim_time(s) - t1));
     mixsph_sim_destroy(c);

@@ -1,9 +1,9 @@
-/* test_walls.c - walls (walls.c, MODEL.md section 8: "no particle crosses a wall, including
- * the moving plate"):
+/* test_walls.c - walls (walls.c, docs/model.md section 8: no particle crosses a wall, the moving
+ * plate included):
  *   - water particles launched at 5 m/s, with gravity, into a basin with a floor, a 45-degree
  *     slope and vertical sides, and a lone particle at a vertical wall: checked every step
  *     against the basin's geometry (independent half-planes), none ever outside, none lost;
- *   - a plate pushing a water column with the Vajont plate's velocity law (CASES.md case B,
+ *   - a plate pushing a water column with the Vajont plate's velocity law (docs/validation/vajont.md,
  *     doubled): the plate's displacement follows the integral of its law, and no particle is
  *     ever behind its face (checked in the plate's frame every step). */
 #include <math.h>
@@ -78,7 +78,7 @@ static void launch_in_basin(const char *bodies, double u, double w, double t_end
         assert_int_equal(st, MIXSPH_OK);
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
-            /* reference: the basin (MODEL.md section 8: no particle crosses a wall); none lost */
+            /* reference: the basin (docs/model.md section 8: no particle crosses a wall); none lost */
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE);
             const double d = basin_inside_distance(P->x[i], P->z[i]);
             if (d < d_min) {
@@ -124,7 +124,7 @@ static void test_lone_particle_at_wall(void **state)
                     5.0, 0.0, 0.4);
 }
 
-/* The Vajont plate's velocity law (CASES.md case B), vx [m/s] at t [s]; 0 after 0.8 s. */
+/* The Vajont plate's velocity law (docs/validation/vajont.md), vx [m/s] at t [s]; 0 after 0.8 s. */
 static const double LAW_T[] = {0.0, 0.05, 0.10, 0.15, 0.20, 0.25, 0.30, 0.60, 0.65, 0.70, 0.75, 0.80};
 static const double LAW_VX[] = {0.0020, 0.1053, 0.2087, 0.3120, 0.4153, 0.5187,
                                 0.6220, 0.6220, 0.4665, 0.3110, 0.1555, 0.0};
@@ -200,7 +200,7 @@ static void test_moving_plate(void **state)
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
             z_max = fmax(z_max, P->z[i]);
             /* in the plate's frame: the face is x' = 0 for 0 <= z <= 0.5, the fluid at x' > 0;
-             * reference: MODEL.md section 8, tolerance 0 (strictly in front of the face) */
+             * reference: docs/model.md section 8, tolerance 0 (strictly in front of the face) */
             const double xp = P->x[i] - X;
             if (P->z[i] <= 0.5 && xp < gap_min) {
                 gap_min = xp;
@@ -217,7 +217,7 @@ static void test_moving_plate(void **state)
                   "of it at t = %.4f s; highest particle z = %.3f m; %.0f wall corrections; %llu steps\n",
                   s->walls[plate].ox, law_displacement(t_end), err_max, gap_min / s->dx, t_gap, z_max,
                   mixsph_sim_output_value(s, (size_t)clips), (unsigned long long)mixsph_sim_steps(s));
-    /* the stroke of the law: about 0.34 m at speed scale 1 (CASES.md), checked on the table */
+    /* the stroke of the law: about 0.34 m at speed scale 1 (cases/vajont_padua.json), checked on the table */
     assert_true(fabs(law_displacement(t_end) / PLATE_SPEED_SCALE - 0.34) < 0.01);
     /* the test did push: the water reached the plate's face closely */
     assert_true(gap_min < s->dx);
