@@ -68,10 +68,8 @@ Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting 
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
 
-import argparse
 import csv
 
-import argparse
 import dataclasses
 import math
 import os
@@ -427,27 +425,18 @@ def plot(path, results, at, dx):
     plt.close(fig)
 
 
-
-
 # ---- main -----------------------------------------------------------------------------------------
 
 
 OPTIONS = campaign.CaseOptions(
+    description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.",
+    own=(("--at", dict(type=float, default=0.5, help="time [s] of the profiles compared and plotted, one of the "
+                       "case's profile times (default 0.5)")),),
     runs="2,5,6,7", known=tuple(PAPER), dx=0.01, out="erosive", case="erosive_dambreak.json", t_end="0.5 s",
     dx_help="particle spacing [m] (default 0.01; the paper's is 0.005)",
     set_example="numerics.fixed_bed_speed=0.0125", sphera=SPHERA_OPTIONS, progress=300.0,
     twin_help="also run each selected reference run (2, 4) again with gravity x (1 + REL), e.g. 1e-6, into "
               "run<k>_dx<D>_twin, and compare it with itself: the floor under the interface errors")
-
-
-def parse_args(argv):
-    ap = argparse.ArgumentParser(
-        prog=PROG,
-        description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.")
-    campaign.add_options(ap, OPTIONS)
-    ap.add_argument("--at", type=float, default=0.5,
-                    help="time [s] of the profiles compared and plotted, one of the case's profile times (default 0.5)")
-    return ap.parse_args(argv)
 
 
 def sediment_index(s, at):
@@ -504,7 +493,7 @@ def report(s, args, results, n_ran):
 
 
 def run(argv=None):
-    args = parse_args(argv)
+    args = campaign.parse_args(PROG, OPTIONS, argv)
     runs = campaign.parse_runs(args.runs, "--runs", PAPER, "2,5,6,7")
     if args.twin is not None and not any(k in REFERENCE_RUNS for k in runs):
         raise mt.ToolError("--twin: no reference run (2 or 4) among --runs")

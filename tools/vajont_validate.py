@@ -65,7 +65,6 @@ Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting 
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
 
-import argparse
 import dataclasses
 import math
 import os
@@ -542,19 +541,14 @@ def plot(path, results, plot_runs, granular):
 
 
 OPTIONS = campaign.CaseOptions(
+    description="Vajont (Manenti et al. 2018, Section 3.2): run V1-V6 with mixsph and compare with the paper's "
+                "Tables 4-5.",
+    own=(("--plot-runs", dict(default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")),),
     runs="all", known=tuple(PAPER), dx=0.02, out="vajont", case="vajont_padua.json", t_end="1.6 s",
     dx_help="particle spacing of V1-V4 [m] (default 0.02; the paper's is 0.005; V5, V6: x1.25, x1.5)",
     set_example="parameters.tension_cutoff=1", sphera=SPHERA_OPTIONS, progress=60.0,
     twin_help="also run V1 again with gravity x (1 + REL), e.g. 1e-6, into V1_dx<D>_twin, and compare it with V1: "
               "the floor under the differences between runs")
-
-
-def parse_args(argv):
-    ap = argparse.ArgumentParser(prog=PROG, description="Vajont (Manenti et al. 2018, Section 3.2): run V1-V6 "
-                                 "with mixsph and compare with the paper's Tables 4-5.")
-    campaign.add_options(ap, OPTIONS)
-    ap.add_argument("--plot-runs", default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")
-    return ap.parse_args(argv)
 
 
 def plan_jobs(s, runs, dx):
@@ -643,7 +637,7 @@ def report(s, dx, results, plot_runs):
 
 
 def run(argv=None):
-    args = parse_args(argv)
+    args = campaign.parse_args(PROG, OPTIONS, argv)
     runs = campaign.parse_runs(args.runs, "--runs", PAPER, "1,2,4", prefix="V")
     plot_runs = campaign.parse_runs(args.plot_runs, "--plot-runs", PAPER, "1,2,4", prefix="V")
     if args.twin is not None and 1 not in runs:

@@ -5,9 +5,7 @@ and the fields every run's result has. A script keeps what is particular to its 
 runs and the overrides that make each, what it reads from a run folder, and how it compares,
 tabulates and plots the results.
 
-    ap = argparse.ArgumentParser(prog=PROG)
-    campaign.add_options(ap, OPTIONS)                   # OPTIONS: a CaseOptions of the script
-    args = ap.parse_args(argv)
+    args = campaign.parse_args(PROG, OPTIONS, argv)     # OPTIONS: the script's CaseOptions
     s = campaign.settings(args, PROG, OPTIONS, n_runs)  # checks everything; raises ToolError
     jobs = [campaign.make_job(s, paper, "V1", dx, "V1_dx0.02", sets, {"run": 1, ...}), ...]
     failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL)
@@ -48,7 +46,8 @@ def main(prog, body):
 
 @dataclass(frozen=True)
 class CaseOptions:
-    """What a script's shared options default to and say."""
+    """A script's command line: what its shared options default to and say, and its own options."""
+    description: str
     runs: str              # default of --runs
     known: tuple           # the paper's run numbers
     dx: float              # default of --dx [m]
@@ -60,6 +59,17 @@ class CaseOptions:
     twin_help: str
     sphera: tuple          # --sphera: (key, value) overrides, SPHERA's own numerical options
     progress: float        # default of --progress [s]
+    own: tuple = ()        # the script's own options: (name, add_argument keywords) each
+
+
+def parse_args(prog, o, argv=None):
+    """The parsed command line of a script with the CaseOptions o (argv None: sys.argv)."""
+    import argparse
+    ap = argparse.ArgumentParser(prog=prog, description=o.description)
+    add_options(ap, o)
+    for name, kw in o.own:
+        ap.add_argument(name, **kw)
+    return ap.parse_args(argv)
 
 
 def add_options(ap, o):
