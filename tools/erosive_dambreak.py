@@ -492,12 +492,12 @@ def report(s, args, results, n_ran):
     print(f"plot:  {show(png_path)}")
 
 
-def run(argv=None):
-    args = campaign.parse_args(PROG, OPTIONS, argv)
+def run(argv=None, prog=PROG):
+    args = campaign.parse_args(prog, OPTIONS, argv)
     runs = campaign.parse_runs(args.runs, "--runs", PAPER, "2,5,6,7")
     if args.twin is not None and not any(k in REFERENCE_RUNS for k in runs):
         raise mt.ToolError("--twin: no reference run (2 or 4) among --runs")
-    s = campaign.settings(args, PROG, OPTIONS, len(runs))
+    s = campaign.settings(args, prog, OPTIONS, len(runs))
     sediment = sediment_index(s, args.at)
     jobs = plan_jobs(s, runs, args.dx)
     failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL, what=f" at dx = {args.dx:g} m")
@@ -506,8 +506,9 @@ def run(argv=None):
     campaign.check_failed(failed)
 
 
-def main(argv=None):
-    campaign.main(PROG, lambda: run(argv))
+def main(argv=None, prog=PROG):
+    """The script; argv None: sys.argv; prog: how its help and its messages name it."""
+    campaign.main(prog, lambda: run(argv, prog))
 
 
 if __name__ == "__main__":

@@ -636,21 +636,22 @@ def report(s, dx, results, plot_runs):
     print(f"plot:  {mt.show(png_path)}" if drew else "plot:  none (no profiles of the plotted runs)")
 
 
-def run(argv=None):
-    args = campaign.parse_args(PROG, OPTIONS, argv)
+def run(argv=None, prog=PROG):
+    args = campaign.parse_args(prog, OPTIONS, argv)
     runs = campaign.parse_runs(args.runs, "--runs", PAPER, "1,2,4", prefix="V")
     plot_runs = campaign.parse_runs(args.plot_runs, "--plot-runs", PAPER, "1,2,4", prefix="V")
     if args.twin is not None and 1 not in runs:
         raise mt.ToolError("--twin: V1, the run it repeats, is not among --runs")
-    s = campaign.settings(args, PROG, OPTIONS, len(runs))
+    s = campaign.settings(args, prog, OPTIONS, len(runs))
     jobs = plan_jobs(s, runs, args.dx)
     failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL)
     report(s, args.dx, load_results(s.case_json, jobs), plot_runs)
     campaign.check_failed(failed)
 
 
-def main(argv=None):
-    campaign.main(PROG, lambda: run(argv))
+def main(argv=None, prog=PROG):
+    """The script; argv None: sys.argv; prog: how its help and its messages name it."""
+    campaign.main(prog, lambda: run(argv, prog))
 
 
 if __name__ == "__main__":

@@ -29,8 +29,7 @@ def main(argv=None):
         print(f"mixsph-validate: error: unknown case '{argv[0]}'\n\n{usage()}", end="", file=sys.stderr)
         return 2
     module = importlib.import_module(CASES[argv[0]][0])
-    module.PROG = f"mixsph-validate {argv[0]}"   # how its help and its messages name it
-    module.main(argv[1:])
+    module.main(argv[1:], prog=f"mixsph-validate {argv[0]}")
     return 0
 
 
