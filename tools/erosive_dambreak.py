@@ -64,6 +64,11 @@ like the paper's Figs 3 (Runs 1-4) and 4 (Runs 2, 5-7).
 Exit status: 0 ok; 1 a mixsph run failed (the others still run, unless mixsph reported bad
 usage or input, and the table is still printed); 2 bad usage or input; 130 interrupted.
 
+The current result, the method and the commands that reproduce it:
+docs/validation/erosive_dambreak.md; the model and the paper's equations cited here by number:
+docs/model.md; the case file's keys: docs/cases.md. The campaign itself (options, runs, --reuse)
+is tools/mixsph_tools/campaign.py.
+
 Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """

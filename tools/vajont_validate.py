@@ -61,6 +61,10 @@ maximum run-up line, and velocity-magnitude snapshots of the first plotted run a
 Exit status: 0 ok; 1 a run failed (the others still run and the table is printed); 2 bad usage
 or input; 130 interrupted.
 
+The current result, the method and the commands that reproduce it: docs/validation/vajont.md; the
+model and the paper's equations cited here by number: docs/model.md; the case file's keys:
+docs/cases.md. The campaign itself (options, runs, --reuse) is tools/mixsph_tools/campaign.py.
+
 Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
