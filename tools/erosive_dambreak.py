@@ -73,8 +73,6 @@ Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting 
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
 
-import csv
-
 import dataclasses
 import math
 import os

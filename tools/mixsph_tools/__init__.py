@@ -19,6 +19,5 @@ The names of ``readers``, ``report`` and ``runs`` are also this package's own (`
 """
 
 from .readers import *  # noqa: F401,F403
-from .readers import H5_REF, STATE_FIXED, STATE_LOST, STATE_MOBILE, STATE_WALL  # noqa: F401
 from .report import *  # noqa: F401,F403
 from .runs import *  # noqa: F401,F403

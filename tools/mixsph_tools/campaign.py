@@ -16,9 +16,12 @@ tabulates and plots the results.
 exit status (2 bad usage or input, 1 a run failed; 130 when interrupted).
 """
 
+import argparse
+import json
 import math
 import os
 import signal
+import subprocess
 import sys
 import time
 from dataclasses import dataclass
@@ -64,7 +67,6 @@ class CaseOptions:
 
 def parse_args(prog, o, argv=None):
     """The parsed command line of a script with the CaseOptions o (argv None: sys.argv)."""
-    import argparse
     ap = argparse.ArgumentParser(prog=prog, description=o.description)
     add_options(ap, o)
     for name, kw in o.own:
@@ -157,7 +159,6 @@ def _check_numbers(args):
 
 
 def _read_case(path):
-    import json
     try:
         with open(path) as f:
             return json.load(f), case_digest(path)
@@ -349,7 +350,6 @@ def progress_line(running, elapsed, t_end):
 
 def stop(running):
     """Terminate the running jobs' mixsph (SIGTERM, then SIGKILL after 10 s)."""
-    import subprocess
     for job in running:
         job.proc.terminate()
     for job in running:
