@@ -7,6 +7,7 @@ and compare them with the paper.
                                      [--mixsph build/mixsph] [--case cases/erosive_dambreak.json]
                                      [--t-end T] [--at 0.5] [--set KEY=VALUE]... [--sphera]
                                      [--twin REL]
+    mixsph-validate erosive ...      (the same, installed by ./tools/do setup)
 
 Each selected run k is ``mixsph run CASE --out OUT/run<k>_dx<D> --set numerics.dx=D --set
 media.sediment.mu_thr=... --set media.sediment.mu0=... --threads N --quiet`` (stdout and stderr in
@@ -63,20 +64,19 @@ like the paper's Figs 3 (Runs 1-4) and 4 (Runs 2, 5-7).
 Exit status: 0 ok; 1 a mixsph run failed (the others still run, unless mixsph reported bad
 usage or input, and the table is still printed); 2 bad usage or input; 130 interrupted.
 
+The current result, the method and the commands that reproduce it:
+docs/validation/erosive_dambreak.md; the model and the paper's equations cited here by number:
+docs/model.md; the case file's keys: docs/cases.md. The campaign itself (options, runs, --reuse)
+is tools/mixsph_tools/campaign.py.
+
 Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
 
-import argparse
-import csv
 import dataclasses
-import json
 import math
 import os
-import signal
-import subprocess
 import sys
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -88,10 +88,10 @@ import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mixsph_tools as mt  # noqa: E402
-from mixsph_tools import fmt, fmt_duration, last_time, num, show, tail  # noqa: E402
+from mixsph_tools import campaign  # noqa: E402
+from mixsph_tools import fmt, num, show  # noqa: E402
 
 PROG = "erosive_dambreak.py"
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 KPA = 1e3  # Pa s per kPa s, Pa per kPa
 
@@ -137,178 +137,49 @@ T_TOL = 1e-3               # [s] a summary's simulated time matches t_end within
 # --sphera: the numerical options of SPHERA's own input for this geometry (SPHERA v9.0.0,
 # input/release_v_9_0_0/14_edb_2D_demo: partial pressure smoothing TetaP = 0.25 and, in its
 # bed-load block, velocity_fixed_bed = 0.0125 m/s with erosion flag 1). Not part of the model as
-# MODEL.md states it; passed to every run as --set overrides before the user's own.
+# docs/model.md states it; passed to every run as --set overrides before the user's own.
 SPHERA_OPTIONS = (("numerics.pressure_smoothing", 0.25), ("numerics.fixed_bed_speed", 0.0125))
-
-
-def fail(msg, code=2):
-    print(f"{PROG}: error: {msg}", file=sys.stderr)
-    sys.exit(code)
 
 
 def warn(msg):
     print(f"{PROG}: warning: {msg}", file=sys.stderr)
 
 
-# ---- one run --------------------------------------------------------------------------------------
-
-
-@dataclass
-class Job:
-    paper: PaperRun
-    outdir: str
-    cmd: list
-    stamp: dict
-    threads: int
-    proc: subprocess.Popen = None
-    log: object = None
-    t0: float = 0.0
-    source: str = ""      # "ran", "reused", "FAILED"
-    message: str = ""     # why it failed
-    checkpoint: str = None  # continue this unfinished run's checkpoint (cmd is then its restart)
-    ts0: float = 0.0        # simulated time at the start [s] (the checkpoint's when continued)
-
-
-@dataclass
-class Result:
-    paper: PaperRun
-    outdir: str
-    source: str
-    status: str = "missing"
-    threads: int = 0
-    sim_time: float = math.nan
-    wall: float = math.nan
-    steps: float = math.nan      # time steps of the whole run (all its pieces)
-    psteps: float = math.nan
-    rise: float = math.nan
-    rise_t: float = math.nan
-    p_peak: float = math.nan     # [Pa]
-    p_peak_t: float = math.nan
-    t_wall: float = math.nan     # water reaches the left wall [s]
-    lost: float = math.nan       # particles that left the case's domain (most over the run)
-    interface: mt.Profile = None
-    interface_frac: mt.Profile = None   # 0.5 iso-line of the sediment fraction, from the snapshot
-    free_surface: mt.Profile = None
-    cells: dict = field(default_factory=dict)   # computed comparison cells
-
-    @property
-    def ok(self):
-        return self.status == "ok"
+# ---- runs and their results ----------------------------------------------------------------------
 
 
 STAMP = "erosive_run.json"
 STAMP_KEYS = ("run", "dx", "mu_thr", "mu0", "t_end", "case", "case_sha256", "sets")   # "sets" only with --set
 
 
-def run_jobs(jobs, n_parallel, t_end, progress_every):
-    """Run the jobs, at most n_parallel at once; a failed run does not stop the others, except
-    for bad usage or input (exit 2), which would repeat. Returns the failed jobs."""
-    pending = list(jobs)
-    running = []
-    failed = []
-    stop = False
-    t_start = time.monotonic()
-    last_progress = t_start
-    try:
-        while pending or running:
-            while pending and len(running) < n_parallel and not stop:
-                job = pending.pop(0)
-                job.t0 = time.monotonic()
-                job.ts0 = mt.checkpoint_time(job.checkpoint) if job.checkpoint else 0.0
-                try:
-                    job.proc, job.log = mt.launch(job.outdir, STAMP, job.stamp, job.cmd, job.checkpoint)
-                except OSError as e:
-                    fail(f"cannot start {job.cmd[0]}: {e}")
-                running.append(job)
-                how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
-                print(f"run {job.paper.name}: {how} ({job.threads} thread{'s' if job.threads > 1 else ''}) "
-                      f"-> {show(job.outdir)}/  (log: mixsph.log)", flush=True)
-            if pending and stop and not running:
-                break
-            time.sleep(0.5)
-            for job in list(running):
-                rc = job.proc.poll()
-                if rc is None:
-                    continue
-                running.remove(job)
-                job.log.close()
-                el = time.monotonic() - job.t0
-                if rc == 0:
-                    job.source = "ran"
-                    print(f"run {job.paper.name}: done in {fmt_duration(el)}", flush=True)
-                else:
-                    job.source = "FAILED"
-                    what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
-                    job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else \
-                        f"mixsph was killed by signal {-rc}"
-                    failed.append(job)
-                    print(f"run {job.paper.name}: FAILED after {fmt_duration(el)}: {job.message}; "
-                          f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
-                    for line in tail(os.path.join(job.outdir, "mixsph.log")):
-                        print(f"    | {line}", flush=True)
-                    if rc == 2 and pending:
-                        # bad usage or input: the other runs would fail the same way
-                        stop = True
-                        print(f"{PROG}: not starting the remaining runs "
-                              f"({', '.join(j.paper.name for j in pending)})", flush=True)
-            now = time.monotonic()
-            if progress_every > 0 and running and now - last_progress >= progress_every:
-                last_progress = now
-                parts = []
-                for job in running:
-                    ts = last_time(os.path.join(job.outdir, "monitors.csv"))
-                    el = now - job.t0
-                    eta = fmt_duration(el * (t_end - ts) / (ts - job.ts0)) if math.isfinite(ts) and ts > job.ts0 else "--"
-                    parts.append(f"run {job.paper.name} t = {fmt(ts, '.3f', '--')}/{t_end:g} s (ETA {eta})")
-                print(f"  [{fmt_duration(now - t_start)}] " + ", ".join(parts), flush=True)
-    except KeyboardInterrupt:
-        for job in running:
-            job.proc.terminate()
-        for job in running:
-            try:
-                job.proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                job.proc.kill()
-                job.proc.wait()
-        print(f"\n{PROG}: interrupted; stopped run(s) {', '.join(j.paper.name for j in running)}",
-              file=sys.stderr)
-        sys.exit(130)
-    for job in pending:
-        job.source = "not run"
-    return failed
-
-
-# ---- analysis -------------------------------------------------------------------------------------
+@dataclass
+class Result(campaign.RunResult):
+    """A run's result: the campaign's fields, the case's measures and the comparison cells."""
+    rise: float = math.nan
+    rise_t: float = math.nan
+    p_peak: float = math.nan     # [Pa]
+    p_peak_t: float = math.nan
+    t_wall: float = math.nan     # water reaches the left wall [s]
+    interface: mt.Profile = None
+    interface_frac: mt.Profile = None   # 0.5 iso-line of the sediment fraction, from the snapshot
+    free_surface: mt.Profile = None
+    cells: dict = field(default_factory=dict)   # computed comparison cells
 
 
 def load_result(job, at, dx, sediment):
-    r = Result(job.paper, job.outdir, job.source)
-    summ_path = os.path.join(job.outdir, "summary.json")
-    if job.source == "not run":
-        r.status = "not run"
+    r = Result(job.paper, job.dx, job.outdir, job.source)
+    summ = campaign.read_run_summary(job, r)
+    if summ is None:
         return r
-    if not os.path.isfile(summ_path):
-        r.status = "no summary"
-        return r
-    summ = mt.read_summary(summ_path)
-    r.status = str(summ.get("status"))
-    r.threads = int(summ.get("threads") or 0)
-    r.sim_time = float(summ.get("simulated_time_s") or math.nan)
-    r.wall = mt.run_wall_time(summ)
-    r.steps = float(summ.get("steps") or math.nan)
-    r.psteps = mt.run_particle_steps_per_s(summ)
     r.rise = mt.summary_value(summ, "bedload_rise_left_wall", "max")
     r.rise_t = mt.summary_value(summ, "bedload_rise_left_wall", "t_max")
     r.p_peak = mt.summary_value(summ, "left_wall_pressure", "max")
     r.p_peak_t = mt.summary_value(summ, "left_wall_pressure", "t_max")
-    r.lost = mt.summary_value(summ, "lost_particles", "max")
-    mon_path = os.path.join(job.outdir, "monitors.csv")
-    if os.path.isfile(mon_path):
-        mon = mt.read_monitors(mon_path)
-        if "water_front" in mon:
-            r.t_wall = mt.first_time_below(mon["t"], mon["water_front"], WALL_REACH_X)
-        else:
-            warn(f"{show(mon_path)}: no column 'water_front'")
+    mon = campaign.read_run_monitors(job.outdir)
+    if mon is not None and "water_front" in mon:
+        r.t_wall = mt.first_time_below(mon["t"], mon["water_front"], WALL_REACH_X)
+    elif mon is not None:
+        warn(f"{show(os.path.join(job.outdir, 'monitors.csv'))}: no column 'water_front'")
     r.interface = mt.find_profile(job.outdir, "interface", at)
     r.free_surface = mt.find_profile(job.outdir, "free_surface", at)
     r.interface_frac = fraction_interface(job.outdir, at, dx, sediment)
@@ -357,24 +228,52 @@ def interface_error(run_prof, ref_prof, x_max=ERR_X_MAX):
     return (float(np.mean(errs)), len(errs)) if errs else (math.nan, 0)
 
 
+
+def reference_cells(c):
+    """The comparison cells of a reference run (Run 4): nothing to compare with."""
+    c["ref"] = "-"
+    c["saving"] = c["err"] = "(reference)"
+    c["paper_saving"] = c["paper_err"] = "(ref)"
+    c["err_frac"] = "(reference)"
+    c["saving_steps"] = "(reference)"
+    c.update(saving_v=math.nan, saving_steps_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0,
+             err_frac_v=math.nan)
+
+
+def measured_cells(c, r, ref, at):
+    """The savings and interface errors of r against its finished reference run ref."""
+    if math.isfinite(r.wall) and math.isfinite(ref.wall) and ref.wall > 0:
+        c["saving_v"] = 100.0 * (1.0 - r.wall / ref.wall)
+        c["saving"] = f"{c['saving_v']:.0f}"
+    else:
+        c["saving"] = "n/a"
+    if math.isfinite(r.steps) and math.isfinite(ref.steps) and ref.steps > 0:
+        c["saving_steps_v"] = 100.0 * (1.0 - r.steps / ref.steps)
+        c["saving_steps"] = f"{c['saving_steps_v']:.0f}"
+    if r.interface is None:
+        c["err"] = f"n/a (no profile at t={at:g} s)"
+    elif ref.interface is None:
+        c["err"] = f"n/a (ref. has no profile at t={at:g} s)"
+    else:
+        e, n = interface_error(r.interface, ref.interface)
+        c["err_v"], c["err_bins"] = e, n
+        c["err"] = f"{e:.2f}" if n else "n/a (no common bins)"
+    if r.interface_frac is not None and ref.interface_frac is not None:
+        e, n = interface_error(r.interface_frac, ref.interface_frac)
+        c["err_frac_v"] = e
+        c["err_frac"] = f"{e:.2f}" if n else "n/a"
+
+
 def compare(results, at):
     """Fill r.cells: saving and interface error versus the reference run, with the reason when n/a."""
     by_run = {r.paper.run: r for r in results if not r.paper.twin}
     for r in results:
-        p = r.paper
-        c = r.cells
+        p, c = r.paper, r.cells
         if p.ref == 0:
-            c["ref"] = "-"
-            c["saving"] = c["err"] = "(reference)"
-            c["paper_saving"] = c["paper_err"] = "(ref)"
-            c["err_frac"] = "(reference)"
-            c["saving_steps"] = "(reference)"
-            c.update(saving_v=math.nan, saving_steps_v=math.nan, paper_saving_v=math.nan, err_v=math.nan, err_bins=0,
-                     err_frac_v=math.nan)
+            reference_cells(c)
             continue
         c["ref"] = str(p.ref)
-        paper_ref = PAPER[p.ref]
-        c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / paper_ref.elapsed_s)
+        c["paper_saving_v"] = 100.0 * (1.0 - p.elapsed_s / PAPER[p.ref].elapsed_s)
         c["paper_saving"] = fmt(c["paper_saving_v"], ".0f", "-")
         c["paper_err"] = fmt(p.err_percent, ".2f", "-")
         c["saving_v"] = c["saving_steps_v"] = c["err_v"] = c["err_frac_v"] = math.nan
@@ -384,114 +283,45 @@ def compare(results, at):
         ref = by_run.get(p.ref)
         if not r.ok:
             c["saving"] = c["err"] = "n/a (run failed)" if r.status not in ("not run", "missing") else "n/a"
-            continue
-        if ref is None:
+        elif ref is None or ref.status == "not run":
             c["saving"] = c["err"] = "n/a (reference not run)"
-            continue
-        if not ref.ok:
-            c["saving"] = c["err"] = "n/a (reference failed)" if ref.status != "not run" else \
-                "n/a (reference not run)"
-            continue
-        if math.isfinite(r.wall) and math.isfinite(ref.wall) and ref.wall > 0:
-            c["saving_v"] = 100.0 * (1.0 - r.wall / ref.wall)
-            c["saving"] = f"{c['saving_v']:.0f}"
+        elif not ref.ok:
+            c["saving"] = c["err"] = "n/a (reference failed)"
         else:
-            c["saving"] = "n/a"
-        if math.isfinite(r.steps) and math.isfinite(ref.steps) and ref.steps > 0:
-            c["saving_steps_v"] = 100.0 * (1.0 - r.steps / ref.steps)
-            c["saving_steps"] = f"{c['saving_steps_v']:.0f}"
-        if r.interface is None:
-            c["err"] = f"n/a (no profile at t={at:g} s)"
-        elif ref.interface is None:
-            c["err"] = f"n/a (ref. has no profile at t={at:g} s)"
-        else:
-            e, n = interface_error(r.interface, ref.interface)
-            c["err_v"], c["err_bins"] = e, n
-            c["err"] = f"{e:.2f}" if n else "n/a (no common bins)"
-        if r.interface_frac is not None and ref.interface_frac is not None:
-            e, n = interface_error(r.interface_frac, ref.interface_frac)
-            c["err_frac_v"] = e
-            c["err_frac"] = f"{e:.2f}" if n else "n/a"
+            measured_cells(c, r, ref, at)
 
 
 # ---- table ----------------------------------------------------------------------------------------
 
 
-def print_table(columns, rows, footer_rows=()):
-    """columns: (group, header, align) per column; rows: lists of cell strings."""
-    n = len(columns)
-    width = [max([len(columns[k][1])] + [len(row[k]) for row in list(rows) + list(footer_rows)]) for k in range(n)]
-    # groups: consecutive columns with the same group label; widen the last column to fit the label
-    groups = []
-    for k, (g, _, _) in enumerate(columns):
-        if groups and groups[-1][0] == g:
-            groups[-1][2] = k
-        else:
-            groups.append([g, k, k])
-    for g, a, b in groups:
-        span = sum(width[a:b + 1]) + 2 * (b - a)
-        if len(g) > span:
-            width[b] += len(g) - span
-
-    def line(cells):
-        out = []
-        for g, a, b in groups:
-            part = []
-            for k in range(a, b + 1):
-                s = cells[k]
-                part.append(s.rjust(width[k]) if columns[k][2] == ">" else s.ljust(width[k]))
-            out.append("  ".join(part))
-        return " | ".join(out).rstrip()
-
-    head = []
-    for g, a, b in groups:
-        span = sum(width[a:b + 1]) + 2 * (b - a)
-        head.append(g.center(span) if g else " " * span)
-    text = [" | ".join(head).rstrip(), line([c[1] for c in columns])]
-    rule = "-" * max(len(s) for s in text)
-    text.append(rule)
-    text += [line(r) for r in rows]
-    if footer_rows:
-        text.append(rule)
-        text += [line(r) for r in footer_rows]
-    text.append(rule)
-    print("\n".join(text))
-
-
-def table(results, at, dx, t_end, threads_note, twin_rel=None):
-    cols = [
+def table_columns(at):
+    err = f"interface err [%], t={at:g} s"
+    return [
         ("", "run", ">"), ("", "mu_thr", ">"), ("", "mu0", ">"), ("", "status", "<"),
         ("wall time [s]", "mixsph", ">"), ("wall time [s]", "paper", ">"),
         ("saving vs ref [%]", "ref", ">"), ("saving vs ref [%]", "mixsph", ">"), ("saving vs ref [%]", "steps", ">"),
-        ("saving vs ref [%]", "paper", ">"),
-        (f"interface err [%], t={at:g} s", "mixsph", ">"), (f"interface err [%], t={at:g} s", "f=0.5", ">"),
-        (f"interface err [%], t={at:g} s", "paper", ">"),
+        ("saving vs ref [%]", "paper", ">"), (err, "mixsph", ">"), (err, "f=0.5", ">"), (err, "paper", ">"),
         ("bed-load rise, wall", "max [m]", ">"), ("bed-load rise, wall", "t [s]", ">"),
         ("peak p, left wall", "[kPa]", ">"), ("peak p, left wall", "t [s]", ">"),
         ("water at wall", "t [s]", ">"), ("", "lost", ">"),
     ]
-    rows = []
-    for r in results:
-        p, c = r.paper, r.cells
-        status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
-        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - PAPER_T_END) > T_TOL:
-            status += f", t={r.sim_time:.3g} s"
-        rows.append([
-            p.name, p.label_thr, p.label_mu0, status,
-            fmt(r.wall, ".1f"), fmt(p.elapsed_s, ",.0f", "-"),
-            c["ref"], c["saving"], c["saving_steps"], c["paper_saving"],
-            c["err"], c["err_frac"], c["paper_err"],
-            fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
-            fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
-            fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"), fmt(r.lost, ".0f"),
-        ])
-    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "", "",
-                 f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}", ""]
-    print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
-          f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
-    print("mu_thr, mu0 in kPa s; the paper's times are SPHERA v8's, on hardware it does not state")
-    print()
-    print_table(cols, rows, [paper_row])
+
+
+def table_row(r):
+    p, c = r.paper, r.cells
+    return [
+        p.name, p.label_thr, p.label_mu0, campaign.status_cell(r, PAPER_T_END, T_TOL),
+        fmt(r.wall, ".1f"), fmt(p.elapsed_s, ",.0f", "-"),
+        c["ref"], c["saving"], c["saving_steps"], c["paper_saving"],
+        c["err"], c["err_frac"], c["paper_err"],
+        fmt(r.rise, ".3f"), fmt(r.rise_t, ".3f"),
+        fmt(r.p_peak / KPA, ".2f"), fmt(r.p_peak_t, ".3f"),
+        fmt(r.t_wall, ".3f", "not reached" if r.ok else "n/a"), fmt(r.lost, ".0f"),
+    ]
+
+
+def print_notes(at, twin_rel):
+    """What the table's columns mean."""
     print(f"interface err: mean over the 0.01 m bins with x <= {ERR_X_MAX:g} m of |z_run - z_ref| / z_ref * 100, "
           f"z = top of the sediment at t = {at:g} s;")
     print("               reference Run 4 for Runs 1-3, Run 2 for Runs 5-7 (the paper's 'aver. err.');")
@@ -513,32 +343,38 @@ def table(results, at, dx, t_end, threads_note, twin_rel=None):
     print("Run 7:         mu1 rheology, mu1 = 5 kPa s, given as mu_thr = 5 kPa s and mu0 = 1e12 Pa s (no limit).")
 
 
+def table(results, at, dx, t_end, threads_note, twin_rel=None):
+    paper_row = ["paper", "", "", "", "", "", "", "", "", "", "", "", "",
+                 f"~{PAPER_BEDLOAD_RISE:g}", "", f"~{PAPER_PEAK_P_KPA:g}", "", f"~{PAPER_T_IMPACT:g}", ""]
+    print(f"Erosive dam break, mixsph versus Manenti et al. (2018) Tables 1-2: dx = {dx:g} m "
+          f"(paper {PAPER_DX:g} m), t_end = {t_end:g} s, {threads_note}")
+    print("mu_thr, mu0 in kPa s; the paper's times are SPHERA v8's, on hardware it does not state")
+    print()
+    mt.print_table(table_columns(at), [table_row(r) for r in results], [paper_row])
+    print_notes(at, twin_rel)
+
+
+CSV_FIELDS = [
+    "run", "mu_thr_Pa_s", "mu0_Pa_s", "dx_m", "t_end_s", "status", "source", "threads", "simulated_time_s",
+    "wall_time_s", "particle_steps_per_s", "paper_elapsed_s", "ref_run", "saving_percent", "paper_saving_percent",
+    "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
+    "paper_err_percent", "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa",
+    "peak_pressure_t_s", "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent", "lost_particles",
+    "twin"]
+
+
+def csv_row(r, dx, t_end, at):
+    p, c = r.paper, r.cells
+    return [p.run, p.mu_thr, p.mu0, dx, t_end, r.status, r.source, r.threads,
+            r.sim_time, r.wall, r.psteps, float(p.elapsed_s),
+            p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
+            at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
+            r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir,
+            int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"], r.lost, int(p.twin)]
+
+
 def write_csv(path, results, dx, t_end, at):
-    fields = ["run", "mu_thr_Pa_s", "mu0_Pa_s", "dx_m", "t_end_s", "status", "source", "threads",
-              "simulated_time_s", "wall_time_s", "particle_steps_per_s", "paper_elapsed_s",
-              "ref_run", "saving_percent", "paper_saving_percent",
-              "compare_time_s", "interface_err_percent", "interface_err_bins", "interface_err_fraction_percent",
-              "paper_err_percent",
-              "bedload_rise_max_m", "bedload_rise_t_s", "peak_left_wall_pressure_kPa", "peak_pressure_t_s",
-              "water_at_left_wall_t_s", "outdir", "steps", "saving_steps_percent", "lost_particles", "twin"]
-
-    def v(x):
-        if isinstance(x, float):
-            return f"{x:.6g}" if math.isfinite(x) else "nan"
-        return str(x)
-
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(fields)
-        for r in results:
-            p, c = r.paper, r.cells
-            w.writerow([v(x) for x in (
-                p.run, p.mu_thr, p.mu0, dx, t_end, r.status, r.source, r.threads,
-                r.sim_time, r.wall, r.psteps, float(p.elapsed_s),
-                p.ref if p.ref else "", c["saving_v"], c["paper_saving_v"],
-                at, c["err_v"], c["err_bins"], c["err_frac_v"], p.err_percent,
-                r.rise, r.rise_t, r.p_peak / KPA, r.p_peak_t, r.t_wall, r.outdir,
-                int(r.steps) if math.isfinite(r.steps) else math.nan, c["saving_steps_v"], r.lost, int(p.twin))])
+    mt.write_csv(path, CSV_FIELDS, [csv_row(r, dx, t_end, at) for r in results])
 
 
 # ---- figure ---------------------------------------------------------------------------------------
@@ -595,180 +431,87 @@ def plot(path, results, at, dx):
 # ---- main -----------------------------------------------------------------------------------------
 
 
-def on_sigterm(signum, frame):
-    """SIGTERM like Ctrl-C: run_jobs then stops its own mixsph runs instead of leaving them running."""
-    raise KeyboardInterrupt
+OPTIONS = campaign.CaseOptions(
+    description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.",
+    own=(("--at", dict(type=float, default=0.5, help="time [s] of the profiles compared and plotted, one of the "
+                       "case's profile times (default 0.5)")),),
+    runs="2,5,6,7", known=tuple(PAPER), dx=0.01, out="erosive", case="erosive_dambreak.json", t_end="0.5 s",
+    dx_help="particle spacing [m] (default 0.01; the paper's is 0.005)",
+    set_example="numerics.fixed_bed_speed=0.0125", sphera=SPHERA_OPTIONS, progress=300.0,
+    twin_help="also run each selected reference run (2, 4) again with gravity x (1 + REL), e.g. 1e-6, into "
+              "run<k>_dx<D>_twin, and compare it with itself: the floor under the interface errors")
 
 
-def parse_runs(text):
-    if text.strip().lower() == "all":
-        return sorted(PAPER)
-    runs = []
-    for part in text.split(","):
-        part = part.strip()
-        if not part:
-            continue
-        if not part.isdigit() or int(part) not in PAPER:
-            fail(f"--runs: '{part}' is not a run number 1-7 (e.g. --runs 2,5,6,7 or --runs all)")
-        if int(part) not in runs:
-            runs.append(int(part))
-    if not runs:
-        fail("--runs: no run given")
-    return sorted(runs)
-
-
-def main():
-    ap = argparse.ArgumentParser(
-        prog=PROG,
-        description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.")
-    ap.add_argument("--runs", default="2,5,6,7",
-                    help="paper runs to do, 1-7, comma-separated or 'all' (default 2,5,6,7)")
-    ap.add_argument("--dx", type=float, default=0.01, help="particle spacing [m] (default 0.01; the paper's is 0.005)")
-    ap.add_argument("--out", default=os.path.join(ROOT, "out", "erosive"), help="output folder (default out/erosive)")
-    ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default max(1, cores // jobs))")
-    ap.add_argument("--jobs", type=int, default=1, help="runs at once (default 1)")
-    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings) "
-                    "and continue unfinished ones from their checkpoints")
-    ap.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
-                    help="each run writes a checkpoint every SECONDS of wall time (default 600; 0: none), "
-                    "from which --reuse continues it after an interruption")
-    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"),
-                    help="mixsph executable (default build/mixsph)")
-    ap.add_argument("--case", default=os.path.join(ROOT, "cases", "erosive_dambreak.json"),
-                    help="case file (default cases/erosive_dambreak.json)")
-    ap.add_argument("--t-end", type=float,
-                    help="end time [s] of every run (default: the case's, 0.5 s); for short tests")
-    ap.add_argument("--at", type=float, default=0.5,
-                    help="time [s] of the profiles compared and plotted, one of the case's profile times (default 0.5)")
-    ap.add_argument("--progress", type=float, default=300.0,
-                    help="print the simulated time of the running runs every this many seconds (default 300, 0: never)")
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
-                    help="an override passed to every run after the run's own (repeatable), "
-                    "e.g. numerics.fixed_bed_speed=0.0125")
-    ap.add_argument("--twin", type=float, metavar="REL",
-                    help="also run each selected reference run (2, 4) again with gravity x (1 + REL), e.g. 1e-6, "
-                    "into run<k>_dx<D>_twin, and compare it with itself: the floor under the interface errors")
-    ap.add_argument("--sphera", action="store_true",
-                    help="run with the numerical options of SPHERA's own input for this test ("
-                    + ", ".join(f"{k}={num(v)}" for k, v in SPHERA_OPTIONS) + "), before any --set")
-    args = ap.parse_args()
-
-    runs = parse_runs(args.runs)
-    if not (args.dx > 0 and math.isfinite(args.dx)):
-        fail("--dx must be a positive number of metres")
-    if args.jobs < 1:
-        fail("--jobs must be at least 1")
-    if args.threads is not None and args.threads < 1:
-        fail("--threads must be at least 1")
-    if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
-        fail("--t-end must be a positive number of seconds")
-    if args.twin is not None and not any(k in REFERENCE_RUNS for k in runs):
-        fail("--twin: no reference run (2 or 4) among --runs")
-    if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
-        fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
-    try:
-        extra = (list(SPHERA_OPTIONS) if args.sphera else []) + mt.parse_sets(args.sets,
-                                                                               "numerics.fixed_bed_speed=0.0125")
-    except mt.ToolError as e:
-        fail(str(e))
-    mixsph = os.path.abspath(args.mixsph)
-    if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
-        fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
-    case = os.path.abspath(args.case)
-    try:
-        with open(case) as f:
-            case_json = json.load(f)
-        case_sha = mt.case_digest(case)
-    except (OSError, ValueError) as e:
-        fail(f"{show(case)}: cannot read the case: {e}")
-    t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
-    if not math.isfinite(t_end):
-        fail(f"{show(case)}: no numerics.t_end (give --t-end)")
+def sediment_index(s, at):
+    """The index of the case's medium 'sediment' (whose top is the interface), after checking that
+    the case writes its interface profile at time ``at``."""
+    case_json = s.case_json
     media = list(case_json.get("media", {})) if isinstance(case_json.get("media"), dict) else []
     if "sediment" not in media:
-        fail(f"{show(case)}: no medium 'sediment' (the interface is the top of it)")
-    try:
-        g_twin = mt.twin_gravity(case_json, extra, args.twin, show(case)) if args.twin is not None else None
-    except mt.ToolError as e:
-        fail(str(e))
-    sediment = media.index("sediment")   # the library numbers the media in the case file's order
+        raise mt.ToolError(f"{show(s.case)}: no medium 'sediment' (the interface is the top of it)")
     prof_times = [float(t) for t in case_json.get("monitors", {}).get("interface", {}).get("times", [])]
-    if not any(abs(t - args.at) < 1e-9 for t in prof_times):
-        fail(f"--at {args.at:g}: the case's interface profile is written at t = "
-             f"{', '.join(f'{t:g}' for t in prof_times) or '(never)'} s only")
-    if args.at > t_end + 1e-12:
-        warn(f"the runs end at t = {t_end:g} s, before the profiles at t = {args.at:g} s: "
+    if not any(abs(t - at) < 1e-9 for t in prof_times):
+        raise mt.ToolError(f"--at {at:g}: the case's interface profile is written at t = "
+                           f"{', '.join(f'{t:g}' for t in prof_times) or '(never)'} s only")
+    if at > s.t_end + 1e-12:
+        warn(f"the runs end at t = {s.t_end:g} s, before the profiles at t = {at:g} s: "
              "the interface errors and the plot will say n/a")
+    return media.index("sediment")   # the library numbers the media in the case file's order
 
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:
-        cores = os.cpu_count() or 1
-    jobs_n = min(args.jobs, len(runs))
-    threads = args.threads if args.threads is not None else max(1, cores // jobs_n)
-    out = os.path.abspath(args.out)
-    os.makedirs(out, exist_ok=True)
 
-    plan = [(PAPER[k], extra) for k in runs]
-    if args.twin is not None:
+def plan_jobs(s, runs, dx):
+    """The Jobs of the runs and, with --twin, of the twins of the reference runs among them."""
+    plan = [(PAPER[k], list(s.extra)) for k in runs]
+    if s.twin is not None:
         plan += [(dataclasses.replace(PAPER[k], twin=True, ref=k, elapsed_s=math.nan, err_percent=math.nan),
-                  extra + [("gravity", g_twin)]) for k in runs if k in REFERENCE_RUNS]
+                  campaign.twin_sets(s)) for k in runs if k in REFERENCE_RUNS]
     jobs = []
     for p, sets in plan:
-        k = p.run
-        d = os.path.join(out, f"run{k}_dx{args.dx:g}" + ("_twin" if p.twin else ""))
-        cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(args.dx)}",
-               "--set", f"media.sediment.mu_thr={num(p.mu_thr)}", "--set", f"media.sediment.mu0={num(p.mu0)}"]
-        for key, val in sets:
-            cmd += ["--set", f"{key}={num(val)}"]
-        if args.t_end is not None:
-            cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
-        cmd += ["--threads", str(threads), "--quiet"]
-        if args.checkpoint_every > 0:
-            cmd += ["--checkpoint-every", num(args.checkpoint_every)]
-        stamp = {"run": k, "dx": args.dx, "mu_thr": p.mu_thr, "mu0": p.mu0, "t_end": t_end, "case": case,
-                 "case_sha256": case_sha, "threads": threads, "command": cmd}
-        if sets:   # absent without --set and --sphera, as in the stamps of earlier runs
-            stamp["sets"] = [list(s) for s in sets]
-        jobs.append(Job(p, d, cmd, stamp, threads))
+        own = [("media.sediment.mu_thr", p.mu_thr), ("media.sediment.mu0", p.mu0)]
+        head = {"run": p.run, "dx": dx, "mu_thr": p.mu_thr, "mu0": p.mu0}
+        tail = {"sets": [list(x) for x in sets]} if sets else None   # absent without --set and --sphera
+        jobs.append(campaign.make_job(s, p, f"run {p.name}", dx, f"run{p.run}_dx{dx:g}" + ("_twin" if p.twin else ""),
+                                      own + sets, head, tail))
+    return jobs
 
-    to_run = []
-    for job in jobs:
-        if args.reuse and not mt.plan_reuse(job, f"run {job.paper.name}", STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
-                                            threads, args.checkpoint_every):
-            continue
-        to_run.append(job)
-    if to_run:
-        print(f"{len(to_run)} run(s) of {show(case)} at dx = {args.dx:g} m to t = {t_end:g} s, "
-              f"{min(jobs_n, len(to_run))} at a time, {threads} thread(s) each, {cores} core(s)", flush=True)
-    signal.signal(signal.SIGTERM, on_sigterm)
-    failed = run_jobs(to_run, jobs_n, t_end, args.progress)
 
-    try:
-        results = [load_result(job, args.at, args.dx, sediment) for job in jobs]
-    except mt.ToolError as e:
-        fail(str(e))
+def report(s, args, results, n_ran):
+    """Print the comparison with the paper and write the table (CSV) and the plot."""
     compare(results, args.at)
-    used_threads = sorted({r.threads for r in results if r.ok})
-    threads_note = f"threads {','.join(str(t) for t in used_threads) or threads}"
-    if len(to_run) > 1 and jobs_n > 1:
-        threads_note += f", up to {jobs_n} runs at once (wall times share the machine)"
-    threads_note += "".join(f"; with {k}={num(v)}" for k, v in extra)
+    threads_note = f"threads {campaign.threads_used(results, s.threads)}"
+    if n_ran > 1 and s.jobs > 1:
+        threads_note += f", up to {s.jobs} runs at once (wall times share the machine)"
+    threads_note += "".join(f"; with {k}={num(v)}" for k, v in s.extra)
     print()
-    table(results, args.at, args.dx, t_end, threads_note, args.twin)
-    if len(used_threads) > 1:
+    table(results, args.at, args.dx, s.t_end, threads_note, s.twin)
+    if len({r.threads for r in results if r.ok}) > 1:
         warn("the runs used different thread counts: the savings compare unlike wall times")
-
-    csv_path = os.path.join(out, "erosive_table.csv")
-    png_path = os.path.join(out, "erosive_profiles.png")
-    write_csv(csv_path, results, args.dx, t_end, args.at)
+    csv_path = os.path.join(s.out, "erosive_table.csv")
+    png_path = os.path.join(s.out, "erosive_profiles.png")
+    write_csv(csv_path, results, args.dx, s.t_end, args.at)
     plot(png_path, results, args.at, args.dx)
     print()
     print(f"table: {show(csv_path)}")
     print(f"plot:  {show(png_path)}")
-    if failed:
-        fail("mixsph failed for run(s) " + "; ".join(
-            f"{j.paper.name}: {j.message} (log {show(os.path.join(j.outdir, 'mixsph.log'))})" for j in failed), code=1)
+
+
+def run(argv=None, prog=PROG):
+    args = campaign.parse_args(prog, OPTIONS, argv)
+    runs = campaign.parse_runs(args.runs, "--runs", PAPER, "2,5,6,7")
+    if args.twin is not None and not any(k in REFERENCE_RUNS for k in runs):
+        raise mt.ToolError("--twin: no reference run (2 or 4) among --runs")
+    s = campaign.settings(args, prog, OPTIONS, len(runs))
+    sediment = sediment_index(s, args.at)
+    jobs = plan_jobs(s, runs, args.dx)
+    failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL, what=f" at dx = {args.dx:g} m")
+    results = [load_result(job, args.at, args.dx, sediment) for job in jobs]
+    report(s, args, results, sum(job.source != "reused" for job in jobs))
+    campaign.check_failed(failed)
+
+
+def main(argv=None, prog=PROG):
+    """The script; argv None: sys.argv; prog: how its help and its messages name it."""
+    campaign.main(prog, lambda: run(argv, prog))
 
 
 if __name__ == "__main__":

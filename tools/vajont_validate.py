@@ -2,12 +2,14 @@
 """Vajont validation: run the paper's runs V1-V6 of the Padua 1968 experiment (test No. 48) and
 compare them with Manenti et al. (2018), Section 3.2, Tables 3-5 and Figs 7-10.
 
-    python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--out out/vajont]
-                                    [--reuse] [--checkpoint-every S] [--t-end T] [--plot-runs 1,2,4]
-                                    [--mixsph build/mixsph] [--twin REL]
-                                    [--case cases/vajont_padua.json] [--set KEY=VALUE]...
+    python tools/vajont_validate.py [--runs 1,2,4 | all] [--dx 0.02] [--threads N] [--jobs J]
+                                    [--out out/vajont] [--reuse] [--checkpoint-every S] [--t-end T]
+                                    [--plot-runs 1,2,4] [--mixsph build/mixsph] [--twin REL]
+                                    [--case cases/vajont_padua.json] [--set KEY=VALUE]... [--sphera]
+    mixsph-validate vajont ...      (the same, installed by ./tools/do setup)
 
-Runs are done one after the other (each with --threads N, default all cores). Run k is
+Runs are done one after the other (each with --threads N, default all cores), or up to J at once
+with --jobs J (each with max(1, cores // J) threads unless --threads is given). Run k is
 ``mixsph run CASE --out OUT/V<k>_dx<D> --set numerics.dx=... --set parameters.<...>=...
 --threads N --quiet`` (stdout and stderr in OUT/V<k>_dx<D>/mixsph.log):
 
@@ -59,20 +61,18 @@ maximum run-up line, and velocity-magnitude snapshots of the first plotted run a
 Exit status: 0 ok; 1 a run failed (the others still run and the table is printed); 2 bad usage
 or input; 130 interrupted.
 
+The current result, the method and the commands that reproduce it: docs/validation/vajont.md; the
+model and the paper's equations cited here by number: docs/model.md; the case file's keys:
+docs/cases.md. The campaign itself (options, runs, --reuse) is tools/mixsph_tools/campaign.py.
+
 Reference: S. Manenti, A. Amicarelli, S. Todeschini (2018), WCSPH with limiting viscosity for
 modeling landslide hazard at the slopes of artificial reservoir, Water 10(4), 515.
 """
 
-import argparse
-import csv
 import dataclasses
-import json
 import math
 import os
-import signal
-import subprocess
 import sys
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -84,10 +84,10 @@ import matplotlib.pyplot as plt  # noqa: E402  (after choosing the backend)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mixsph_tools as mt  # noqa: E402
-from mixsph_tools import fmt, fmt_duration, last_time, num, show, tail  # noqa: E402
+from mixsph_tools import campaign  # noqa: E402
+from mixsph_tools import fmt, num  # noqa: E402
 
 PROG = "vajont_validate.py"
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 EXP_RUN_UP = 0.712        # [m] lab frame, test No. 48
 EXP_Z = 863.0             # [m a.m.s.l.]
@@ -95,10 +95,11 @@ STILL_LEVEL = 0.46        # [m] reservoir level of the model
 PAPER_DX = 0.005          # [m]
 PLATE_STOP = 0.8          # [s] the plate stops
 T_TOL = 1e-3              # [s]
+CASE_T_END = 1.6          # [s] the case's end time (a run that ended elsewhere says so)
 # --sphera: the numerical options of SPHERA's own input for this test (SPHERA v9.0.0,
 # input/release_v_9_0_0/35_2D_Vajont_experiment: partial pressure smoothing TetaP = 0.4 and, in
 # its bed-load block, velocity_fixed_bed = 0 with erosion flag 1). Not part of the model as
-# MODEL.md states it; passed to every run as --set overrides after the run's own, before the user's.
+# docs/model.md states it; passed to every run as --set overrides after the run's own, before the user's.
 SPHERA_OPTIONS = (("numerics.pressure_smoothing", 0.4), ("numerics.fixed_bed_speed", 0.0))
 
 
@@ -132,21 +133,12 @@ PAPER = {
 }
 
 
-def fail(msg, code=2):
-    print(f"{PROG}: error: {msg}", file=sys.stderr)
-    sys.exit(code)
-
-
-def warn(msg):
-    print(f"{PROG}: warning: {msg}", file=sys.stderr)
-
-
 def d_eta(z):
     """The paper's error (13) in the lab frame [%]."""
     return 100.0 * abs(z - EXP_RUN_UP) / 0.1345 if math.isfinite(z) else math.nan
 
 
-# ---- runs -----------------------------------------------------------------------------------------
+# ---- runs and their results ----------------------------------------------------------------------
 
 
 STAMP = "vajont_run.json"
@@ -154,86 +146,14 @@ STAMP_KEYS = ("run", "dx", "sets", "t_end", "case", "case_sha256")
 
 
 @dataclass
-class Job:
-    paper: PaperRun
-    dx: float
-    outdir: str
-    cmd: list
-    stamp: dict
-    source: str = ""       # "ran", "reused", "FAILED", "not run"
-    message: str = ""
-    checkpoint: str = None  # continue this unfinished run's checkpoint (cmd is then its restart)
-
-
-def run_job(job, t_end, progress_every):
-    """Run one job to completion. Returns the exit code of mixsph."""
-    t0 = time.monotonic()
-    ts0 = mt.checkpoint_time(job.checkpoint) if job.checkpoint else 0.0   # simulated time at the start
-    try:
-        proc, log = mt.launch(job.outdir, STAMP, job.stamp, job.cmd, job.checkpoint)
-    except OSError as e:
-        fail(f"cannot start {job.cmd[0]}: {e}")
-    with log:
-        how = f"continued from {show(job.checkpoint)}" if job.checkpoint else "started"
-        print(f"{job.paper.label}: {how}, dx = {job.dx:g} m -> {show(job.outdir)}/", flush=True)
-        last = t0
-        try:
-            while proc.poll() is None:
-                time.sleep(0.5)
-                now = time.monotonic()
-                if progress_every > 0 and now - last >= progress_every:
-                    last = now
-                    ts = last_time(os.path.join(job.outdir, "monitors.csv"))
-                    el = now - t0
-                    eta = el * (t_end - ts) / (ts - ts0) if math.isfinite(ts) and ts > ts0 else math.nan
-                    print(f"  [{fmt_duration(el)}] {job.paper.label} t = {fmt(ts, '.3f', '--')}/{t_end:g} s "
-                          f"(ETA {fmt_duration(eta)})", flush=True)
-        except KeyboardInterrupt:
-            proc.terminate()
-            try:
-                proc.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                proc.kill()
-                proc.wait()
-            print(f"\n{PROG}: interrupted; stopped {job.paper.label}", file=sys.stderr)
-            sys.exit(130)
-    rc = proc.returncode
-    el = time.monotonic() - t0
-    if rc == 0:
-        job.source = "ran"
-        print(f"{job.paper.label}: done in {fmt_duration(el)}", flush=True)
-    else:
-        what = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
-        job.source = "FAILED"
-        job.message = f"mixsph exited with {rc} ({what.get(rc, 'error')})" if rc > 0 else f"killed by signal {-rc}"
-        print(f"{job.paper.label}: FAILED after {fmt_duration(el)}: {job.message}; "
-              f"log {show(os.path.join(job.outdir, 'mixsph.log'))}:", flush=True)
-        for line in tail(os.path.join(job.outdir, "mixsph.log")):
-            print(f"    | {line}", flush=True)
-    return rc
-
-
-# ---- analysis -------------------------------------------------------------------------------------
-
-
-@dataclass
-class Result:
-    paper: PaperRun
-    dx: float
-    outdir: str
-    source: str
-    status: str = "missing"
-    threads: int = 0
-    particles: int = 0
+class Result(campaign.RunResult):
+    """A run's result: the campaign's fields (steps counted as an int), the run-up, the checks."""
     steps: int = 0
-    sim_time: float = math.nan
-    wall: float = math.nan
-    psteps: float = math.nan
+    particles: int = 0
     run_up: float = math.nan
     t_run_up: float = math.nan
     Z: float = math.nan
     d_eta: float = math.nan
-    lost: float = math.nan
     mass_drift: float = math.nan      # max |m - m0| / m0
     wall_corr: float = math.nan
     front_max: float = math.nan
@@ -245,10 +165,6 @@ class Result:
     tension: float = math.nan         # largest fraction of the grains with a negative pressure in a snapshot
     tension_t: float = math.nan       # its time [s]
     profiles: dict = field(default_factory=dict)   # name -> mt.Profile at the max run-up
-
-    @property
-    def ok(self):
-        return self.status == "ok"
 
 
 PROFILE_NAMES = ("water_surface", "landslide_surface_above", "landslide_surface_below")
@@ -360,42 +276,31 @@ def crossed_walls(outdir, bed, plate_index, dx, snaps=None):
 
 
 def load_result(job, rho0=None, walls=None, granular=()):
+    """The Result of a job's run folder; rho0 (reference_densities), walls ((bed polyline, index of
+    the plate wall)) and granular (granular_media) for the checks on its snapshots."""
     r = Result(job.paper, job.dx, job.outdir, job.source)
-    if job.source == "not run":
-        r.status = "not run"
+    s = campaign.read_run_summary(job, r)
+    if s is None:
         return r
-    summ_path = os.path.join(job.outdir, "summary.json")
-    if not os.path.isfile(summ_path):
-        r.status = "no summary"
-        return r
-    s = mt.read_summary(summ_path)
-    r.status = str(s.get("status"))
-    r.threads = int(s.get("threads") or 0)
     r.particles = int(s.get("particles") or 0)
     r.steps = int(s.get("steps") or 0)
-    r.sim_time = float(s.get("simulated_time_s") or math.nan)
-    r.wall = mt.run_wall_time(s)
-    r.psteps = mt.run_particle_steps_per_s(s)
     r.run_up = mt.summary_value(s, "run_up", "max")
     r.t_run_up = mt.summary_value(s, "run_up", "t_max")
     r.Z = mt.summary_value(s, "run_up_Z", "max")
     r.d_eta = mt.summary_value(s, "run_up_d_eta", "final")
     if not math.isfinite(r.d_eta):
         r.d_eta = d_eta(r.run_up)
-    r.lost = mt.summary_value(s, "lost_particles", "max")
     r.wall_corr = mt.summary_value(s, "wall_corrections", "final")
     r.front_max = mt.summary_value(s, "landslide_front", "max")
-    mon_path = os.path.join(job.outdir, "monitors.csv")
-    if os.path.isfile(mon_path):
-        mon = mt.read_monitors(mon_path)
+    mon = campaign.read_run_monitors(job.outdir)
+    if mon is not None:
         m = mon.get("mass")
         if m is not None and m.size and m[0] > 0:
             r.mass_drift = float(np.nanmax(np.abs(m - m[0])) / m[0])
         v = mon.get("max_speed")
-        if v is not None:
-            sel = (mon["t"] >= PLATE_STOP - 0.1) & (mon["t"] <= PLATE_STOP + 0.1)
-            if sel.any():
-                r.vmax_stop = float(np.nanmax(v[sel]))
+        sel = (mon["t"] >= PLATE_STOP - 0.1) & (mon["t"] <= PLATE_STOP + 0.1)
+        if v is not None and sel.any():
+            r.vmax_stop = float(np.nanmax(v[sel]))
     snaps = read_snapshots(job.outdir)
     if rho0 is not None:
         r.drho, r.drho_t, r.drho99 = density_variation(snaps, rho0)
@@ -409,26 +314,35 @@ def load_result(job, rho0=None, walls=None, granular=()):
     return r
 
 
+def load_results(case_json, jobs):
+    """The Results of the jobs, checked against the case's bed, plate and media."""
+    wall_defs = case_json.get("walls", {})
+    bed = wall_defs.get("bed", {}).get("polyline")
+    bed = np.array(bed, dtype=float) if bed else None
+    plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
+    granular = granular_media(case_json)
+    return [load_result(job, reference_densities(case_json, job.stamp["sets"]), (bed, plate), granular)
+            for job in jobs]
+
+
 # ---- table ----------------------------------------------------------------------------------------
 
 
-COLUMNS = [
+COLUMNS = [("", name, align) for name, align in (
     ("run", "<"), ("change", "<"), ("status", "<"), ("dx [m]", ">"), ("particles", ">"), ("steps", ">"),
     ("wall s", ">"), ("paper s", ">"), ("run-up [m]", ">"), ("paper", ">"), ("t [s]", ">"), ("paper ", ">"),
     ("Z [m asl]", ">"), ("paper  ", ">"), ("d_eta %", ">"), ("paper   ", ">"), ("lost", ">"), ("mass drift", ">"),
-]
+)]
 
 
 def rows_of(results):
     rows = []
     for r in results:
         p = r.paper
-        status = r.source if r.ok else (r.status if r.source != "FAILED" else f"FAILED ({r.status})")
-        if r.ok and math.isfinite(r.sim_time) and abs(r.sim_time - 1.6) > T_TOL:
-            status += f", t={r.sim_time:.3g} s"
         paper = fmt if not p.twin else (lambda v, spec: "-")   # a twin has no paper values
         rows.append([
-            p.label, p.change, status, fmt(r.dx, "g"), str(r.particles) if r.particles else "n/a",
+            p.label, p.change, campaign.status_cell(r, CASE_T_END, T_TOL), fmt(r.dx, "g"),
+            str(r.particles) if r.particles else "n/a",
             str(r.steps) if r.steps else "n/a", fmt(r.wall, ".0f"), paper(p.elapsed_s, ",.0f"),
             fmt(r.run_up, ".3f"), paper(p.run_up, ".3f"), fmt(r.t_run_up, ".2f"), paper(p.t_run_up, ".2f"),
             fmt(r.Z, ".1f"), paper(p.Z, ".1f"), fmt(r.d_eta, ".1f"), paper(p.d_eta, "g"),
@@ -440,14 +354,7 @@ def rows_of(results):
 
 
 def print_table(rows):
-    w = [max(len(c[0]), *(len(row[k]) for row in rows)) for k, c in enumerate(COLUMNS)]
-
-    def line(cells):
-        return "  ".join(s.rjust(w[k]) if COLUMNS[k][1] == ">" else s.ljust(w[k]) for k, s in enumerate(cells)).rstrip()
-
-    head = line([c[0].strip() for c in COLUMNS])
-    rule = "-" * len(head)
-    print("\n".join([head, rule] + [line(r) for r in rows[:-1]] + [rule, line(rows[-1]), rule]))
+    mt.print_table(COLUMNS, rows[:-1], rows[-1:])
 
 
 ORDER_TOL = 0.001  # [m] run-up differences below this are no ordering (paper's: 15 and 17 mm)
@@ -490,40 +397,30 @@ def verdict_text(holds):
     return "holds" if holds else "does NOT hold"
 
 
+
+CSV_FIELDS = [
+    "run", "change", "dx_m", "status", "source", "threads", "particles", "steps", "simulated_time_s", "wall_time_s",
+    "particle_steps_per_s", "paper_elapsed_s", "run_up_m", "paper_run_up_m", "t_run_up_s", "paper_t_run_up_s",
+    "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent", "lost_particles", "mass_drift",
+    "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop", "max_density_variation",
+    "max_density_variation_t_s", "density_variation_p99", "crossed_walls", "grains_in_tension",
+    "grains_in_tension_t_s", "outdir", "twin"]
+
+
 def write_csv(path, results):
-    fields = ["run", "change", "dx_m", "status", "source", "threads", "particles", "steps", "simulated_time_s",
-              "wall_time_s", "particle_steps_per_s", "paper_elapsed_s", "run_up_m", "paper_run_up_m", "t_run_up_s",
-              "paper_t_run_up_s", "Z_m_asl", "paper_Z_m_asl", "d_eta_percent", "paper_d_eta_percent",
-              "lost_particles", "mass_drift", "wall_corrections", "landslide_front_max_m", "max_speed_at_plate_stop",
-              "max_density_variation", "max_density_variation_t_s", "density_variation_p99", "crossed_walls",
-              "grains_in_tension", "grains_in_tension_t_s", "outdir", "twin"]
-
-    def v(x):
-        if isinstance(x, float):
-            return f"{x:.6g}" if math.isfinite(x) else "nan"
-        return str(x)
-
-    with open(path, "w", newline="") as f:
-        w = csv.writer(f)
-        w.writerow(fields)
-        for r in results:
-            p = r.paper
-            w.writerow([v(x) for x in (
-                f"V{p.run}", p.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
-                r.wall, r.psteps, float(p.elapsed_s), r.run_up, p.run_up, r.t_run_up, p.t_run_up, r.Z, p.Z,
-                r.d_eta, float(p.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop, r.drho,
-                r.drho_t, r.drho99, r.crossed, r.tension, r.tension_t, r.outdir, int(p.twin))])
+    mt.write_csv(path, CSV_FIELDS, [[
+        f"V{r.paper.run}", r.paper.change, r.dx, r.status, r.source, r.threads, r.particles, r.steps, r.sim_time,
+        r.wall, r.psteps, float(r.paper.elapsed_s), r.run_up, r.paper.run_up, r.t_run_up, r.paper.t_run_up, r.Z,
+        r.paper.Z, r.d_eta, float(r.paper.d_eta), r.lost, r.mass_drift, r.wall_corr, r.front_max, r.vmax_stop,
+        r.drho, r.drho_t, r.drho99, r.crossed, r.tension, r.tension_t, r.outdir, int(r.paper.twin)]
+        for r in results])
 
 
 def write_md(path, results, header_lines, checks):
-    rows = rows_of(results)
     with open(path, "w") as f:
         for line in header_lines:
             f.write(line + "\n\n")
-        f.write("| " + " | ".join(c[0].strip() for c in COLUMNS) + " |\n")
-        f.write("|" + "|".join(" --- " for _ in COLUMNS) + "|\n")
-        for row in rows:
-            f.write("| " + " | ".join(c if c else " " for c in row) + " |\n")
+        f.write("\n".join(mt.markdown_table(COLUMNS, rows_of(results))) + "\n")
         if checks:
             f.write("\n")
             for what, holds, detail in checks:
@@ -643,166 +540,40 @@ def plot(path, results, plot_runs, granular):
     return True
 
 
+
 # ---- main -----------------------------------------------------------------------------------------
 
 
-def parse_runs(text, what):
-    if text.strip().lower() == "all":
-        return sorted(PAPER)
-    runs = []
-    for part in text.split(","):
-        part = part.strip().upper().lstrip("V")
-        if not part:
-            continue
-        if not part.isdigit() or int(part) not in PAPER:
-            fail(f"{what}: '{part}' is not a run 1-6 (e.g. {what} 1,2,4 or {what} all)")
-        if int(part) not in runs:
-            runs.append(int(part))
-    if not runs:
-        fail(f"{what}: no run given")
-    return sorted(runs)
+OPTIONS = campaign.CaseOptions(
+    description="Vajont (Manenti et al. 2018, Section 3.2): run V1-V6 with mixsph and compare with the paper's "
+                "Tables 4-5.",
+    own=(("--plot-runs", dict(default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")),),
+    runs="all", known=tuple(PAPER), dx=0.02, out="vajont", case="vajont_padua.json", t_end="1.6 s",
+    dx_help="particle spacing of V1-V4 [m] (default 0.02; the paper's is 0.005; V5, V6: x1.25, x1.5)",
+    set_example="parameters.tension_cutoff=1", sphera=SPHERA_OPTIONS, progress=60.0,
+    twin_help="also run V1 again with gravity x (1 + REL), e.g. 1e-6, into V1_dx<D>_twin, and compare it with V1: "
+              "the floor under the differences between runs")
 
 
-def on_sigterm(signum, frame):
-    raise KeyboardInterrupt
-
-
-def main():
-    ap = argparse.ArgumentParser(prog=PROG, description="Vajont (Manenti et al. 2018, Section 3.2): run V1-V6 "
-                                 "with mixsph and compare with the paper's Tables 4-5.")
-    ap.add_argument("--runs", default="all", help="runs to do, 1-6, comma-separated or 'all' (default all)")
-    ap.add_argument("--dx", type=float, default=0.02,
-                    help="particle spacing of V1-V4 [m] (default 0.02; the paper's is 0.005; V5, V6: x1.25, x1.5)")
-    ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default: all cores)")
-    ap.add_argument("--out", default=os.path.join(ROOT, "out", "vajont"), help="output folder (default out/vajont)")
-    ap.add_argument("--reuse", action="store_true", help="keep runs already done (summary.json ok, same settings) "
-                    "and continue unfinished ones from their checkpoints")
-    ap.add_argument("--checkpoint-every", type=float, default=600.0, metavar="SECONDS",
-                    help="each run writes a checkpoint every SECONDS of wall time (default 600; 0: none), "
-                    "from which --reuse continues it after an interruption")
-    ap.add_argument("--t-end", type=float, help="end time [s] (default the case's 1.6 s; for short tests)")
-    ap.add_argument("--plot-runs", default="1,2,4", help="runs whose profiles are plotted (default 1,2,4)")
-    ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"), help="mixsph executable")
-    ap.add_argument("--case", default=os.path.join(ROOT, "cases", "vajont_padua.json"), help="case file")
-    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
-                    help="an override passed to every run after the run's own (repeatable), "
-                    "e.g. parameters.tension_cutoff=1")
-    ap.add_argument("--sphera", action="store_true",
-                    help="run with the numerical options of SPHERA's own input for this test ("
-                    + ", ".join(f"{k}={num(v)}" for k, v in SPHERA_OPTIONS) + "), before any --set")
-    ap.add_argument("--twin", type=float, metavar="REL",
-                    help="also run V1 again with gravity x (1 + REL), e.g. 1e-6, into V1_dx<D>_twin, and compare "
-                    "it with V1: the floor under the differences between runs")
-    ap.add_argument("--progress", type=float, default=60.0,
-                    help="print the simulated time every this many seconds (default 60, 0: never)")
-    args = ap.parse_args()
-
-    runs = parse_runs(args.runs, "--runs")
-    plot_runs = parse_runs(args.plot_runs, "--plot-runs")
-    if not (args.dx > 0 and math.isfinite(args.dx)):
-        fail("--dx must be a positive number of metres")
-    if args.threads is not None and args.threads < 1:
-        fail("--threads must be at least 1")
-    if args.t_end is not None and not (args.t_end > 0 and math.isfinite(args.t_end)):
-        fail("--t-end must be a positive number of seconds")
-    if not (args.checkpoint_every >= 0 and math.isfinite(args.checkpoint_every)):
-        fail("--checkpoint-every must be a number of seconds >= 0 (0: no checkpoints)")
-    if args.twin is not None and 1 not in runs:
-        fail("--twin: V1, the run it repeats, is not among --runs")
-    try:
-        extra = (list(SPHERA_OPTIONS) if args.sphera else []) + mt.parse_sets(args.sets,
-                                                                               "parameters.tension_cutoff=1")
-    except mt.ToolError as e:
-        fail(str(e))
-    mixsph = os.path.abspath(args.mixsph)
-    if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
-        fail(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
-    case = os.path.abspath(args.case)
-    try:
-        with open(case) as f:
-            case_json = json.load(f)
-        case_sha = mt.case_digest(case)
-    except (OSError, ValueError) as e:
-        fail(f"{show(case)}: cannot read the case: {e}")
-    t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
-    try:
-        g_twin = mt.twin_gravity(case_json, extra, args.twin, show(case)) if args.twin is not None else None
-    except mt.ToolError as e:
-        fail(str(e))
-    try:
-        cores = len(os.sched_getaffinity(0))
-    except AttributeError:
-        cores = os.cpu_count() or 1
-    threads = args.threads or cores
-    out = os.path.abspath(args.out)
-    os.makedirs(out, exist_ok=True)
-
-    plan = [(PAPER[k], extra) for k in runs]
-    if args.twin is not None:
+def plan_jobs(s, runs, dx):
+    """The Jobs of the runs (V5, V6 at their ratios to dx) and, with --twin, of V1's twin."""
+    plan = [(PAPER[k], list(PAPER[k].sets) + s.extra) for k in runs]
+    if s.twin is not None:
         nan = math.nan
-        plan.append((dataclasses.replace(PAPER[1], twin=True, change=f"V1, gravity x (1 + {args.twin:g})",
+        plan.append((dataclasses.replace(PAPER[1], twin=True, change=f"V1, gravity x (1 + {s.twin:g})",
                                          elapsed_s=nan, run_up=nan, t_run_up=nan, Z=nan, d_eta=nan),
-                     extra + [("gravity", g_twin)]))
+                     list(PAPER[1].sets) + campaign.twin_sets(s)))
     jobs = []
-    for p, more in plan:
-        k = p.run
-        dx = round(args.dx * p.dx_ratio, 12)
-        d = os.path.join(out, f"V{k}_dx{dx:g}" + ("_twin" if p.twin else ""))
-        cmd = [mixsph, "run", case, "--out", d, "--set", f"numerics.dx={num(dx)}"]
-        sets = list(p.sets) + more
-        for key, val in sets:
-            cmd += ["--set", f"{key}={num(val)}"]
-        if args.t_end is not None:
-            cmd += ["--set", f"numerics.t_end={num(args.t_end)}"]
-        cmd += ["--threads", str(threads), "--quiet"]
-        if args.checkpoint_every > 0:
-            cmd += ["--checkpoint-every", num(args.checkpoint_every)]
-        stamp = {"run": k, "twin": p.twin, "dx": dx, "sets": [list(s) for s in sets], "t_end": t_end, "case": case,
-                 "case_sha256": case_sha, "threads": threads, "command": cmd}
-        jobs.append(Job(p, dx, d, cmd, stamp))
+    for p, sets in plan:
+        d = round(dx * p.dx_ratio, 12)
+        head = {"run": p.run, "twin": p.twin, "dx": d, "sets": [list(x) for x in sets]}
+        jobs.append(campaign.make_job(s, p, p.label, d, f"V{p.run}_dx{d:g}" + ("_twin" if p.twin else ""), sets,
+                                      head))
+    return jobs
 
-    signal.signal(signal.SIGTERM, on_sigterm)
-    failed = []
-    for job in jobs:
-        if args.reuse and not mt.plan_reuse(job, job.paper.label, STAMP, STAMP_KEYS, t_end, T_TOL, mixsph,
-                                            threads, args.checkpoint_every):
-            continue
-        rc = run_job(job, t_end, args.progress)
-        if rc != 0:
-            failed.append(job)
-            if rc == 2:
-                for j in jobs:
-                    if not j.source:
-                        j.source = "not run"
-                break
 
-    try:
-        wall_defs = case_json.get("walls", {})
-        bed = wall_defs.get("bed", {}).get("polyline")
-        bed = np.array(bed, dtype=float) if bed else None
-        plate = list(wall_defs).index("plate") if "plate" in wall_defs else None
-        granular = granular_media(case_json)
-        results = [load_result(job, reference_densities(case_json, job.stamp["sets"]), (bed, plate), granular)
-                   for job in jobs]
-    except mt.ToolError as e:
-        fail(str(e))
-    used_threads = sorted({r.threads for r in results if r.ok})
-    head = (f"Vajont (Padua 1968, test No. 48), mixsph versus Manenti et al. (2018) Tables 4-5: V1-V4 at dx = "
-            f"{args.dx:g} m (paper {PAPER_DX:g} m), t_end = {t_end:g} s, threads "
-            f"{','.join(str(t) for t in used_threads) or threads}; paper: SPHERA on 16 cores at 2.3 GHz"
-            + "".join(f"; with {k}={num(v)}" for k, v in extra))
-    print()
-    print(head)
-    print()
-    rows = rows_of(results)
-    print_table(rows)
-    print("run-up: highest water particle centre (>= 3 water neighbours within 2h) over the opposite slope, "
-          "x in [0.75, 1.81] m, every 0.005 s;")
-    print("        Z = 1211.8 z + 0.3 m a.m.s.l.; d_eta% = |Z - 863.0| / (863.0 - 700.0) * 100 "
-          "(= 100 |z - 0.712| / 0.1345), the paper's error (13).")
-    print("lost: particles that left the domain; mass drift: max |M(t) - M(0)| / M(0) of the fluid and granular "
-          "particles.")
-    print()
+def print_runs(results):
+    """One line per finished run: its run-up beside the paper's (a twin's beside V1's)."""
     by_run = {r.paper.run: r for r in results if r.ok and not r.paper.twin}
     for r in results:
         if r.ok and r.paper.twin:
@@ -818,12 +589,9 @@ def main():
                   f"Z = {fmt(r.Z, '.1f')} m a.m.s.l., d_eta = {fmt(r.d_eta, '.1f')} % at dx = {r.dx:g} m "
                   f"(paper V{p.run}: {p.run_up:.3f} m at {p.t_run_up:.2f} s, Z = {p.Z:.1f}, d_eta {p.d_eta:g} %; "
                   f"experiment {EXP_RUN_UP} m); wall time {fmt(r.wall, '.0f')} s on {r.threads} thread(s)")
-    checks = ordering(results)
-    if checks:
-        print()
-        for what, holds, detail in checks:
-            print(f"ordering: {what}: {verdict_text(holds)} ({detail})")
-    print()
+
+
+def print_stability(results):
     print("stability (plate starts at t = 0, stops at t = 0.8 s):")
     for r in results:
         if r.status in ("not run", "missing", "no summary"):
@@ -838,18 +606,56 @@ def main():
               f"{fmt(100 * r.tension, '.1f')} % (t = {fmt(r.tension_t, '.1f')} s), landslide front max "
               f"{fmt(r.front_max, '.3f')} m")
 
-    csv_path = os.path.join(out, "vajont_table.csv")
-    md_path = os.path.join(out, "vajont_table.md")
-    png_path = os.path.join(out, "vajont_profiles.png")
+
+def report(s, dx, results, plot_runs):
+    """Print the comparison with the paper and write the table (CSV, Markdown) and the plot."""
+    head = (f"Vajont (Padua 1968, test No. 48), mixsph versus Manenti et al. (2018) Tables 4-5: V1-V4 at dx = "
+            f"{dx:g} m (paper {PAPER_DX:g} m), t_end = {s.t_end:g} s, threads "
+            f"{campaign.threads_used(results, s.threads)}; paper: SPHERA on 16 cores at 2.3 GHz"
+            + "".join(f"; with {k}={num(v)}" for k, v in s.extra))
+    print(f"\n{head}\n")
+    print_table(rows_of(results))
+    print("run-up: highest water particle centre (>= 3 water neighbours within 2h) over the opposite slope, "
+          "x in [0.75, 1.81] m, every 0.005 s;")
+    print("        Z = 1211.8 z + 0.3 m a.m.s.l.; d_eta% = |Z - 863.0| / (863.0 - 700.0) * 100 "
+          "(= 100 |z - 0.712| / 0.1345), the paper's error (13).")
+    print("lost: particles that left the domain; mass drift: max |M(t) - M(0)| / M(0) of the fluid and granular "
+          "particles.")
+    print()
+    print_runs(results)
+    checks = ordering(results)
+    if checks:
+        print()
+        for what, holds, detail in checks:
+            print(f"ordering: {what}: {verdict_text(holds)} ({detail})")
+    print()
+    print_stability(results)
+    csv_path, md_path, png_path = (os.path.join(s.out, n) for n in ("vajont_table.csv", "vajont_table.md",
+                                                                     "vajont_profiles.png"))
     write_csv(csv_path, results)
     write_md(md_path, results, [head], checks)
-    granular = granular_media(case_json)
-    drew = plot(png_path, results, plot_runs, granular)
+    drew = plot(png_path, results, plot_runs, granular_media(s.case_json))
     print()
-    print(f"table: {show(csv_path)}, {show(md_path)}")
-    print(f"plot:  {show(png_path)}" if drew else "plot:  none (no profiles of the plotted runs)")
-    if failed:
-        fail("mixsph failed for " + "; ".join(f"{j.paper.label}: {j.message}" for j in failed), code=1)
+    print(f"table: {mt.show(csv_path)}, {mt.show(md_path)}")
+    print(f"plot:  {mt.show(png_path)}" if drew else "plot:  none (no profiles of the plotted runs)")
+
+
+def run(argv=None, prog=PROG):
+    args = campaign.parse_args(prog, OPTIONS, argv)
+    runs = campaign.parse_runs(args.runs, "--runs", PAPER, "1,2,4", prefix="V")
+    plot_runs = campaign.parse_runs(args.plot_runs, "--plot-runs", PAPER, "1,2,4", prefix="V")
+    if args.twin is not None and 1 not in runs:
+        raise mt.ToolError("--twin: V1, the run it repeats, is not among --runs")
+    s = campaign.settings(args, prog, OPTIONS, len(runs))
+    jobs = plan_jobs(s, runs, args.dx)
+    failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL)
+    report(s, args.dx, load_results(s.case_json, jobs), plot_runs)
+    campaign.check_failed(failed)
+
+
+def main(argv=None, prog=PROG):
+    """The script; argv None: sys.argv; prog: how its help and its messages name it."""
+    campaign.main(prog, lambda: run(argv, prog))
 
 
 if __name__ == "__main__":

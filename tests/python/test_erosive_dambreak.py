@@ -258,3 +258,18 @@ def test_twin_reruns_the_reference_with_perturbed_gravity(tmp_path):
     with open(os.path.join(ROOT, "cases", "erosive_dambreak.json")) as f:
         g = json.load(f)["gravity"]
     assert stamp["sets"] == [["gravity", g * (1 + 1e-6)]]
+
+
+def test_mixsph_validate_dispatches_to_the_scripts(capsys):
+    # mixsph-validate CASE ... (pyproject.toml's console script) is the script of CASE with its
+    # options and exit status, its messages naming it "mixsph-validate CASE"; no case or an
+    # unknown one: the list of cases and exit status 2.
+    import pytest
+    from mixsph_tools import validate
+    assert validate.main(["--help"]) == 0 and "vajont" in capsys.readouterr().out
+    assert validate.main([]) == 2 and validate.main(["nope"]) == 2
+    assert "unknown case 'nope'" in capsys.readouterr().err
+    for case, message in (("vajont", "--runs: '9' is not a run 1-6"), ("erosive", "--runs: '9' is not a run 1-7")):
+        with pytest.raises(SystemExit) as e:
+            validate.main([case, "--runs", "9"])
+        assert e.value.code == 2 and f"mixsph-validate {case}: error: {message}" in capsys.readouterr().err

@@ -14,6 +14,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)
 sys.path.insert(0, os.path.join(ROOT, "tools"))
 import mixsph_tools as mt  # noqa: E402
 import vajont_validate as vv  # noqa: E402
+from mixsph_tools import campaign  # noqa: E402
 
 
 def case_json():
@@ -39,10 +40,12 @@ def test_reference_densities():
 
 
 def test_runs_and_ratios():
-    assert vv.parse_runs("all", "--runs") == [1, 2, 3, 4, 5, 6]
-    assert vv.parse_runs("V4,1, 2", "--runs") == [1, 2, 4]
-    with pytest.raises(SystemExit):
-        vv.parse_runs("7", "--runs")
+    def parse_runs(text):
+        return campaign.parse_runs(text, "--runs", vv.PAPER, "1,2,4", prefix="V")
+    assert parse_runs("all") == [1, 2, 3, 4, 5, 6]
+    assert parse_runs("V4,1, 2") == [1, 2, 4]
+    with pytest.raises(mt.ToolError, match="'7' is not a run 1-6"):
+        parse_runs("7")
     assert vv.PAPER[5].dx_ratio * 0.005 == pytest.approx(6.25e-3)
     assert vv.PAPER[6].dx_ratio * 0.005 == pytest.approx(7.5e-3)
 
@@ -78,7 +81,7 @@ def write_run(d):
 def test_load_result_and_outputs(tmp_path):
     d = str(tmp_path / "V4_dx0.02")
     write_run(d)
-    job = vv.Job(vv.PAPER[4], 0.02, d, [], {}, source="reused")
+    job = campaign.Job(vv.PAPER[4], 0.02, d, [], {}, source="reused")
     r = vv.load_result(job, vv.reference_densities(case_json(), vv.PAPER[4].sets), None,
                        vv.granular_media(case_json()))
     assert r.ok and r.particles == 3 and r.steps == 100
@@ -202,7 +205,7 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     assert summ["run_wall_time_s"] > carried and summ["wall_time_s"] > 0
     assert (run_dir / "monitors.csv").read_bytes() == (whole / "V1_dx0.03" / "monitors.csv").read_bytes()
     # the table's elapsed time is the whole run's
-    res = vv.load_result(vv.Job(vv.PAPER[1], 0.03, str(run_dir), [], {}, source="ran"))
+    res = vv.load_result(campaign.Job(vv.PAPER[1], 0.03, str(run_dir), [], {}, source="ran"))
     assert res.wall == summ["run_wall_time_s"]
     # a third call reuses the finished run
     r3 = subprocess.run(tool + ["--out", str(cut), "--reuse"], capture_output=True, text=True, env=ENV, timeout=600)

@@ -1,0 +1,37 @@
+"""mixsph-validate CASE [OPTIONS]: run a validation campaign of mixsph against its paper.
+
+    mixsph-validate vajont --runs 1,2,4 --dx 0.01     # tools/vajont_validate.py, docs/validation/vajont.md
+    mixsph-validate erosive --runs 2,6 --jobs 2       # tools/erosive_dambreak.py, docs/validation/erosive_dambreak.md
+
+CASE's options, outputs and exit status are its script's (``mixsph-validate CASE --help``).
+"""
+
+import importlib
+import sys
+
+CASES = {
+    "vajont": ("vajont_validate", "the Vajont runs V1-V6 of Manenti et al. (2018), Tables 4-5"),
+    "erosive": ("erosive_dambreak", "the erosive dam break Runs 1-7 of Manenti et al. (2018), Tables 1-2"),
+}
+
+
+def usage():
+    return "usage: mixsph-validate CASE [OPTIONS]   (mixsph-validate CASE --help)\n\ncases:\n" + "".join(
+        f"  {name:8s}  {what}\n" for name, (_, what) in CASES.items())
+
+
+def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if not argv or argv[0] in ("-h", "--help"):
+        print(usage(), end="", file=sys.stdout if argv else sys.stderr)
+        return 0 if argv else 2
+    if argv[0] not in CASES:
+        print(f"mixsph-validate: error: unknown case '{argv[0]}'\n\n{usage()}", end="", file=sys.stderr)
+        return 2
+    module = importlib.import_module(CASES[argv[0]][0])
+    module.main(argv[1:], prog=f"mixsph-validate {argv[0]}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
