@@ -432,7 +432,7 @@ static void test_full_scale_errors(void **state)
     /* at_max_of belongs to profiles and names a max_elevation monitor */
     EXPECT_FULL_SCALE_ERROR(
         "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\", \"at_max_of\": \"top\" }\n", NULL,
-        ORIGIN ": monitors.top.at_max_of: only a profile takes at_max_of");
+        ORIGIN ": monitors.top.at_max_of: a max_elevation monitor does not take this key (only profile)");
     EXPECT_FULL_SCALE_ERROR(
         "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\" },\n"
         "    \"surface\": { \"type\": \"profile\", \"medium\": \"water\", \"x_min\": 0.0, \"x_max\": 0.2, \"at_max_of\": \"fr\" }\n",
