@@ -237,7 +237,7 @@ static const struct case_key full_scale_keys[] = {
     {.key = "z_offset", .type = CASE_NUMBER, ANYWHERE, DEF(0), .unit = "full-scale unit",
      .field = CASE_FIELD(full_scale, z_offset), .meaning = "full-scale elevation of z = 0"},
     {.key = "unit", .type = CASE_STRING, .hi = CASE_NAME_LEN - 1, .def_text = "m", .field = CASE_FIELD(full_scale, unit),
-     .meaning = "unit of Z, for reports"},
+     .meaning = "unit of Z, a label (recorded; no output prints it yet)"},
     {.key = "reference", .type = CASE_OBJECT, .meaning = "the observation the error (13) compares with (below)"},
 };
 
@@ -330,8 +330,8 @@ void case_schema_range_text(const struct case_key *k, int unicode, char *buf, si
         size_t at = 0;
         buf[0] = '\0';
         for (const struct case_choice *c = k->choices; c->name && at < len; c++)
-            at += (size_t)snprintf(buf + at, len - at, "%s\"%s\"", c == k->choices ? "" : c[1].name ? ", " : " or ",
-                                   c->name);
+            at += (size_t)snprintf(buf + at, len - at, unicode ? "%s`\"%s\"`" : "%s\"%s\"",
+                                   c == k->choices ? "" : c[1].name ? ", " : " or ", c->name);
         break;
     }
     case CASE_NUMBERS: snprintf(buf, len, "at least %s", lo); break;
@@ -343,7 +343,7 @@ void case_schema_range_text(const struct case_key *k, int unicode, char *buf, si
 void case_schema_default_text(const struct case_key *k, char *buf, size_t len)
 {
     if (k->def_text) {
-        snprintf(buf, len, k->type == CASE_STRING ? "\"%s\"" : "%s", k->def_text);
+        snprintf(buf, len, k->type == CASE_STRING ? "`\"%s\"`" : "%s", k->def_text);
         return;
     }
     buf[0] = '\0';
@@ -352,7 +352,7 @@ void case_schema_default_text(const struct case_key *k, char *buf, size_t len)
         snprintf(buf, len, "%s", k->def != 0.0 ? "true" : "false");
     } else if (k->type == CASE_CHOICE) {
         for (const struct case_choice *c = k->choices; c->name; c++)
-            if (c->value == (int)k->def) snprintf(buf, len, "\"%s\"", c->name);
+            if (c->value == (int)k->def) snprintf(buf, len, "`\"%s\"`", c->name);
     } else {
         case_schema_number_text(k->def, buf, len);
     }

@@ -105,9 +105,10 @@ mixsph_status case_schema_numbers(const struct case_reader *r, const struct cJSO
 mixsph_status case_schema_points(const struct case_reader *r, const struct cJSON *obj, const char *path,
                                  const char *key, size_t min_n, struct polyline *pl);
 
-/** The range of a key as text: "0 < x <= 10" (unicode: "0 < x ≤ 10"), "" if none. */
+/** The range of a key as text: "0 < x <= 10", or for the document (unicode) markdown "0 < x ≤ 10"
+ * ("" if none). */
 void case_schema_range_text(const struct case_key *k, int unicode, char *buf, size_t len);
-/** The default of a key as text for the document ("" if none). */
+/** The default of a key as markdown for the document ("" if none). */
 void case_schema_default_text(const struct case_key *k, char *buf, size_t len);
 /** A number as short text: %g with "1e+09" written "1e9". */
 void case_schema_number_text(double v, char *buf, size_t len);
