@@ -46,10 +46,10 @@ static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
 
 static const struct case_key top_keys[] = {
     {.key = "name", .type = CASE_STRING, .need = CASE_REQUIRED, .lo = 1, .hi = CASE_NAME_LEN - 1,
-     .field = CASE_FIELD(case_def, name), .meaning = "case name; the default output folder is out/<name>"},
+     .field = CASE_FIELD(case_def, name), .meaning = "case name; the default output folder is `out/<name>`"},
     {.key = "description", .type = CASE_STRING, .meaning = "free text (not read by the model)"},
     {.key = "parameters", .type = CASE_OBJECT,
-     .meaning = "named numbers that values elsewhere in the case use as \"$name\" (see Parameters)"},
+     .meaning = "named numbers that values elsewhere in the case use as `\"$name\"` (see Parameters)"},
     {.key = "gravity", .type = CASE_NUMBER, RANGE(0, 0, 100, 0), DEF(9.81), .unit = "m/s²",
      .field = CASE_FIELD(case_def, g), .meaning = "gravity magnitude, acting along −z"},
     {.key = "numerics", .type = CASE_OBJECT, .need = CASE_REQUIRED, .meaning = "resolution, time step, end time"},
@@ -228,7 +228,7 @@ static const struct case_key monitor_keys[] = {
      .unit = "s", .only = V(MONITOR_PROFILE), .meaning = "times at which the profile is written, increasing (at most 16)"},
     {.key = "at_max_of", .type = CASE_NAME, .only = V(MONITOR_PROFILE),
      .meaning = "name of a max_elevation monitor: the profile is also written at each new highest value of that "
-                "monitor (profile_<name>_atmax.csv)"},
+                "monitor (`profile_<name>_atmax.csv`)"},
 };
 
 static const struct case_key full_scale_keys[] = {
