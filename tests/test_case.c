@@ -673,6 +673,8 @@ static void test_table_rows(void **state)
             assert_true(k->need != CASE_SOMETIMES || k->need_text);
             assert_true(!k->only || sec->variants);
             assert_true(!k->field || (k->type != CASE_NAME && k->type != CASE_NUMBERS && k->type != CASE_OBJECT));
+            assert_true(k->type != CASE_STRING || !k->field || (k->hi > 0 && k->hi < CASE_NAME_LEN)); /* fits its field */
+            assert_true(k->type != CASE_INTEGER || (k->lo >= -1e6 && k->hi <= 1e6));                  /* fits an int */
             /* an infinite default means "no limit" (mu0) or "everywhere" (regions) */
             if (k->has_def && (k->type == CASE_NUMBER || k->type == CASE_INTEGER) && !isinf(k->def)) {
                 assert_true(k->lo_open ? k->def > k->lo : k->def >= k->lo);
