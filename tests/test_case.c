@@ -1,7 +1,8 @@
-/* test_case.c - case files (case.c): every class of bad input is refused with a message naming
- * the file, the key path and what was expected (STYLE.md, "Errors"); numeric overrides
+/* test_case.c - case files (case.c, case_schema.c): every class of bad input is refused with a
+ * message naming the file, the key path and what was expected; numeric overrides
  * (mixsph_override_parse and their application); reading from a file; a good case with an
- * override of numerics.dx gives the expected particle count. */
+ * override of numerics.dx gives the expected particle count; the key tables: each range, type,
+ * variant and default of a row is what the reader enforces, and d50 is refused. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +15,7 @@
 #include <cmocka.h>
 
 #include "case.h"
+#include "case_schema.h"
 #include "mixsph.h"
 
 #define ORIGIN "tiny.json"
@@ -432,7 +434,7 @@ static void test_full_scale_errors(void **state)
     /* at_max_of belongs to profiles and names a max_elevation monitor */
     EXPECT_FULL_SCALE_ERROR(
         "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\", \"at_max_of\": \"top\" }\n", NULL,
-        ORIGIN ": monitors.top.at_max_of: only a profile takes at_max_of");
+        ORIGIN ": monitors.top.at_max_of: a max_elevation monitor does not take this key (only profile)");
     EXPECT_FULL_SCALE_ERROR(
         "    \"top\": { \"type\": \"max_elevation\", \"medium\": \"water\" },\n"
         "    \"surface\": { \"type\": \"profile\", \"medium\": \"water\", \"x_min\": 0.0, \"x_max\": 0.2, \"at_max_of\": \"fr\" }\n",
@@ -481,7 +483,7 @@ static void test_full_scale_map(void **state)
     mixsph_sim_destroy(s);
 
     /* the Vajont case: Z = 1211.8 z + 0.3, Z_exp = 863, Z_still = 700, i.e. the lab-frame
-     * d_eta% = 100 |z - 0.712| / 0.1345 of CASES.md (within 0.1 % for the paper's run-ups: the
+     * d_eta% = 100 |z - 0.712| / 0.1345 of docs/cases.md (within 0.1 % for the paper's run-ups: the
      * map puts z = 0.712 at 863.1 and 0.1345 m at 163.0 m) */
     char *text = NULL;
     assert_int_equal(case_read_file(MIXSPH_SOURCE_DIR "/cases/vajont_padua.json", &text, err, sizeof err), MIXSPH_OK);
@@ -497,6 +499,190 @@ static void test_full_scale_map(void **state)
         assert_true(fabs(case_full_scale_error(&c, Z) - 100.0 * fabs(paper_z[k] - 0.712) / 0.1345) < 0.1);
     }
     case_free(&c);
+}
+
+/* ---- the table-driven reader (case_schema.c) --------------------------------------------------- */
+
+/* BASE with a granular medium "sand" after the water; `extra` is added to its keys. Caller frees. */
+static char *with_sand(const char *extra)
+{
+    char sand[512];
+    snprintf(sand, sizeof sand,
+             "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, "
+             "\"porosity\": 0.35, \"phi\": 35.0, \"mu_thr\": 320e3%s }\n",
+             extra);
+    return edit("\"alpha_m\": 0.1 }\n", sand);
+}
+
+/* Every number of numerics below its range is refused with the key and the range of its table row. */
+static void test_table_ranges(void **state)
+{
+    (void)state;
+    const struct case_section *s = case_schema_find("numerics");
+    assert_non_null(s);
+    size_t checked = 0;
+    for (size_t i = 0; i < s->n_keys; i++) {
+        const struct case_key *k = &s->keys[i];
+        if (k->type != CASE_NUMBER && k->type != CASE_INTEGER) continue;
+        char key[96], range[96], want[256];
+        snprintf(key, sizeof key, "numerics.%s", k->key);
+        case_schema_range_text(k, 0, range, sizeof range);
+        snprintf(want, sizeof want, ORIGIN ": %s: %g is out of range (expected %s)", key, k->lo - 1.0, range);
+        const mixsph_override ov = {key, k->lo - 1.0};
+        assert_true(error_matches(BASE, &ov, 1, MIXSPH_ERR_CASE, want, (const char *)NULL));
+        checked++;
+    }
+    assert_true(checked >= 9);
+    /* upper ends, open and closed, in other sections */
+    EXPECT_EDIT_ERROR("\"alpha_m\": 0.1", "\"alpha_m\": 11", ORIGIN ": media.water.alpha_m: 11 is out of range (expected 0 <= x <= 10)");
+    char *j = with_sand(", \"porosity_x\": 1");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, ORIGIN ": media.sand.porosity_x: unknown key", (const char *)NULL));
+    free(j);
+    j = edit("\"alpha_m\": 0.1 }\n", "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, "
+             "\"K\": 4.24e6, \"porosity\": 0.96, \"phi\": 35.0, \"mu_thr\": 320e3 }\n");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE,
+                              ORIGIN ": media.sand.porosity: 0.96 is out of range (expected 0 < x <= 0.95)", (const char *)NULL));
+    free(j);
+    EXPECT_EDIT_ERROR("\"direction\": \"+x\"", "\"direction\": \"+x\", \"min_neighbours\": 101",
+                      ORIGIN ": monitors.front.min_neighbours: 101 is out of range (expected 0 <= x <= 100)");
+}
+
+static void test_table_types(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3, \"av_wall\": \"yes\"",
+                      ORIGIN ": numerics.av_wall: expected true or false");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3, \"av_mixed\": 2", ORIGIN ": numerics.av_mixed: expected true or false");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": \"3\"", ORIGIN ": numerics.wall_layers: expected an integer");
+    EXPECT_EDIT_ERROR("\"direction\": \"+x\"", "\"direction\": \"+x\", \"min_neighbours\": 2.5",
+                      ORIGIN ": monitors.front.min_neighbours: expected an integer");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3, \"kernel\": 1", ORIGIN ": numerics.kernel: expected a string");
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3, \"kernel\": \"gauss\"",
+                      ORIGIN ": numerics.kernel: 'gauss' (expected \"cubic_spline\" or \"wendland_c2\")");
+    EXPECT_EDIT_ERROR("\"medium\": \"water\", \"polygon\"", "\"medium\": 1, \"polygon\"", ORIGIN ": bodies.pool.medium: expected a string");
+    EXPECT_EDIT_ERROR("\"name\": \"tiny\"", "\"name\": \"\"", ORIGIN ": name: expected 1 to 47 characters");
+    EXPECT_EDIT_ERROR("\"name\": \"tiny\"", "\"name\": \"tiny\", \"description\": 3", ORIGIN ": description: expected a string");
+    EXPECT_EDIT_ERROR("\"monitors\": {", "\"monitors\": { \"bad\": 3,", ORIGIN ": monitors.bad: expected an object");
+}
+
+/* A key of another variant (monitor type) is refused, naming the types that take it. */
+static void test_table_variants(void **state)
+{
+    (void)state;
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"max_elevation\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      ORIGIN ": monitors.front.direction: a max_elevation monitor does not take this key (only front)");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"kinetic_energy\", \"medium\": \"water\", \"min_neighbours\": 3",
+                      ORIGIN ": monitors.front.min_neighbours: a kinetic_energy monitor does not take this key "
+                      "(only front, max_elevation or profile)");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"medium\": \"water\"",
+                      ORIGIN ": monitors.front.medium: a wall_pressure monitor does not take this key");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"", "\"type\": \"wall_pressure\"",
+                      ORIGIN ": monitors.front.wall: missing (expected a string)");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"front\", \"direction\": \"+x\"", ORIGIN ": monitors.front.medium: missing (expected a string)");
+}
+
+/* Absent keys get the defaults of their table rows. */
+static void test_table_defaults(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    char *j = edit("\"numerics\": { \"dx\": 0.02, \"h_over_dx\": 1.3, \"cfl\": 0.1, \"cfl_visc\": 0.05,\n"
+                   "                \"t_end\": 0.1, \"wall_layers\": 3 },",
+                   "\"numerics\": { \"dx\": 0.02, \"t_end\": 0.1 },");
+    char *k = edit_text(j, "\"output\": { \"monitor_interval\": 0.01 }", "\"output\": { }");
+    free(j);
+    j = edit_text(k, "\"gravity\": 9.81,\n", "");
+    free(k);
+    k = edit_text(j, "\"alpha_m\": 0.1 }\n", "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, "
+                  "\"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, \"mu_thr\": 320e3 }\n");
+    free(j);
+    assert_int_equal(case_parse(k, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    free(k);
+    assert_true(c.g == 9.81);
+    assert_true(c.h_over_dx == 1.3 && c.cfl == 0.1 && c.cfl_visc == 0.05 && c.wall_layers == 3);
+    assert_int_equal(c.kernel, 0);
+    assert_true(c.p_background == 0.0 && c.pressure_smoothing == 0.0 && c.fixed_bed_speed == -1.0);
+    assert_true(c.av_wall == 1 && c.av_mixed == 0 && c.av_separating == 0);
+    assert_true(c.monitor_interval == 0.1 / 200.0 && c.snapshot_interval == 0.0);
+    assert_true(c.bodies[0].z_min == -INFINITY && c.bodies[0].z_max == INFINITY);
+    assert_int_equal(c.walls[0].slip, WALL_NO_SLIP);
+    assert_true(c.motions[0].speed_scale == 1.0 && c.motions[0].time_scale == 1.0);
+    assert_int_equal(c.monitors[0].min_neighbours, 3);
+    assert_true(c.monitors[0].x_min == -INFINITY && c.monitors[0].z_max == INFINITY);
+    const struct medium *sand = &c.media[1];
+    assert_int_equal(sand->kind, MEDIUM_GRANULAR);
+    assert_true(sand->mu0 == INFINITY && sand->alpha_m == 0.0);
+    assert_true(sand->saturated == 0 && sand->tension_cutoff == 0 && sand->hold_fixed == 0 && sand->pore_fluid == -1);
+    assert_true(sand->rho0 == (1.0 - 0.35) * 2650.0);
+    case_free(&c);
+    /* the front's direction and a full_scale unit */
+    j = edit("\"direction\": \"+x\"", "\"min_neighbours\": 0");
+    k = edit_text(j, "  \"output\"", "  \"full_scale\": { \"z_scale\": 2 },\n  \"output\"");
+    free(j);
+    assert_int_equal(case_parse(k, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    free(k);
+    assert_int_equal(c.monitors[0].direction, 1);
+    assert_int_equal(c.monitors[0].min_neighbours, 0);
+    assert_string_equal(c.full_scale.unit, "m");
+    assert_true(c.full_scale.z_offset == 0.0 && c.full_scale.z_scale == 2.0);
+    case_free(&c);
+}
+
+/* d50 changes nothing in the model, so a case may not give it. */
+static void test_d50_refused(void **state)
+{
+    (void)state;
+    char *j = with_sand(", \"d50\": 0.004");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, ORIGIN ": media.sand.d50: not used by the model",
+                              "has no grain size", (const char *)NULL));
+    free(j);
+    /* nor through an override */
+    j = with_sand("");
+    const mixsph_override ov = {"media.sand.d50", 0.004};
+    assert_true(error_matches(j, &ov, 1, MIXSPH_ERR_CASE, ORIGIN ": media.sand.d50: not used by the model", (const char *)NULL));
+    free(j);
+    /* the granular medium without it is fine */
+    struct case_def c;
+    char err[512] = "";
+    j = with_sand("");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    free(j);
+    case_free(&c);
+}
+
+/* Every table row is well formed: a key once per section, a meaning, a field only where the
+ * type has one, choices for a choice, a finite default inside the range. */
+static void test_table_rows(void **state)
+{
+    (void)state;
+    size_t n = 0;
+    for (size_t s = 0; case_schema_section(s); s++) {
+        const struct case_section *sec = case_schema_section(s);
+        assert_ptr_equal(case_schema_find(sec->id), sec);
+        for (size_t i = 0; i < sec->n_keys; i++, n++) {
+            const struct case_key *k = &sec->keys[i];
+            print_message("  %s.%s\n", sec->id, k->key);
+            assert_ptr_equal(case_schema_key(sec, k->key), k);
+            assert_true(k->meaning && *k->meaning);
+            assert_true(k->type != CASE_CHOICE || k->choices);
+            assert_true(k->need != CASE_SOMETIMES || k->need_text);
+            assert_true(!k->only || sec->variants);
+            assert_true(!k->field || (k->type != CASE_NAME && k->type != CASE_NUMBERS && k->type != CASE_OBJECT));
+            assert_true(k->type != CASE_STRING || !k->field || (k->hi > 0 && k->hi < CASE_NAME_LEN)); /* fits its field */
+            assert_true(k->type != CASE_INTEGER || (k->lo >= -1e6 && k->hi <= 1e6));                  /* fits an int */
+            /* an infinite default means "no limit" (mu0) or "everywhere" (regions) */
+            if (k->has_def && (k->type == CASE_NUMBER || k->type == CASE_INTEGER) && !isinf(k->def)) {
+                assert_true(k->lo_open ? k->def > k->lo : k->def >= k->lo);
+                assert_true(k->hi_open ? k->def < k->hi : k->def <= k->hi);
+            }
+        }
+    }
+    assert_true(n > 60);
 }
 
 int main(void)
@@ -516,6 +702,12 @@ int main(void)
         cmocka_unit_test(test_create),
         cmocka_unit_test(test_full_scale_errors),
         cmocka_unit_test(test_full_scale_map),
+        cmocka_unit_test(test_table_ranges),
+        cmocka_unit_test(test_table_types),
+        cmocka_unit_test(test_table_variants),
+        cmocka_unit_test(test_table_defaults),
+        cmocka_unit_test(test_d50_refused),
+        cmocka_unit_test(test_table_rows),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -49,7 +49,7 @@ static const char *const CASE_FMT =
 #define WATER "\"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 40.0, \"mu\": 1.0e-3 }"
 #define DRY_SAND                                                                                                      \
     "\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "         \
-    "\"d50\": 0.001, \"mu_thr\": 320e3, \"mu0\": 5e3 }"
+    "\"mu_thr\": 320e3, \"mu0\": 5e3 }"
 #define WET_SAND                                                                                                      \
     "\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "         \
     "\"saturated\": true, \"pore_fluid\": \"water\", \"mu_thr\": 320e3, \"mu0\": 5e3 }"

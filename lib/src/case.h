@@ -23,12 +23,11 @@ struct medium {
     double c;          /* sound speed [m/s]; granular: sqrt(K_s / rho_s) */
     double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
     double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (granular: 0 unless given) */
-    /* granular media (MODEL.md sections 5-6) */
+    /* granular media (docs/model.md sections 5-6) */
     double rho_grain;  /* density of the grains rho_s [kg/m3] */
     double porosity;   /* n = eps_f at the packing limit [-] */
     double phi_deg;    /* angle of internal friction [deg] */
     double sin_phi;
-    double d50;        /* median grain size [m] (recorded; the packing-limit law does not use it) */
     int saturated;     /* pores filled with the pore fluid (else dry) */
     int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
     double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */

@@ -1,0 +1,573 @@
+/* case_schema.c - the key tables of a case file and the table-driven reading of one section.
+ * Each table row says what a key is (type, range, default, unit, meaning) and which field of
+ * struct case_def (case.h) it fills; tests/case_docs.c prints the same rows as the key tables of
+ * docs/cases.md, and CTest (case_docs) fails when the document differs. Physics: docs/model.md
+ * (1 kernel, 3 EOS, 4 time step, 5 mixture, 6 regimes, 8 walls, 9 reported quantities).
+ * Messages have the form "<file>: <key path>: <what was expected>". */
+#include "case_schema.h"
+
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "case.h"
+#include "status.h"
+
+#define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
+#define TRY(expr)                         \
+    do {                                  \
+        mixsph_status st_ = (expr);       \
+        if (st_ != MIXSPH_OK) return st_; \
+    } while (0)
+
+#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
+#define DEF(v) .has_def = 1, .def = (v)
+#define RANGE(l, lopen, h, hopen) .lo = (l), .lo_open = (lopen), .hi = (h), .hi_open = (hopen)
+#define ANYWHERE RANGE(-1e9, 0, 1e9, 0) /* coordinates [m] */
+#define V(kind) (1u << (kind))
+
+/* ---- choices -------------------------------------------------------------------------------- */
+
+static const struct case_choice kernels[] = {{"cubic_spline", 0}, {"wendland_c2", 1}, {NULL, 0}};
+static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
+static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
+static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
+static const struct case_choice directions[] = {{"+x", 1}, {"-x", -1}, {NULL, 0}};
+static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
+                                                   {"max_elevation", MONITOR_MAX_ELEVATION},
+                                                   {"kinetic_energy", MONITOR_KINETIC_ENERGY},
+                                                   {"profile", MONITOR_PROFILE},
+                                                   {"wall_pressure", MONITOR_WALL_PRESSURE},
+                                                   {NULL, 0}};
+
+/* ---- the tables ------------------------------------------------------------------------------ */
+
+static const struct case_key top_keys[] = {
+    {.key = "name", .type = CASE_STRING, .need = CASE_REQUIRED, .lo = 1, .hi = CASE_NAME_LEN - 1,
+     .field = CASE_FIELD(case_def, name), .meaning = "case name; the default output folder is `out/<name>`"},
+    {.key = "description", .type = CASE_STRING, .meaning = "free text (not read by the model)"},
+    {.key = "parameters", .type = CASE_OBJECT,
+     .meaning = "named numbers that values elsewhere in the case use as `\"$name\"` (see Parameters)"},
+    {.key = "gravity", .type = CASE_NUMBER, RANGE(0, 0, 100, 0), DEF(9.81), .unit = "m/s²",
+     .field = CASE_FIELD(case_def, g), .meaning = "gravity magnitude, acting along −z"},
+    {.key = "numerics", .type = CASE_OBJECT, .need = CASE_REQUIRED, .meaning = "resolution, time step, end time"},
+    {.key = "domain", .type = CASE_OBJECT, .def_text = "bounding box", .meaning = "region of the run"},
+    {.key = "media", .type = CASE_OBJECT, .need = CASE_REQUIRED, .meaning = "materials, keyed by name (at most 8)"},
+    {.key = "bodies", .type = CASE_OBJECT, .need = CASE_REQUIRED,
+     .meaning = "regions filled with particles, keyed by name (at most 16)"},
+    {.key = "walls", .type = CASE_OBJECT, .need = CASE_REQUIRED, .meaning = "boundaries, keyed by name (at most 16)"},
+    {.key = "motions", .type = CASE_OBJECT, .meaning = "prescribed velocity laws of walls, keyed by name (at most 8)"},
+    {.key = "monitors", .type = CASE_OBJECT, .meaning = "measured outputs, keyed by name (at most 16)"},
+    {.key = "full_scale", .type = CASE_OBJECT,
+     .meaning = "map of lab elevations to full scale and the error (13) of the run-up"},
+    {.key = "output", .type = CASE_OBJECT, .meaning = "output intervals"},
+};
+
+static const struct case_key numerics_keys[] = {
+    {.key = "dx", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 10, 0), .unit = "m",
+     .field = CASE_FIELD(case_def, dx), .meaning = "particle spacing"},
+    {.key = "h_over_dx", .type = CASE_NUMBER, RANGE(1, 0, 3, 0), DEF(1.3), .unit = "-",
+     .field = CASE_FIELD(case_def, h_over_dx), .meaning = "smoothing length h = h_over_dx dx"},
+    {.key = "cfl", .type = CASE_NUMBER, RANGE(0, 1, 1, 0), DEF(0.1), .unit = "-", .field = CASE_FIELD(case_def, cfl),
+     .meaning = "coefficient of the acoustic (CFL) time-step limit"},
+    {.key = "cfl_visc", .type = CASE_NUMBER, RANGE(0, 1, 1, 0), DEF(0.05), .unit = "-",
+     .field = CASE_FIELD(case_def, cfl_visc), .meaning = "coefficient of the viscous time-step limit"},
+    {.key = "t_end", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e6, 0), .unit = "s",
+     .field = CASE_FIELD(case_def, t_end), .meaning = "end time"},
+    {.key = "wall_layers", .type = CASE_INTEGER, RANGE(1, 0, 8, 0), DEF(3), .unit = "-",
+     .field = CASE_FIELD(case_def, wall_layers),
+     .meaning = "layers of wall particles behind each wall; at least ⌈2 h_over_dx⌉, to cover the kernel support 2h"},
+    {.key = "kernel", .type = CASE_CHOICE, DEF(0), .choices = kernels, .field = CASE_FIELD(case_def, kernel),
+     .meaning = "SPH kernel, support 2h (cubic_spline: the cubic B-spline)"},
+    {.key = "background_pressure", .type = CASE_NUMBER, RANGE(0, 0, 1e9, 0), DEF(0), .unit = "Pa",
+     .field = CASE_FIELD(case_def, p_background),
+     .meaning = "pressure added by the equation of state, for confined flows without a free surface; "
+                "subtracted again in the grains' effective stress"},
+    {.key = "pressure_smoothing", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0), .unit = "-",
+     .field = CASE_FIELD(case_def, pressure_smoothing),
+     .meaning = "θ_P of the partial pressure smoothing (below); 0: off"},
+    {.key = "fixed_bed_speed", .type = CASE_NUMBER, RANGE(-1, 0, 100, 0), DEF(-1), .def_text = "-1 (off)",
+     .unit = "m/s", .field = CASE_FIELD(case_def, fixed_bed_speed),
+     .meaning = "the fixed bed (below): speed at or below which a grain counts as bed; negative: off"},
+    {.key = "av_wall", .type = CASE_BOOL, DEF(1), .field = CASE_FIELD(case_def, av_wall),
+     .meaning = "Monaghan artificial viscosity between a particle and wall particles (below)"},
+    {.key = "av_mixed", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_mixed),
+     .meaning = "the Monaghan term also between particles of different media (below)"},
+    {.key = "av_separating", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_separating),
+     .meaning = "the Monaghan term also on separating pairs, not only approaching ones (below)"},
+};
+
+#define DOMAIN_FIELD(k) (offsetof(struct case_def, domain) + (k) * sizeof(double) + 1)
+static const struct case_key domain_keys[] = {
+    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0),
+     .meaning = "left end"},
+    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(1),
+     .meaning = "right end, > x_min"},
+    {.key = "z_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(2),
+     .meaning = "bottom"},
+    {.key = "z_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(3),
+     .meaning = "top, > z_min"},
+};
+
+static const struct case_key fluid_keys[] = {
+    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = medium_types,
+     .field = CASE_FIELD(medium, kind), .meaning = "\"fluid\" (this table) or \"granular\" (the next)"},
+    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
+     .field = CASE_FIELD(medium, rho0), .meaning = "reference density ρ0"},
+    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e12, 0),
+     .unit = "Pa", .meaning = "bulk modulus of the linear equation of state: c = √(K/ρ0)"},
+    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e5, 0),
+     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
+    {.key = "mu", .type = CASE_NUMBER, RANGE(0, 0, 1e9, 0), DEF(0), .unit = "Pa s", .field = CASE_FIELD(medium, mu),
+     .meaning = "dynamic viscosity"},
+    {.key = "alpha_m", .type = CASE_NUMBER, RANGE(0, 0, 10, 0), DEF(0), .unit = "-",
+     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M"},
+};
+
+static const struct case_key granular_keys[] = {
+    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = medium_types,
+     .field = CASE_FIELD(medium, kind), .meaning = "\"granular\": a mixture at the packing limit"},
+    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
+     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
+    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e12, 0),
+     .unit = "Pa", .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s)"},
+    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e5, 0),
+     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
+    {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 0.95, 0), .unit = "-",
+     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n = ε_f at the packing limit"},
+    {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 89, 0), .unit = "deg",
+     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
+    {.key = "saturated", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, saturated),
+     .meaning = "pores filled with the pore fluid (else dry)"},
+    {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
+     .meaning = "name of a fluid medium defined before this one"},
+    {.key = "mu_thr", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "unless mu1", RANGE(0, 1, 1e12, 0),
+     .unit = "Pa s", .field = CASE_FIELD(medium, mu_thr),
+     .meaning = "threshold viscosity μ_thr: a grain with μ_app ≥ μ_thr is held fixed"},
+    {.key = "mu0", .type = CASE_NUMBER, RANGE(0, 1, 1e12, 0), DEF(INFINITY), .def_text = "+∞ (no limit)",
+     .unit = "Pa s", .field = CASE_FIELD(medium, mu0),
+     .meaning = "limiting viscosity μ0: μ_app between μ0 and μ_thr is replaced by μ0; μ0 ≥ μ_thr: no limit"},
+    {.key = "mu1", .type = CASE_NUMBER, RANGE(0, 1, 1e12, 0), .unit = "Pa s",
+     .meaning = "instead of mu_thr and mu0: the rheology of Run 7, μ_thr = μ1 without a limit"},
+    {.key = "tension_cutoff", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, tension_cutoff),
+     .meaning = "no tensile pressure: p below the background pressure is raised to it (below)"},
+    {.key = "hold_fixed", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, hold_fixed),
+     .meaning = "a grain held fixed gets no acceleration (below)"},
+    {.key = "alpha_m", .type = CASE_NUMBER, RANGE(0, 0, 10, 0), DEF(0), .unit = "-",
+     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M of the grains"},
+};
+
+static const struct case_refused granular_refused[] = {
+    {"d50", "not used by the model: the packing-limit law of the mixture has no grain size (docs/model.md "
+            "sections 5-6); remove the key"},
+    {NULL, NULL}};
+
+static const struct case_key body_keys[] = {
+    {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .meaning = "name of one of the media"},
+    {.key = "polygon", .type = CASE_POINTS, .need = CASE_REQUIRED, .lo = 3, .unit = "m",
+     .field = CASE_FIELD(body, polygon), .meaning = "the outline, closed implicitly"},
+    {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(body, z_min),
+     .meaning = "the body is clipped to z ≥ z_min"},
+    {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(body, z_max),
+     .meaning = "the body is clipped to z ≤ z_max (e.g. a reservoir level)"},
+};
+
+static const struct case_key wall_keys[] = {
+    {.key = "polyline", .type = CASE_POINTS, .need = CASE_REQUIRED, .lo = 2, .unit = "m",
+     .field = CASE_FIELD(wall, line), .meaning = "the wall, an open polyline; consecutive points differ"},
+    {.key = "fluid_side", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = sides,
+     .field = CASE_FIELD(wall, side), .meaning = "the side of the fluid, seen along the polyline's direction of travel"},
+    {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .field = CASE_FIELD(wall, slip),
+     .meaning = "the condition on the tangential velocity"},
+    {.key = "motion", .type = CASE_NAME, .def_text = "fixed", .meaning = "name of one of the motions"},
+};
+
+static const struct case_key motion_keys[] = {
+    {.key = "t", .type = CASE_NUMBERS, .need = CASE_REQUIRED, .lo = 1, .unit = "s",
+     .meaning = "times of the velocity law, strictly increasing"},
+    {.key = "vx", .type = CASE_NUMBERS, .need = CASE_REQUIRED, .lo = 1, .unit = "m/s",
+     .meaning = "horizontal velocity at those times (as many as t)"},
+    {.key = "vz", .type = CASE_NUMBERS, .need = CASE_REQUIRED, .lo = 1, .unit = "m/s",
+     .meaning = "vertical velocity at those times (as many as t)"},
+    {.key = "speed_scale", .type = CASE_NUMBER, RANGE(0, 0, 1e3, 0), DEF(1), .unit = "-",
+     .field = CASE_FIELD(motion, speed_scale), .meaning = "the velocities are multiplied by this"},
+    {.key = "time_scale", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), DEF(1), .unit = "-",
+     .field = CASE_FIELD(motion, time_scale), .meaning = "the law is stretched in time by this (law time = t / time_scale)"},
+    {.key = "stroke_scale", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .unit = "-",
+     .meaning = "instead of speed_scale: the displacement is multiplied by this (speed_scale = "
+                "stroke_scale / time_scale)"},
+};
+
+#define PARTICLE_MONITORS (V(MONITOR_FRONT) | V(MONITOR_MAX_ELEVATION) | V(MONITOR_PROFILE))
+#define MEDIUM_MONITORS (PARTICLE_MONITORS | V(MONITOR_KINETIC_ENERGY))
+static const struct case_key monitor_keys[] = {
+    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = monitor_types,
+     .field = CASE_FIELD(monitor_def, kind), .meaning = "what the monitor measures (below)"},
+    {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .only = MEDIUM_MONITORS,
+     .meaning = "name of one of the media"},
+    {.key = "wall", .type = CASE_NAME, .need = CASE_REQUIRED, .only = V(MONITOR_WALL_PRESSURE),
+     .meaning = "name of one of the walls"},
+    {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions, .only = V(MONITOR_FRONT),
+     .field = CASE_FIELD(monitor_def, direction), .meaning = "\"+x\": the largest x of the medium, \"-x\": the smallest"},
+    {.key = "min_neighbours", .type = CASE_INTEGER, RANGE(0, 0, 100, 0), DEF(3), .unit = "-", .only = PARTICLE_MONITORS,
+     .field = CASE_FIELD(monitor_def, min_neighbours),
+     .meaning = "a particle counts only with at least this many neighbours of its own medium within 2h (not spray)"},
+    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, DEF(-INFINITY),
+     .unit = "m", .field = CASE_FIELD(monitor_def, x_min), .meaning = "region the monitor looks at: left end"},
+    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, DEF(INFINITY),
+     .unit = "m", .field = CASE_FIELD(monitor_def, x_max), .meaning = "right end, > x_min"},
+    {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_min),
+     .meaning = "bottom"},
+    {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_max),
+     .meaning = "top, > z_min"},
+    {.key = "bin", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .def_text = "dx", .unit = "m", .only = V(MONITOR_PROFILE),
+     .field = CASE_FIELD(monitor_def, bin), .meaning = "width of the x bins"},
+    {.key = "times", .type = CASE_NUMBERS, .need = CASE_SOMETIMES, .need_text = "unless at_max_of", .lo = 1,
+     .unit = "s", .only = V(MONITOR_PROFILE), .meaning = "times at which the profile is written, increasing (at most 16)"},
+    {.key = "at_max_of", .type = CASE_NAME, .only = V(MONITOR_PROFILE),
+     .meaning = "name of a max_elevation monitor: the profile is also written at each new highest value of that "
+                "monitor (`profile_<name>_atmax.csv`)"},
+};
+
+static const struct case_key full_scale_keys[] = {
+    {.key = "z_scale", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e9, 0), .unit = "full-scale unit / m",
+     .field = CASE_FIELD(full_scale, z_scale), .meaning = "Z = z_scale z + z_offset"},
+    {.key = "z_offset", .type = CASE_NUMBER, ANYWHERE, DEF(0), .unit = "full-scale unit",
+     .field = CASE_FIELD(full_scale, z_offset), .meaning = "full-scale elevation of z = 0"},
+    {.key = "unit", .type = CASE_STRING, .hi = CASE_NAME_LEN - 1, .def_text = "m", .field = CASE_FIELD(full_scale, unit),
+     .meaning = "unit of Z, a label (recorded; no output prints it yet)"},
+    {.key = "reference", .type = CASE_OBJECT, .meaning = "the observation the error (13) compares with (below)"},
+};
+
+static const struct case_key reference_keys[] = {
+    {.key = "monitor", .type = CASE_NAME, .need = CASE_REQUIRED,
+     .meaning = "name of a max_elevation monitor (the run-up)"},
+    {.key = "observed", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "full-scale unit",
+     .field = CASE_FIELD(full_scale, observed), .meaning = "observed highest elevation Z_exp"},
+    {.key = "still", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "full-scale unit",
+     .field = CASE_FIELD(full_scale, still), .meaning = "still-water elevation Z_still of the error (13), < observed"},
+};
+
+static const struct case_key output_keys[] = {
+    {.key = "monitor_interval", .type = CASE_NUMBER, RANGE(0, 1, 1e6, 0), .def_text = "t_end / 200", .unit = "s",
+     .field = CASE_FIELD(case_def, monitor_interval), .meaning = "time between rows of monitors.csv"},
+    {.key = "snapshot_interval", .type = CASE_NUMBER, RANGE(0, 0, 1e6, 0), DEF(0), .def_text = "0 (none)",
+     .unit = "s", .field = CASE_FIELD(case_def, snapshot_interval), .meaning = "time between particle snapshots"},
+};
+
+#define SECTION(id_, title_, keys_) .id = (id_), .title = (title_), .keys = (keys_), .n_keys = COUNT(keys_)
+static const struct case_section sections[] = {
+    {SECTION("case", "the case (top level)", top_keys)},
+    {SECTION("numerics", "numerics", numerics_keys)},
+    {SECTION("domain", "domain", domain_keys)},
+    {SECTION("media.fluid", "media.<name> of type fluid", fluid_keys)},
+    {SECTION("media.granular", "media.<name> of type granular", granular_keys), .refused = granular_refused},
+    {SECTION("bodies", "bodies.<name>", body_keys)},
+    {SECTION("walls", "walls.<name>", wall_keys)},
+    {SECTION("motions", "motions.<name>", motion_keys)},
+    {SECTION("monitors", "monitors.<name>", monitor_keys), .variant_noun = "monitor", .variants = monitor_types},
+    {SECTION("full_scale", "full_scale", full_scale_keys)},
+    {SECTION("full_scale.reference", "full_scale.reference", reference_keys)},
+    {SECTION("output", "output", output_keys)},
+};
+
+const struct case_section *case_schema_section(size_t k) { return k < COUNT(sections) ? &sections[k] : NULL; }
+
+const struct case_section *case_schema_find(const char *id)
+{
+    for (size_t k = 0; k < COUNT(sections); k++)
+        if (strcmp(sections[k].id, id) == 0) return &sections[k];
+    return NULL;
+}
+
+const struct case_key *case_schema_key(const struct case_section *s, const char *key)
+{
+    for (size_t k = 0; k < s->n_keys; k++)
+        if (strcmp(s->keys[k].key, key) == 0) return &s->keys[k];
+    return NULL;
+}
+
+/* ---- text --------------------------------------------------------------------------------------- */
+
+void case_schema_number_text(double v, char *buf, size_t len)
+{
+    if (isinf(v)) {
+        snprintf(buf, len, "%s", v > 0 ? "+∞" : "−∞");
+        return;
+    }
+    char t[32];
+    snprintf(t, sizeof t, "%g", v);
+    char *e = strchr(t, 'e');
+    if (e) { /* 1e+09 -> 1e9, 1e-05 -> 1e-5 */
+        char *d = e + 1, *s = e + 1;
+        if (*s == '+') s++;
+        else if (*s == '-') *d++ = *s++;
+        while (*s == '0' && s[1]) s++;
+        memmove(d, s, strlen(s) + 1);
+    }
+    snprintf(buf, len, "%s", t);
+}
+
+void case_schema_range_text(const struct case_key *k, int unicode, char *buf, size_t len)
+{
+    char lo[32], hi[32];
+    case_schema_number_text(k->lo, lo, sizeof lo);
+    case_schema_number_text(k->hi, hi, sizeof hi);
+    const char *le = unicode ? "≤" : "<=";
+    switch (k->type) {
+    case CASE_NUMBER:
+    case CASE_INTEGER:
+        snprintf(buf, len, "%s %s x %s %s", lo, k->lo_open ? "<" : le, k->hi_open ? "<" : le, hi);
+        break;
+    case CASE_STRING:
+        if (k->hi <= 0) snprintf(buf, len, "%s", "");
+        else if (k->lo > 0) snprintf(buf, len, "%s to %s characters", lo, hi);
+        else snprintf(buf, len, "at most %s characters", hi);
+        break;
+    case CASE_CHOICE: {
+        size_t at = 0;
+        buf[0] = '\0';
+        for (const struct case_choice *c = k->choices; c->name && at < len; c++)
+            at += (size_t)snprintf(buf + at, len - at, unicode ? "%s`\"%s\"`" : "%s\"%s\"",
+                                   c == k->choices ? "" : c[1].name ? ", " : " or ", c->name);
+        break;
+    }
+    case CASE_NUMBERS: snprintf(buf, len, "at least %s", lo); break;
+    case CASE_POINTS: snprintf(buf, len, "at least %s points", lo); break;
+    default: snprintf(buf, len, "%s", "");
+    }
+}
+
+void case_schema_default_text(const struct case_key *k, char *buf, size_t len)
+{
+    if (k->def_text) {
+        snprintf(buf, len, k->type == CASE_STRING ? "`\"%s\"`" : "%s", k->def_text);
+        return;
+    }
+    buf[0] = '\0';
+    if (!k->has_def) return;
+    if (k->type == CASE_BOOL) {
+        snprintf(buf, len, "%s", k->def != 0.0 ? "true" : "false");
+    } else if (k->type == CASE_CHOICE) {
+        for (const struct case_choice *c = k->choices; c->name; c++)
+            if (c->value == (int)k->def) snprintf(buf, len, "`\"%s\"`", c->name);
+    } else {
+        case_schema_number_text(k->def, buf, len);
+    }
+}
+
+/* ---- reading ------------------------------------------------------------------------------------ */
+
+static void key_path(char *buf, size_t len, const char *path, const char *key)
+{
+    snprintf(buf, len, "%s%s%s", path, *path ? "." : "", key);
+}
+
+static const char *expected_noun(enum case_type t)
+{
+    switch (t) {
+    case CASE_NUMBER: return "a number";
+    case CASE_INTEGER: return "an integer";
+    case CASE_BOOL: return "true or false";
+    case CASE_NUMBERS: return "an array of numbers";
+    case CASE_POINTS: return "an array of [x, z] points";
+    case CASE_OBJECT: return "an object";
+    default: return "a string";
+    }
+}
+
+mixsph_status case_schema_numbers(const struct case_reader *r, const cJSON *obj, const char *path, const char *key,
+                                  size_t min_n, double **out, size_t *n)
+{
+    char kp[256];
+    key_path(kp, sizeof kp, path, key);
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return FAIL(r, "%s: %s: missing (expected an array of numbers)", r->origin, kp);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s: expected an array of numbers", r->origin, kp);
+    const size_t len = (size_t)cJSON_GetArraySize(it);
+    if (len < min_n) return FAIL(r, "%s: %s: expected at least %zu number(s)", r->origin, kp, min_n);
+    double *v = calloc(len ? len : 1, sizeof *v);
+    if (!v) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (const cJSON *e = it->child; e; e = e->next, k++) {
+        if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble)) {
+            free(v);
+            return FAIL(r, "%s: %s[%zu]: expected a number", r->origin, kp, k);
+        }
+        v[k] = e->valuedouble;
+    }
+    *out = v;
+    *n = len;
+    return MIXSPH_OK;
+}
+
+mixsph_status case_schema_points(const struct case_reader *r, const cJSON *obj, const char *path, const char *key,
+                                 size_t min_n, struct polyline *pl)
+{
+    char kp[256];
+    key_path(kp, sizeof kp, path, key);
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, key);
+    if (!it) return FAIL(r, "%s: %s: missing (expected an array of [x, z] points)", r->origin, kp);
+    if (!cJSON_IsArray(it)) return FAIL(r, "%s: %s: expected an array of [x, z] points", r->origin, kp);
+    const size_t len = (size_t)cJSON_GetArraySize(it);
+    if (len < min_n) return FAIL(r, "%s: %s: expected at least %zu [x, z] point(s)", r->origin, kp, min_n);
+    pl->x = calloc(len, sizeof(double));
+    pl->z = calloc(len, sizeof(double));
+    pl->n = len;
+    if (!pl->x || !pl->z) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    size_t k = 0;
+    for (const cJSON *e = it->child; e; e = e->next, k++) {
+        const cJSON *a = cJSON_IsArray(e) && cJSON_GetArraySize(e) == 2 ? e->child : NULL;
+        if (!a || !cJSON_IsNumber(a) || !cJSON_IsNumber(a->next) || !isfinite(a->valuedouble) ||
+            !isfinite(a->next->valuedouble))
+            return FAIL(r, "%s: %s[%zu]: expected a point [x, z] of two numbers", r->origin, kp, k);
+        pl->x[k] = a->valuedouble;
+        pl->z[k] = a->next->valuedouble;
+        if (k > 0 && pl->x[k] == pl->x[k - 1] && pl->z[k] == pl->z[k - 1])
+            return FAIL(r, "%s: %s[%zu]: repeats the previous point", r->origin, kp, k);
+    }
+    return MIXSPH_OK;
+}
+
+static void *field_of(const struct case_key *k, void *base) { return base && k->field ? (char *)base + k->field - 1 : NULL; }
+
+/* A number of the key's type in its range. */
+static mixsph_status read_number(const struct case_reader *r, const cJSON *it, const char *kp, const struct case_key *k,
+                                 double *v)
+{
+    if (!cJSON_IsNumber(it) || !isfinite(it->valuedouble))
+        return FAIL(r, "%s: %s: expected %s", r->origin, kp, expected_noun(k->type));
+    *v = it->valuedouble;
+    if ((k->lo_open ? *v <= k->lo : *v < k->lo) || (k->hi_open ? *v >= k->hi : *v > k->hi)) {
+        char range[96];
+        case_schema_range_text(k, 0, range, sizeof range);
+        return FAIL(r, "%s: %s: %g is out of range (expected %s)", r->origin, kp, *v, range);
+    }
+    if (k->type == CASE_INTEGER && *v != floor(*v)) return FAIL(r, "%s: %s: expected an integer", r->origin, kp);
+    return MIXSPH_OK;
+}
+
+static mixsph_status read_choice(const struct case_reader *r, const cJSON *it, const char *kp, const struct case_key *k,
+                                 int *value)
+{
+    for (const struct case_choice *c = k->choices; c->name; c++)
+        if (strcmp(it->valuestring, c->name) == 0) {
+            *value = c->value;
+            return MIXSPH_OK;
+        }
+    char list[256];
+    case_schema_range_text(k, 0, list, sizeof list);
+    return FAIL(r, "%s: %s: '%s' (expected %s)", r->origin, kp, it->valuestring, list);
+}
+
+mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj, const char *path,
+                                   const struct case_key *k, void *base)
+{
+    char kp[256];
+    key_path(kp, sizeof kp, path, k->key);
+    const cJSON *it = cJSON_GetObjectItemCaseSensitive(obj, k->key);
+    void *f = field_of(k, base);
+    if (!it) {
+        if (k->need == CASE_REQUIRED)
+            return FAIL(r, "%s: %s: missing (expected %s)", r->origin, kp, expected_noun(k->type));
+        if (!f) return MIXSPH_OK;
+        if (k->type == CASE_STRING && k->def_text) snprintf((char *)f, (size_t)k->hi + 1, "%s", k->def_text);
+        if (!k->has_def) return MIXSPH_OK;
+        if (k->type == CASE_NUMBER) *(double *)f = k->def;
+        else *(int *)f = (int)k->def; /* integer, Boolean, choice */
+        return MIXSPH_OK;
+    }
+    double v = 0.0;
+    int iv = 0;
+    switch (k->type) {
+    case CASE_NUMBER:
+    case CASE_INTEGER:
+        TRY(read_number(r, it, kp, k, &v));
+        if (f && k->type == CASE_NUMBER) *(double *)f = v;
+        else if (f) *(int *)f = (int)v;
+        return MIXSPH_OK;
+    case CASE_BOOL:
+        if (cJSON_IsNumber(it) && (it->valuedouble == 0.0 || it->valuedouble == 1.0)) iv = it->valuedouble != 0.0;
+        else if (cJSON_IsBool(it)) iv = cJSON_IsTrue(it);
+        else return FAIL(r, "%s: %s: expected true or false", r->origin, kp);
+        if (f) *(int *)f = iv;
+        return MIXSPH_OK;
+    case CASE_STRING:
+    case CASE_CHOICE:
+    case CASE_NAME:
+        if (!cJSON_IsString(it)) return FAIL(r, "%s: %s: expected a string", r->origin, kp);
+        if (k->type == CASE_CHOICE) {
+            TRY(read_choice(r, it, kp, k, &iv));
+            if (f) *(int *)f = iv;
+        } else if (k->type == CASE_STRING && k->hi > 0) {
+            const size_t n = strlen(it->valuestring);
+            if ((double)n < k->lo || (double)n > k->hi) {
+                char range[96];
+                case_schema_range_text(k, 0, range, sizeof range);
+                return FAIL(r, "%s: %s: expected %s", r->origin, kp, range);
+            }
+            if (f) memcpy(f, it->valuestring, n + 1);
+        }
+        return MIXSPH_OK;
+    case CASE_NUMBERS: {
+        double *tmp = NULL;
+        size_t n = 0;
+        TRY(case_schema_numbers(r, obj, path, k->key, (size_t)k->lo, &tmp, &n));
+        free(tmp);
+        return MIXSPH_OK;
+    }
+    case CASE_POINTS: {
+        struct polyline tmp = {0, NULL, NULL};
+        struct polyline *pl = f ? (struct polyline *)f : &tmp;
+        const mixsph_status st = case_schema_points(r, obj, path, k->key, (size_t)k->lo, pl);
+        geom_free(&tmp);
+        return st;
+    }
+    case CASE_OBJECT:
+        if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, kp);
+        return MIXSPH_OK;
+    }
+    return MIXSPH_OK;
+}
+
+/* "a kinetic_energy monitor does not take this key (only front, max_elevation or profile)" */
+static mixsph_status refuse_variant(const struct case_reader *r, const char *kp, const struct case_section *s,
+                                    unsigned variant, unsigned only)
+{
+    char list[256] = "";
+    const char *mine = "";
+    size_t at = 0, n = 0, total = 0;
+    for (const struct case_choice *c = s->variants; c->name; c++) total += (only & V(c->value)) != 0;
+    for (const struct case_choice *c = s->variants; c->name; c++) {
+        if (variant & V(c->value)) mine = c->name;
+        if (!(only & V(c->value)) || at >= sizeof list) continue;
+        n++;
+        at += (size_t)snprintf(list + at, sizeof list - at, "%s%s", n == 1 ? "" : n == total ? " or " : ", ", c->name);
+    }
+    return FAIL(r, "%s: %s: a %s %s does not take this key (only %s)", r->origin, kp, mine, s->variant_noun, list);
+}
+
+mixsph_status case_schema_read(const struct case_reader *r, const cJSON *obj, const char *path,
+                               const struct case_section *s, unsigned variant, void *base)
+{
+    if (!cJSON_IsObject(obj)) return FAIL(r, "%s: %s: expected an object", r->origin, *path ? path : "the case");
+    for (const cJSON *it = obj->child; it; it = it->next) {
+        char kp[256];
+        key_path(kp, sizeof kp, path, it->string);
+        const struct case_key *k = case_schema_key(s, it->string);
+        if (!k) {
+            for (const struct case_refused *x = s->refused; x && x->key; x++)
+                if (strcmp(x->key, it->string) == 0) return FAIL(r, "%s: %s: %s", r->origin, kp, x->why);
+            return FAIL(r, "%s: %s: unknown key", r->origin, kp);
+        }
+        if (k->only && variant && !(k->only & variant)) return refuse_variant(r, kp, s, variant, k->only);
+    }
+    for (size_t i = 0; i < s->n_keys; i++) {
+        const struct case_key *k = &s->keys[i];
+        if (k->only && variant && !(k->only & variant)) continue;
+        TRY(case_schema_read_key(r, obj, path, k, base));
+    }
+    return MIXSPH_OK;
+}
