@@ -31,6 +31,7 @@
 /* ---- choices -------------------------------------------------------------------------------- */
 
 static const struct case_choice kernels[] = {{"cubic_spline", 0}, {"wendland_c2", 1}, {NULL, 0}};
+static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
 static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
@@ -97,6 +98,17 @@ static const struct case_key numerics_keys[] = {
      .meaning = "the Monaghan term also between particles of different media (below)"},
     {.key = "av_separating", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_separating),
      .meaning = "the Monaghan term also on separating pairs, not only approaching ones (below)"},
+    {.key = "viscosity", .type = CASE_CHOICE, DEF(0), .choices = viscous_schemes,
+     .field = CASE_FIELD(case_def, viscosity_implicit),
+     .meaning = "the laminar viscous term: explicit (in the momentum pass, time step bounded by cfl_visc) or "
+                "implicit (backward Euler, solved by conjugate gradients; no viscous time-step bound)"},
+    {.key = "viscous_tolerance", .type = CASE_NUMBER, RANGE(0, 1, 1e-2, 0), DEF(1e-6), .unit = "-",
+     .field = CASE_FIELD(case_def, viscous_tolerance),
+     .meaning = "implicit viscosity: relative residual ‖b − A u‖ / ‖b‖ at which a solve stops"},
+    {.key = "viscous_max_iterations", .type = CASE_INTEGER, RANGE(1, 0, 100000, 0), DEF(500), .unit = "-",
+     .field = CASE_FIELD(case_def, viscous_max_iterations),
+     .meaning = "implicit viscosity: iteration budget of one solve; a solve that does not reach its tolerance "
+                "within it stops the run"},
 };
 
 #define DOMAIN_FIELD(k) (offsetof(struct case_def, domain) + (k) * sizeof(double) + 1)

@@ -77,6 +77,11 @@ struct forces {
     double *smooth_sum;       /* smoothing: sum_j B_ij W_ij V_j */
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
     size_t scratch_cap;
+    /* implicit viscosity: the viscous coupling w_ij >= 0 of every lane (layout of fk), stored by
+     * the momentum pass, so that m_i du_i/dt = -sum_j w_ij (u_i - u_j) */
+    double *visc_w;
+    size_t visc_w_cap;
+    int visc_valid;           /* visc_w holds the couplings at the current positions */
 };
 
 /* Constants of one pass of the pair loops. */
@@ -91,6 +96,9 @@ struct pair_ctx {
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
     double *sum, *weight;
+    double *visc_w;       /* the viscous couplings of the lanes (implicit viscosity), or NULL */
+    const double *in_x, *in_z; /* the velocity field a viscous operator is applied to */
+    double *out_x, *out_z;     /* and its result */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -106,6 +114,9 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
+    X->visc_w = NULL;
+    X->in_x = X->in_z = NULL;
+    X->out_x = X->out_z = NULL;
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -246,11 +257,13 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
 }
 
 /* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth) is added to
- * i and subtracted from j (ax, az hold forces during the pass; forces_compute divides by the
- * masses after it). */
+ * i and subtracted from j (ax, az hold forces during the pass; forces_momentum divides by the
+ * masses after it). With `implicit` the viscous force is left out and its coupling
+ * w_ij = -F fv (>= 0) is stored per lane in wl instead. */
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double *axi, double *azi,
-                                  const double *restrict fk, const int wendland, const int cached)
+                                  const double *restrict fk, double *restrict wl, const int wendland,
+                                  const int cached, const int implicit)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
@@ -296,8 +309,15 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             /* laminar viscosity, pairwise harmonic mean: mu_i + mu_j of Morris is replaced by
              * 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j); times r^2 / (r^2 + eta^2) */
             const double fv = vv * 4.0 * mu_i * muj * r2 * inv_d;
-            const double fx = F * (fr * rx + fv * (uvxi - uvx[j]));
-            const double fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+            double fx, fz;
+            if (implicit) {
+                wl[k] = -F * fv;
+                fx = F * (fr * rx);
+                fz = F * (fr * rz);
+            } else {
+                fx = F * (fr * rx + fv * (uvxi - uvx[j]));
+                fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+            }
             sx[k] += fx;
             sz[k] += fz;
             ajx[k] = -fx; /* forces: divided by the masses once, after the pass */
@@ -306,6 +326,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         chunk_add(P->ax, jb, n, ajx);
         chunk_add(P->az, jb, n, ajz);
         if (cached) fk += FORCES_CHUNK;
+        if (implicit) wl += FORCES_CHUNK;
     }
     double tx = 0.0, tz = 0.0;
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -346,13 +367,68 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                 size_t b0, size_t b1, const int wendland, const int cached)
+                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit)
 {
     for (size_t i = b0; i < b1; i++) {
         double sx = 0.0, sz = 0.0;
-        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL, wendland, cached);
+        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL,
+                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit);
         P->ax[i] += sx;
         P->az[i] += sz;
+    }
+}
+
+/* The viscous operator's pair sums over i's two ranges: for each component,
+ * out_i += sum_j w_ij (in_i - in_j) and out_j -= w_ij (in_i - in_j) (diagonal: with in = NULL,
+ * out_i += sum_j w_ij and out_j += w_ij). */
+FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint32_t *restrict rng,
+                                 const double *restrict wl, const int diagonal)
+{
+    const double *restrict ux = X->in_x, *restrict uz = X->in_z;
+    double *restrict ox = X->out_x, *restrict oz = X->out_z;
+    const double uxi = diagonal ? 0.0 : ux[i], uzi = diagonal ? 0.0 : uz[i];
+    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0};
+    for (int r = 0; r < 2; r++)
+    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
+        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        double jx[FORCES_CHUNK], jz[FORCES_CHUNK];
+#pragma omp simd
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const double w = wl[k];
+            if (diagonal) {
+                sx[k] += w;
+                jx[k] = w;
+            } else {
+                const size_t j = jb + k;
+                const double dx = w * (uxi - ux[j]), dz = w * (uzi - uz[j]);
+                sx[k] += dx;
+                sz[k] += dz;
+                jx[k] = -dx;
+                jz[k] = -dz;
+            }
+        }
+        chunk_add(ox, jb, m, jx);
+        if (!diagonal) chunk_add(oz, jb, m, jz);
+        wl += FORCES_CHUNK;
+    }
+    double tx = 0.0, tz = 0.0;
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        tx += sx[k];
+        tz += sz[k];
+    }
+    ox[i] += tx;
+    if (!diagonal) oz[i] += tz;
+}
+
+FORCES_CLONES
+static void viscous_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
+                         size_t b0, size_t b1)
+{
+    (void)P;
+    const int diagonal = X->in_x == NULL;
+    for (size_t i = b0; i < b1; i++) {
+        if (diagonal) viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 1);
+        else viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 0);
     }
 }
 
@@ -390,7 +466,14 @@ FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    FORCES_DISPATCH(momentum_walk, X, NB, P, b0, b1);
+    if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
+        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, 1);
+        else momentum_walk(X, NB, P, b0, b1, 0, 1, 1);
+        return;
+    }
+#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) momentum_walk(X, NB, P, b0, b1, wendland, cached, 0)
+    FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
+#undef MOMENTUM_EXPLICIT
 }
 
 struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
@@ -403,12 +486,19 @@ void forces_free(struct forces *F)
     free(F->nbr_count);
     free(F->smooth_sum);
     free(F->smooth_weight);
+    free(F->visc_w);
     free(F);
 }
 
 int forces_cache_pending(const struct forces *F) { return F->fk_valid; }
 
-void forces_forget_cache(struct forces *F) { F->fk_valid = 0; }
+void forces_forget_cache(struct forces *F)
+{
+    F->fk_valid = 0;
+    F->visc_valid = 0;
+}
+
+int forces_viscous_ready(const struct forces *F) { return F->visc_valid; }
 
 /* The kernel-factor cache: the density pass stores F(r_ij) of every lane it evaluates (masked
  * lanes 0), and the momentum pass of the same step, at the same positions and over the same
@@ -529,6 +619,20 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     const size_t n = active_count(S);
     memset(P->ax, 0, n * sizeof(double));
     memset(P->az, 0, n * sizeof(double));
+    F->visc_valid = 0;
+    if (S->params.implicit_viscosity) {
+        /* the couplings are stored in the cache's lane layout, so the cache must be there */
+        if (!F->fk_valid) return -1;
+        const size_t lanes = F->fk_off[n];
+        if (F->visc_w_cap < lanes) {
+            const size_t cap = lanes + lanes / 4 + FORCES_CHUNK;
+            free(F->visc_w);
+            F->visc_w = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
+            F->visc_w_cap = F->visc_w ? cap : 0;
+            if (!F->visc_w) return -1;
+        }
+        X.visc_w = F->visc_w;
+    }
     if (F->fk_valid) { /* the density pass of this step filled it, at these positions */
         X.fk = F->fk;
         X.fk_off = F->fk_off;
@@ -543,7 +647,27 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         P->az[i] = P->az[i] * P->inv_m[i] - g;
         bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
     }
+    F->visc_valid = X.visc_w != NULL;
     return bad;
+}
+
+int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
+                         double *out_x, double *out_z)
+{
+    if (!F->visc_valid) return -1;
+    struct pair_ctx X;
+    pair_ctx_init(S, &X);
+    const size_t n = active_count(S);
+    memset(out_x, 0, n * sizeof(double));
+    if (out_z) memset(out_z, 0, n * sizeof(double));
+    X.visc_w = F->visc_w;
+    X.fk_off = F->fk_off;
+    X.in_x = in_x;
+    X.in_z = in_z;
+    X.out_x = out_x;
+    X.out_z = out_z;
+    for_bands(S, viscous_band, &X);
+    return 0;
 }
 
 void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho)
@@ -559,7 +683,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, X.wendland, 0);
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, 0);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];

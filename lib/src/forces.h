@@ -21,6 +21,8 @@ struct forces_params {
     int av_wall;        /* artificial viscosity between particles and walls */
     int av_mixed;       /* ... between particles of different media too */
     int av_separating;  /* ... for separating pairs too */
+    int implicit_viscosity; /* the momentum pass leaves the viscous term out and stores its
+                               couplings for forces_viscous_apply (docs/numerics.md) */
 };
 
 /* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */
@@ -58,9 +60,18 @@ int forces_density_rate(struct forces *F, const struct pair_system *S);
  *  lost, over its gather ranges (walls enter with their no-slip velocity). */
 void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out);
 
-/** Acceleration (ax, az) of every particle, gravity included. Returns 1 if a non-finite value
- *  appeared at a mobile particle, 0 otherwise. */
+/** Acceleration (ax, az) of every particle, gravity included (without the viscous term when
+ *  params.implicit_viscosity; the pass then stores the viscous couplings w_ij of the pairs, and
+ *  must follow this step's forces_density_rate). Returns 1 if a non-finite value appeared at a
+ *  mobile particle, -1 when out of memory or without this step's density pass, 0 otherwise. */
 int forces_momentum(struct forces *F, const struct pair_system *S);
+
+/** The viscous operator of the last implicit momentum pass, out_i = sum_j w_ij (in_i - in_j)
+ *  for both components, so that the viscous acceleration of a velocity field u is
+ *  -out_i / m_i. With in_x = NULL its diagonal instead: out_x_i = sum_j w_ij (out_z unused).
+ *  Arrays of the active particles. Returns -1 without a stored operator. */
+int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
+                         double *out_x, double *out_z);
 
 /** SPHERA's partial pressure smoothing with factor theta_P dt / h (docs/model.md section 3):
  *  pressures and densities of the non-wall particles relax toward their neighbours'. Returns -1
@@ -69,8 +80,11 @@ int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double
 
 /** Whether the cache holds factors the next momentum pass will use (tests). */
 int forces_cache_pending(const struct forces *F);
-/** Drop the cached factors (the particles were replaced, e.g. by a restored state). */
+/** Drop the cached factors and viscous couplings (the particles were replaced, e.g. by a
+ *  restored state). */
 void forces_forget_cache(struct forces *F);
+/** Whether the viscous couplings of the last implicit momentum pass are there. */
+int forces_viscous_ready(const struct forces *F);
 
 /** Test hook: the acceleration (without gravity) and the density rate particle j gives i,
  *  evaluated by the same pair code. */

@@ -24,6 +24,7 @@
 
 #include "eos.h"
 #include "status.h"
+#include "viscous.h"
 
 /* Distance [dx] at which a particle that would cross a wall is put back on its side. */
 #define INTEGRATE_CLIP_GAP 0.1
@@ -38,14 +39,15 @@ double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;
     const double h = s->h, cfl = s->cfg.cfl, cflv = s->cfg.cfl_visc, cmax = s->c_max;
+    const int implicit = s->cfg.viscosity_implicit; /* no viscous bound: the viscous step is implicit */
     double dt = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : dt) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
         double d = cfl * 2.0 * h / (cmax + u);
-        double mu = P->mu[i];
-        if (P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
+        double mu = implicit ? 0.0 : P->mu[i];
+        if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
             const struct medium *m = &s->cfg.media[P->medium[i]];
             mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
         }
@@ -138,6 +140,7 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.params.av_wall = s->cfg.av_wall;
     S.params.av_mixed = s->cfg.av_mixed;
     S.params.av_separating = s->cfg.av_separating;
+    S.params.implicit_viscosity = s->cfg.viscosity_implicit;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
@@ -164,6 +167,49 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
     return 0;
 }
 
+/* v += dt a of the particles that take kicks (not walls, lost particles or grains held fixed
+ * with hold_fixed). */
+static void kick_velocities(mixsph_sim *s, double dt)
+{
+    struct particles *P = &s->P;
+#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        if (P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed) continue;
+        P->vx[i] += dt * P->ax[i];
+        P->vz[i] += dt * P->az[i];
+    }
+}
+
+/* The implicit viscous step over dt with the operator of the last momentum pass (at the current
+ * positions; after a restored state it is rebuilt first). The step is symplectic Euler: the
+ * velocities take the whole step's kick of the other forces and then the viscous step, and the
+ * drift uses the result, so that at a steady state the velocity the particles move with is the
+ * one at which the viscous and the other forces balance (a half kick before the drift, as in the
+ * explicit leapfrog, would move them with an unbalanced half kick of the other forces: 2.4 % of
+ * the lid speed in the lid-driven channel at 20 times the explicit viscous time step). A solve
+ * that misses its tolerance stops the run. */
+static mixsph_status viscous_step(mixsph_sim *s, double dt)
+{
+    if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    const struct pair_system S = sim_pair_system(s);
+    if (!forces_viscous_ready(s->forces)) { /* a restored state: the couplings at its positions */
+        if (density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0)
+            return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    }
+    struct viscous_report *rep = &s->viscous_last;
+    if (viscous_solve(s->viscous, s->forces, &S, dt, s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, rep) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
+    s->viscous_iterations += (uint64_t)rep->iterations;
+    if (!rep->converged)
+        return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
+                        "implicit viscous step: relative residual %.3g after %d iterations (tolerance %g, "
+                        "numerics.viscous_max_iterations %d) at t = %.6g s (step %llu)",
+                        rep->residual, rep->iterations, s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, s->t,
+                        (unsigned long long)s->step);
+    return MIXSPH_OK;
+}
+
 mixsph_status integrate_initial_rates(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
@@ -171,7 +217,9 @@ mixsph_status integrate_initial_rates(mixsph_sim *s)
     if (bad < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     pressures_and_regimes(s, &S, 0);
-    if (forces_momentum(s->forces, &S)) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
+    const int bad_a = forces_momentum(s->forces, &S);
+    if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    if (bad_a) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
     s->dt = integrate_time_step(s);
     return MIXSPH_OK;
 }
@@ -188,14 +236,21 @@ mixsph_status integrate_step(mixsph_sim *s)
         ox_old[w] = s->walls[w].ox;
         oz_old[w] = s->walls[w].oz;
     }
+    const int implicit = s->cfg.viscosity_implicit;
+    if (implicit) { /* kick with the other forces over the whole step, then the viscous step */
+        kick_velocities(s, dt);
+        const mixsph_status st = viscous_step(s, dt);
+        if (st != MIXSPH_OK) return st;
+    }
     walls_move(&s->cfg, s->walls, P, s->t, dt);
     const double gap = INTEGRATE_CLIP_GAP * s->dx;
+    const double half_kick = implicit ? 0.0 : 0.5 * dt;
     long clips = 0;
 #pragma omp parallel for schedule(static) reduction(+ : clips) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         const int st = P->state[i];
         if (st == MIXSPH_STATE_WALL || st == MIXSPH_STATE_LOST) continue;
-        const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : 0.5 * dt;
+        const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : half_kick;
         double vx = P->vx[i] + kick * P->ax[i];
         double vz = P->vz[i] + kick * P->az[i];
         if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
@@ -230,20 +285,16 @@ mixsph_status integrate_step(mixsph_sim *s)
     }
     if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
-    if (forces_momentum(s->forces, &S) || bad_rho) {
+    const int bad_a = forces_momentum(s->forces, &S);
+    if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    if (bad_a || bad_rho) {
         for (size_t i = 0; i < P->n; i++)
             if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                                 "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
                                 P->rho[i], P->id[i], P->x[i], P->z[i], s->t);
     }
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed) continue;
-        P->vx[i] += 0.5 * dt * P->ax[i];
-        P->vz[i] += 0.5 * dt * P->az[i];
-    }
+    if (!implicit) kick_velocities(s, 0.5 * dt);
     s->dt = integrate_time_step(s);
     return MIXSPH_OK;
 }

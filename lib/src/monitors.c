@@ -29,9 +29,13 @@
 
 #include "status.h"
 
-enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_N_DIAG };
+/* Diagnostics; the last two (the implicit viscous solve's) only with numerics.viscosity = "implicit". */
+enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_VISC_ITER, OUT_VISC_RES, OUT_N_DIAG };
 static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt", "lost_particles", "wall_corrections",
-                                                   "max_speed", "fixed_particles"};
+                                                   "max_speed", "fixed_particles", "viscous_iterations",
+                                                   "viscous_residual"};
+/* out_monitor[k] of diagnostic d */
+#define OUT_DIAG_CODE(d) (-1 - (int)(d))
 
 /* out_monitor[k] of a monitor output: the case monitor m plus CASE_MAX_MONITORS times the kind
  * of output (the monitor's value, its full-scale elevation, the error (13) of its maximum). */
@@ -55,8 +59,9 @@ static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffi
 void monitors_init(mixsph_sim *s)
 {
     s->n_out = 0;
-    for (size_t k = 0; k < OUT_N_DIAG; k++) {
-        s->out_monitor[s->n_out] = -1;
+    const size_t n_diag = s->cfg.viscosity_implicit ? OUT_N_DIAG : OUT_VISC_ITER;
+    for (size_t k = 0; k < n_diag; k++) {
+        s->out_monitor[s->n_out] = OUT_DIAG_CODE(k);
         snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", diag_names[k]);
     }
     for (size_t k = 0; k < s->cfg.n_monitors; k++) {
@@ -117,11 +122,11 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 double monitors_value(const mixsph_sim *s, size_t k)
 {
     const struct particles *P = &s->P;
-    if (k >= OUT_N_DIAG) {
+    if (s->out_monitor[k] >= 0) {
         const int m = s->out_monitor[k] % CASE_MAX_MONITORS, kind = s->out_monitor[k] / CASE_MAX_MONITORS;
         if (kind == OUTK_FULL_ERR) {
             /* the error (13) of the highest value so far of the monitor's own output */
-            for (size_t j = OUT_N_DIAG; j < s->n_out; j++)
+            for (size_t j = 0; j < s->n_out; j++)
                 if (s->out_monitor[j] == OUT_CODE(m, OUTK_VALUE))
                     return isnan(s->out_max[j]) ? NAN
                                                 : case_full_scale_error(&s->cfg, case_full_scale_z(&s->cfg, s->out_max[j]));
@@ -130,10 +135,13 @@ double monitors_value(const mixsph_sim *s, size_t k)
         const double v = monitor_eval(s, &s->cfg.monitors[m]);
         return kind == OUTK_FULL_Z && !isnan(v) ? case_full_scale_z(&s->cfg, v) : v;
     }
-    if (k == OUT_DT) return s->dt;
-    if (k == OUT_LOST) return (double)s->n_lost;
-    if (k == OUT_CLIPS) return (double)s->n_clipped;
-    if (k == OUT_FIXED) return (double)s->n_fixed;
+    const int d = -1 - s->out_monitor[k];
+    if (d == OUT_DT) return s->dt;
+    if (d == OUT_LOST) return (double)s->n_lost;
+    if (d == OUT_CLIPS) return (double)s->n_clipped;
+    if (d == OUT_FIXED) return (double)s->n_fixed;
+    if (d == OUT_VISC_ITER) return (double)s->viscous_last.iterations;
+    if (d == OUT_VISC_RES) return s->viscous_last.residual;
     double ke = 0.0, mass = 0.0, vmax = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
@@ -142,7 +150,7 @@ double monitors_value(const mixsph_sim *s, size_t k)
         mass += P->m[i];
         if (v2 > vmax) vmax = v2;
     }
-    return k == OUT_KE ? ke : k == OUT_MASS ? mass : sqrt(vmax);
+    return d == OUT_KE ? ke : d == OUT_MASS ? mass : sqrt(vmax);
 }
 
 mixsph_status monitors_open(mixsph_sim *s)

@@ -276,6 +276,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
     output_close(s);
     mixture_free(s->mixture);
     forces_free(s->forces);
+    viscous_free(s->viscous);
     particles_free(&s->P);
     cells_free(&s->C);
     neighbours_free(&s->NB);

@@ -16,6 +16,7 @@
 #include "mixture.h"
 #include "neighbours.h"
 #include "particles.h"
+#include "viscous.h"
 #include "walls.h"
 
 #ifdef _OPENMP
@@ -30,7 +31,7 @@
 #define SIM_CELL_COLUMNS 4
 #endif
 
-#define SIM_MAX_OUTPUTS (8 + CASE_MAX_MONITORS)
+#define SIM_MAX_OUTPUTS (10 + CASE_MAX_MONITORS)
 
 struct mixsph_sim {
     struct case_def cfg;
@@ -49,6 +50,9 @@ struct mixsph_sim {
     struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
     struct forces *forces;        /* the pair loops' cache and scratch */
+    struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
+    struct viscous_report viscous_last; /* the last solve */
+    uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
     struct mixture *mixture;      /* granular phase; NULL without granular media */

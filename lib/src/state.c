@@ -16,7 +16,7 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 2u /* 2: neighbour build positions (Verlet ranges) */
+#define STATE_VERSION 3u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
@@ -136,7 +136,10 @@ static void put_source(struct writer *w, const mixsph_sim *s)
     IO(&(s)->step, sizeof(s)->step) IO(&(s)->n_lost, sizeof(s)->n_lost) \
     IO(&(s)->n_clipped, sizeof(s)->n_clipped) IO(&(s)->n_fixed, sizeof(s)->n_fixed) \
     IO(&(s)->n_samples, sizeof(s)->n_samples) IO(&(s)->next_sample, sizeof(s)->next_sample) \
-    IO(&(s)->next_snapshot, sizeof(s)->next_snapshot) IO(&(s)->snap_index, sizeof(s)->snap_index)
+    IO(&(s)->next_snapshot, sizeof(s)->next_snapshot) IO(&(s)->snap_index, sizeof(s)->snap_index) \
+    IO(&(s)->viscous_last.iterations, sizeof(s)->viscous_last.iterations)                       \
+    IO(&(s)->viscous_last.residual, sizeof(s)->viscous_last.residual)                           \
+    IO(&(s)->viscous_iterations, sizeof(s)->viscous_iterations)
 
 static void put_dynamic(struct writer *w, const mixsph_sim *s)
 {
