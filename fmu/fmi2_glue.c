@@ -177,18 +177,21 @@ static fmi2Status check_declared_parameters(struct fmu_instance *in, const char 
     for (size_t k = 0; k < req->n_ov; k++) {
         const char *key = req->ov[k].ov.key;
         if (strncmp(key, prefix, sizeof prefix - 1) != 0) continue;
+        const char *param = key + sizeof prefix - 1;
         char err[FMU_MSG_LEN];
         int declared = 0;
-        if (mixsph_case_declares_parameter(path, key + sizeof prefix - 1, &declared, err, sizeof err) != MIXSPH_OK)
+        if (mixsph_case_declares_parameter(path, param, &declared, err, sizeof err) != MIXSPH_OK)
             return fmu_fail(in, "cannot read the case file: %s", err);
         if (declared) continue;
         char names[1024];
         size_t n = 0;
         if (mixsph_case_parameter_names(path, names, sizeof names, &n, err, sizeof err) != MIXSPH_OK) names[0] = '\0';
         return fmu_fail(in,
-                        "%s was set, but the case file %s does not declare it in its parameters block (no %s), so "
-                        "the value could not reach the case; it declares %s%s",
-                        req->ov[k].variable, path, key, n ? "only " : "no parameters", n ? names : "");
+                        "%s was set, but the case file %s does not declare it: its parameters block has no \"%s\" "
+                        "(the override %s), so the value would not reach the case. The case declares %s%s. Leave "
+                        "%s unset, or declare it in the case's parameters block and use it there as \"$%s\"",
+                        req->ov[k].variable, path, param, key, n ? "only: " : "no parameters", n ? names : "", param,
+                        param);
     }
     return fmi2OK;
 }
