@@ -135,6 +135,9 @@ static void set_defaults(void *data)
 
 /* ---- the simulation ----------------------------------------------------------------------- */
 
+/* every parameter set at once fits in one request */
+_Static_assert(N_REAL_PARAMS + N_BOOL_PARAMS <= FMU_MAX_OVERRIDES, "FMU_MAX_OVERRIDES too small for the parameters");
+
 static void request(const struct fmu_instance *in, struct fmu_sim_request *req)
 {
     const struct landslide_data *d = data_of(in);
