@@ -68,7 +68,7 @@ def test_zip_layout():
     with zipfile.ZipFile(H.fmu_path()) as z:
         files = set(z.namelist())
     assert {"modelDescription.xml", "binaries/linux64/LandslideWave.so",
-            "resources/vajont_padua.json"} <= files
+            "resources/vajont_padua.json", "resources/slope_tank.json"} <= files
 
 
 # ---- the same run as the executable -----------------------------------------------------------
