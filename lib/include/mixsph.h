@@ -192,6 +192,35 @@ void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, 
 const char *mixsph_sim_case_text(const mixsph_sim *s);
 const char *mixsph_sim_case_origin(const mixsph_sim *s);
 
+/* ---- queries: walls and case parameters (for hosts such as the FMU) ------------------------ */
+
+/** Number of walls of the case (the "walls" object, in file order). */
+size_t mixsph_sim_wall_count(const mixsph_sim *s);
+/** Name of wall `k` as the case names it (the name mixsph_sim_set_wall_velocity takes), or NULL
+ *  when k >= mixsph_sim_wall_count. */
+const char *mixsph_sim_wall_name(const mixsph_sim *s, size_t k);
+/** 1 if wall `k` has a prescribed motion in the case (it can be driven by
+ *  mixsph_sim_set_wall_velocity), 0 if it is fixed or k is out of range. */
+int mixsph_sim_wall_moves(const mixsph_sim *s, size_t k);
+/** The direction of travel of moving wall `k`: the unit vector (*ux, *uz) of the fastest row of
+ *  its motion law's velocity table (the first one if several tie), before the law's scales.
+ *  MIXSPH_ERR_ARG (and 0, 0) for a fixed wall, a k out of range or a law that never moves. */
+mixsph_status mixsph_sim_wall_travel_direction(const mixsph_sim *s, size_t k, double *ux, double *uz);
+
+/** Whether the case file `case_path` declares `name` in its `parameters` block, i.e. lets a host
+ *  set it by the override "parameters.NAME" (*declared = 1) or not (0; also when the case has no
+ *  such block). An override of an undeclared parameter is not an error of mixsph_sim_create when
+ *  the case has a parameters block (the key is added and nothing uses it), so a host that maps
+ *  its own parameters onto a case's asks first. MIXSPH_ERR_IO or MIXSPH_ERR_CASE, with a message
+ *  in err, when the file cannot be read or is not JSON. */
+mixsph_status mixsph_case_declares_parameter(const char *case_path, const char *name, int *declared, char *err,
+                                             size_t err_len);
+/** The names the case file `case_path` declares in its `parameters` block, in file order,
+ *  separated by ", " into names[names_len] (cut short if it does not fit), and their number in *n
+ *  ("" and 0 when it declares none). Errors as mixsph_case_declares_parameter. */
+mixsph_status mixsph_case_parameter_names(const char *case_path, char *names, size_t names_len, size_t *n,
+                                          char *err, size_t err_len);
+
 #ifdef __cplusplus
 }
 #endif

@@ -1,7 +1,8 @@
 /* test_fmu_dlopen.c - the LandslideWave FMU's shared library driven through dlopen, without
  * Python, as a C co-simulation master would: every FMI 2.0 function resolves; the resource
  * location in its URI spellings; doStep of any size gives the same trajectory; FMU state
- * save/restore and serialisation; two interleaved instances; errors reported through the logger.
+ * save/restore and serialisation; two interleaved instances; errors reported through the logger;
+ * a second landslide case through case_file.
  *
  *   test_fmu_dlopen STAGE_DIR     (the unpacked FMU: modelDescription.xml, binaries/, resources/)
  *
@@ -30,6 +31,9 @@ enum {
     VR_PHI = 2,
     VR_MU0 = 3,
     VR_DX = 6,
+    VR_CASE_FILE = 12,
+    VR_PUSH_VELOCITY = 20,
+    VR_PUSH_EXTERNAL = 21,
     VR_RUN_UP = 30,
     VR_MAX_RUN_UP = 31,
     VR_FRONT = 33,
@@ -169,8 +173,10 @@ static void test_value_references_match_the_model_description(void **state)
     const struct {
         const char *name;
         int vr;
-    } vars[] = {{"phi", VR_PHI}, {"mu0", VR_MU0}, {"dx", VR_DX}, {"run_up", VR_RUN_UP}, {"max_run_up", VR_MAX_RUN_UP},
-                {"landslide_front", VR_FRONT}, {"kinetic_energy", VR_KE}, {"steps", VR_STEPS}};
+    } vars[] = {{"phi", VR_PHI}, {"mu0", VR_MU0}, {"dx", VR_DX}, {"case_file", VR_CASE_FILE},
+                {"push_velocity", VR_PUSH_VELOCITY}, {"push_external", VR_PUSH_EXTERNAL}, {"run_up", VR_RUN_UP},
+                {"max_run_up", VR_MAX_RUN_UP}, {"landslide_front", VR_FRONT}, {"kinetic_energy", VR_KE},
+                {"steps", VR_STEPS}};
     for (size_t k = 0; k < sizeof vars / sizeof vars[0]; k++) {
         char want[128];
         snprintf(want, sizeof want, "name=\"%s\" valueReference=\"%d\"", vars[k].name, vars[k].vr);
@@ -329,6 +335,46 @@ static void test_errors_are_logged_not_fatal(void **state)
     SYM(fmi2FreeInstance)(NULL);
 }
 
+/* Another landslide case by its resource name (cases/slope_tank.json: its walls and media are not
+ * the Vajont ones): a parameter it declares is taken, one it does not is an error naming it, and
+ * its moving wall (the "ram") is found and pushed. */
+static void test_second_case_through_case_file(void **state)
+{
+    (void)state;
+    char uri[4200];
+    resource_uri(uri, sizeof uri, "file://", "");
+    struct log_counts lc = {0};
+    fmi2Component c = instantiate("slope", uri, &lc);
+    assert_non_null(c);
+    const fmi2ValueReference vcase = VR_CASE_FILE, vphi_mu0[] = {VR_PHI, VR_MU0};
+    const fmi2String slope = "slope_tank.json";
+    const fmi2Real phi_mu0[] = {30.0, 100.0};
+    assert_int_equal(SYM(fmi2SetupExperiment)(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+    assert_int_equal(SYM(fmi2EnterInitializationMode)(c), fmi2OK);
+    assert_int_equal(SYM(fmi2SetString)(c, &vcase, 1, &slope), fmi2OK);
+    assert_int_equal(SYM(fmi2SetReal)(c, vphi_mu0, 2, phi_mu0), fmi2OK);
+    assert_int_equal(SYM(fmi2ExitInitializationMode)(c), fmi2Error);
+    assert_int_equal(lc.n[fmi2Error], 1);
+    if (strncmp(lc.last, "mu0 was set", 11) != 0 || !strstr(lc.last, "parameters.mu0")) fail_msg("message: %s", lc.last);
+
+    /* the declared one alone runs, and the ram takes the push */
+    assert_int_equal(SYM(fmi2Reset)(c), fmi2OK);
+    assert_int_equal(SYM(fmi2SetupExperiment)(c, fmi2False, 0.0, 0.0, fmi2False, 0.0), fmi2OK);
+    assert_int_equal(SYM(fmi2EnterInitializationMode)(c), fmi2OK);
+    assert_int_equal(SYM(fmi2SetString)(c, &vcase, 1, &slope), fmi2OK);
+    assert_int_equal(SYM(fmi2SetReal)(c, vphi_mu0, 1, phi_mu0), fmi2OK);
+    if (SYM(fmi2ExitInitializationMode)(c) != fmi2OK) fail_msg("fmi2ExitInitializationMode: %s", lc.last);
+    const fmi2ValueReference vpush = VR_PUSH_EXTERNAL, vv = VR_PUSH_VELOCITY;
+    const fmi2Boolean on = fmi2True;
+    const fmi2Real fast = 1.5;
+    assert_int_equal(SYM(fmi2SetBoolean)(c, &vpush, 1, &on), fmi2OK);
+    assert_int_equal(SYM(fmi2SetReal)(c, &vv, 1, &fast), fmi2OK);
+    step_to(c, 0.0, 0.1, 0.05);
+    assert_true(outputs(c).steps > 100);
+    assert_int_equal(lc.n[fmi2Error], 1);
+    SYM(fmi2FreeInstance)(c);
+}
+
 /* The GUID of the staged modelDescription.xml. */
 static int read_guid(void)
 {
@@ -384,6 +430,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_state_restore_and_serialize),
         cmocka_unit_test(test_interleaved_instances_match_solo_runs),
         cmocka_unit_test(test_errors_are_logged_not_fatal),
+        cmocka_unit_test(test_second_case_through_case_file),
     };
     /* no dlclose: the library stays mapped so that a leak report (ASan) can name its functions */
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -24,16 +24,16 @@ CASE = ROOT / "cases" / "vajont_padua.json"
 
 # The coarse test setting: parameters of the FMU and the same as case overrides of mixsph.
 COARSE = {"dx": 0.03, "mu0": 1000.0}
+# The FMU's physical parameters reach a case through its `parameters` block (override
+# "parameters.NAME"), the numerical ones through keys every case has (fmu/landslide_model.c).
+PHYSICAL = ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "tension_cutoff", "porosity", "grain_density",
+            "plate_duration_scale", "plate_stroke_scale"]
 CASE_KEYS = {
-    "reservoir_level": ["parameters.reservoir_level"],
-    "phi": ["parameters.phi"],
-    "mu0": ["parameters.mu0"],
-    "mu_thr": ["parameters.mu_thr"],
-    "dx": ["numerics.dx"],
-    "output_interval": ["output.monitor_interval"],
-    "tension_cutoff": ["parameters.tension_cutoff"],
-    "pressure_smoothing": ["numerics.pressure_smoothing"],
-    "av_wall": ["numerics.av_wall"],
+    **{name: f"parameters.{name}" for name in PHYSICAL},
+    "dx": "numerics.dx",
+    "output_interval": "output.monitor_interval",
+    "pressure_smoothing": "numerics.pressure_smoothing",
+    "av_wall": "numerics.av_wall",
 }
 
 ENV = {"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}
@@ -140,15 +140,15 @@ def outputs(fmu):
     return tuple(r) + tuple(i)
 
 
-def run_mixsph(overrides, out_dir, t_end=None):
-    """Run the mixsph executable on the Vajont case; returns summary.json as a dict."""
+def run_mixsph(overrides, out_dir, t_end=None, case=CASE):
+    """Run the mixsph executable on a case (the Vajont one by default) with the FMU parameters
+    `overrides` given as the case keys they map onto (CASE_KEYS); returns summary.json."""
     import json
     if not MIXSPH.is_file():
         pytest.fail(f"{MIXSPH} not found (./tools/do build)")
-    cmd = [str(MIXSPH), "run", str(CASE), "--threads", "1", "--quiet", "--out", str(out_dir)]
+    cmd = [str(MIXSPH), "run", str(case), "--threads", "1", "--quiet", "--out", str(out_dir)]
     for name, value in overrides.items():
-        for key in CASE_KEYS[name]:
-            cmd += ["--set", f"{key}={int(value) if isinstance(value, bool) else value!r}"]
+        cmd += ["--set", f"{CASE_KEYS[name]}={int(value) if isinstance(value, bool) else value!r}"]
     if t_end is not None:
         cmd += ["--set", f"numerics.t_end={t_end!r}"]
     subprocess.run(cmd, check=True, env={**os.environ, **ENV}, stdout=subprocess.DEVNULL)

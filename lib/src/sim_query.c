@@ -1,0 +1,102 @@
+/* sim_query.c - read-only questions a host asks about a simulation or a case file before or
+ * while it drives it (the FMU: which walls move and which way, which parameters a case lets a
+ * host set). Nothing here changes a simulation. See the last section of mixsph.h. */
+#include <cjson/cJSON.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "sim.h"
+#include "status.h"
+
+size_t mixsph_sim_wall_count(const mixsph_sim *s)
+{
+    return s ? s->cfg.n_walls : 0;
+}
+
+const char *mixsph_sim_wall_name(const mixsph_sim *s, size_t k)
+{
+    return s && k < s->cfg.n_walls ? s->cfg.walls[k].name : NULL;
+}
+
+int mixsph_sim_wall_moves(const mixsph_sim *s, size_t k)
+{
+    return s && k < s->cfg.n_walls && s->cfg.walls[k].motion >= 0;
+}
+
+mixsph_status mixsph_sim_wall_travel_direction(const mixsph_sim *s, size_t k, double *ux, double *uz)
+{
+    if (!s || !ux || !uz) return MIXSPH_ERR_ARG;
+    *ux = *uz = 0.0;
+    if (k >= s->cfg.n_walls || s->cfg.walls[k].motion < 0) return MIXSPH_ERR_ARG;
+    /* The law's own rows, before its speed and time scales: the scales stretch a law, they do not
+     * turn it, and a speed scale of 0 would otherwise leave no direction at all. The first row
+     * of largest speed wins, so a law that reverses travels the way it goes fastest. */
+    const struct motion *law = &s->cfg.motions[s->cfg.walls[k].motion];
+    double fastest = 0.0;
+    for (size_t row = 0; row < law->n; row++) {
+        const double speed = hypot(law->vx[row], law->vz[row]);
+        if (speed > fastest) {
+            fastest = speed;
+            *ux = law->vx[row] / speed;
+            *uz = law->vz[row] / speed;
+        }
+    }
+    return fastest > 0.0 ? MIXSPH_OK : MIXSPH_ERR_ARG;
+}
+
+/* The `parameters` object of the case file at path (parsed into *root, which the caller
+ * deletes), or NULL when the case has none. */
+static mixsph_status read_parameters_block(const char *path, cJSON **root, const cJSON **params, char *err,
+                                           size_t err_len)
+{
+    *root = NULL;
+    *params = NULL;
+    if (!path) return status_set(err, err_len, MIXSPH_ERR_ARG, "no case file given");
+    char *text = NULL;
+    const mixsph_status st = case_read_file(path, &text, err, err_len);
+    if (st != MIXSPH_OK) return st;
+    *root = cJSON_Parse(text);
+    free(text);
+    if (!*root) return status_set(err, err_len, MIXSPH_ERR_CASE, "%s: not valid JSON", path);
+    const cJSON *p = cJSON_GetObjectItemCaseSensitive(*root, "parameters");
+    *params = cJSON_IsObject(p) ? p : NULL;
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_case_declares_parameter(const char *case_path, const char *name, int *declared, char *err,
+                                             size_t err_len)
+{
+    if (!name || !declared) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_case_declares_parameter: NULL argument");
+    *declared = 0;
+    cJSON *root;
+    const cJSON *params;
+    const mixsph_status st = read_parameters_block(case_path, &root, &params, err, err_len);
+    if (st != MIXSPH_OK) return st;
+    *declared = cJSON_IsNumber(cJSON_GetObjectItemCaseSensitive(params, name));
+    cJSON_Delete(root);
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_case_parameter_names(const char *case_path, char *names, size_t names_len, size_t *n,
+                                          char *err, size_t err_len)
+{
+    if (!names || names_len == 0 || !n)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_case_parameter_names: NULL argument");
+    names[0] = '\0';
+    *n = 0;
+    cJSON *root;
+    const cJSON *params;
+    const mixsph_status st = read_parameters_block(case_path, &root, &params, err, err_len);
+    if (st != MIXSPH_OK) return st;
+    size_t used = 0;
+    for (const cJSON *p = params ? params->child : NULL; p; p = p->next) {
+        if (!cJSON_IsNumber(p) || !p->string) continue;
+        const int w = snprintf(names + used, names_len - used, "%s%s", *n ? ", " : "", p->string);
+        (*n)++;
+        used = w < 0 || used + (size_t)w >= names_len ? names_len - 1 : used + (size_t)w;
+    }
+    cJSON_Delete(root);
+    return MIXSPH_OK;
+}
