@@ -685,6 +685,31 @@ static void test_table_rows(void **state)
     assert_true(n > 60);
 }
 
+/* The parameters block: "$name" values take the parameter's value, an override of
+ * parameters.NAME moves them, and names the block does not declare are refused (an override of
+ * one would reach nothing; a "$name" without a parameter has no value). */
+static void test_parameters(void **state)
+{
+    (void)state;
+    char *j = edit("\"gravity\": 9.81", "\"parameters\": { \"g\": 9.5 }, \"gravity\": \"$g\"");
+    struct case_def c;
+    char err[512] = "";
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.g == 9.5);
+    case_free(&c);
+    const mixsph_override moved[] = {{"parameters.g", 3.0}};
+    assert_int_equal(case_parse(j, ORIGIN, moved, 1, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.g == 3.0);
+    case_free(&c);
+    const mixsph_override undeclared[] = {{"parameters.phi", 30.0}};
+    assert_true(error_matches(j, undeclared, 1, MIXSPH_ERR_CASE, ORIGIN ": override parameters.phi: ",
+                              "declares no parameter 'phi'", (const char *)NULL));
+    free(j);
+    j = edit("\"gravity\": 9.81", "\"parameters\": { \"g\": 9.5 }, \"gravity\": \"$h\"");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "gravity", "'$h'", (const char *)NULL));
+    free(j);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -708,6 +733,7 @@ int main(void)
         cmocka_unit_test(test_table_defaults),
         cmocka_unit_test(test_d50_refused),
         cmocka_unit_test(test_table_rows),
+        cmocka_unit_test(test_parameters),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -209,9 +209,9 @@ mixsph_status mixsph_sim_wall_travel_direction(const mixsph_sim *s, size_t k, do
 
 /** Whether the case file `case_path` declares `name` in its `parameters` block, i.e. lets a host
  *  set it by the override "parameters.NAME" (*declared = 1) or not (0; also when the case has no
- *  such block). An override of an undeclared parameter is not an error of mixsph_sim_create when
- *  the case has a parameters block (the key is added and nothing uses it), so a host that maps
- *  its own parameters onto a case's asks first. MIXSPH_ERR_IO or MIXSPH_ERR_CASE, with a message
+ *  such block). An override of an undeclared parameter is refused by mixsph_sim_create
+ *  (MIXSPH_ERR_CASE); a host that maps its own parameters onto a case's asks first, to give its
+ *  own message. MIXSPH_ERR_IO or MIXSPH_ERR_CASE, with a message
  *  in err, when the file cannot be read or is not JSON. */
 mixsph_status mixsph_case_declares_parameter(const char *case_path, const char *name, int *declared, char *err,
                                              size_t err_len);

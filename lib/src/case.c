@@ -82,6 +82,10 @@ static mixsph_status apply_override(const struct case_reader *r, cJSON *root, co
     for (char *save = NULL, *tok = strtok_r(path, ".", &save); tok; tok = strtok_r(NULL, ".", &save)) {
         char *rest = save && *save ? save : NULL;
         if (!rest && cJSON_IsObject(node) && !cJSON_GetObjectItemCaseSensitive(node, tok)) {
+            /* a parameter the case does not declare would reach nothing (no "$name" uses it) */
+            if (node == cJSON_GetObjectItemCaseSensitive(root, "parameters"))
+                return FAIL(r, "%s: override %s: the case declares no parameter '%s' in its parameters block, so the "
+                               "value would change nothing", r->origin, ov->key, tok);
             /* a key with a default, absent from the file: add it (validation rejects unknown keys) */
             if (!cJSON_AddNumberToObject(node, tok, ov->value))
                 return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
