@@ -1,0 +1,207 @@
+/* test_implicit_viscous.c - the implicit viscous step (viscous.c, numerics.viscosity =
+ * "implicit"; docs/numerics.md) at time steps many times the explicit viscous limit.
+ *
+ * 1. Lid-driven closed channel (the flow of test_viscous.c, shorter): oil between a fixed floor
+ *    and a lid sliding at U, closed ends, length L = 0.2 m, height H = 0.05 m. The developed flow
+ *    far from the ends is Couette flow plus the pressure-driven (Poiseuille) back flow of zero
+ *    net flux, u(z) = U eta (3 eta - 2), eta = z / H (e.g. White, Viscous Fluid Flow, section
+ *    3-2). The viscosity is chosen so that the acoustic time step the implicit run takes is 20
+ *    and 50 times the explicit viscous limit cfl_visc 2 h^2 rho / mu. The back flow is driven by a
+ *    pressure gradient that builds by compression: in this weakly compressible fluid it spreads
+ *    along the channel diffusively, with D = c^2 H^2 rho / (12 mu) (lubrication flow), so the run
+ *    lasts about 6 L^2 / (pi^2 D) (0.4 s at mu = 330 Pa s, 1.2 s at 820 Pa s) before it is
+ *    measured. The lid speed is small (1 mm/s) so that the pressure differences stay below 1 % of
+ *    rho c^2. Norm: the largest over the z-bins of dx of |mean u_sph - mean u_exact| / U, over
+ *    the particles with 0.08 < x < 0.12 m at the end.
+ * 2. Momentum: in a closed box with a no-slip floor and walls, the viscous solve changes the
+ *    total momentum of the mobile particles only by the force of the prescribed particles (walls):
+ *    sum_i m_i du_i = -dt sum_{i mobile} sum_{j} w_ij (u_i - u_j) (the pairs among mobile
+ *    particles cancel), to the solver's tolerance. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <cmocka.h>
+
+#include "sim_passes.h"
+
+#define DX 0.0025 /* [m] */
+#define H 0.05    /* [m] */
+#define U_LID 0.001 /* [m/s] */
+#define NBIN 20   /* H / DX */
+
+static const char *const CHANNEL =
+    "{ \"name\": \"lid_channel_implicit\", \"gravity\": 0.0,\n"
+    "  \"numerics\": { \"dx\": 0.0025, \"t_end\": 2.0, \"background_pressure\": 200.0, \"viscosity\": \"implicit\" },\n"
+    "  \"media\": { \"oil\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 10.0, \"mu\": %g, \"alpha_m\": 0.0 } },\n"
+    "  \"bodies\": { \"oil\": { \"medium\": \"oil\", \"polygon\": [[0.0, 0.0], [0.2, 0.0], [0.2, 0.05], [0.0, 0.05]] } },\n"
+    "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.05], [0.0, 0.0], [0.2, 0.0], [0.2, 0.05]], \"fluid_side\": \"left\" },\n"
+    "    \"lid\": { \"polyline\": [[-0.1, 0.05], [0.3, 0.05]], \"fluid_side\": \"right\", \"motion\": \"slide\" } },\n"
+    "  \"motions\": { \"slide\": { \"t\": [0.0], \"vx\": [0.001], \"vz\": [0.0] } },\n"
+    "  \"domain\": { \"x_min\": -0.15, \"x_max\": 0.4, \"z_min\": -0.02, \"z_max\": 0.08 } }\n";
+
+static mixsph_sim *create(const char *fmt, double mu)
+{
+    char text[4096];
+    snprintf(text, sizeof text, fmt, mu);
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = mixsph_sim_create_from_text(text, "implicit_test.json", NULL, 0, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* ctest -j runs tests side by side */
+    return s;
+}
+
+/* Run the channel at viscosity mu to t_end; the largest bin error / U, and the ratio of the time
+ * step taken to the explicit viscous limit. */
+static double channel_error(double mu, double t_end, double *dt_ratio)
+{
+    mixsph_sim *s = create(CHANNEL, mu);
+    uint64_t iterations = 0;
+    int most = 0;
+    while (mixsph_sim_time(s) < t_end) {
+        const mixsph_status st = mixsph_sim_step(s);
+        if (st != MIXSPH_OK) print_error("%s\n", mixsph_sim_last_error(s));
+        assert_int_equal(st, MIXSPH_OK);
+        iterations += (uint64_t)s->viscous_last.iterations;
+        if (s->viscous_last.iterations > most) most = s->viscous_last.iterations;
+    }
+    const double dt_visc = s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / mu;
+    *dt_ratio = s->dt / dt_visc;
+    double su[NBIN] = {0}, sa[NBIN] = {0};
+    long cnt[NBIN] = {0};
+    const struct particles *P = &s->P;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] == MIXSPH_STATE_WALL) continue;
+        assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
+        if (P->x[i] < 0.08 || P->x[i] > 0.12) continue;
+        const int b = (int)floor(P->z[i] / DX);
+        assert_true(b >= 0 && b < NBIN);
+        const double eta = P->z[i] / H;
+        su[b] += P->vx[i];
+        sa[b] += U_LID * eta * (3.0 * eta - 2.0);
+        cnt[b]++;
+    }
+    double worst = 0.0;
+    for (int b = 0; b < NBIN; b++) {
+        assert_true(cnt[b] > 0);
+        worst = fmax(worst, fabs(su[b] - sa[b]) / cnt[b] / U_LID);
+    }
+    print_message("mu = %g Pa s: %llu steps to t = %.3f s, dt = %.3g s = %.1f x the explicit viscous limit, "
+                  "%.1f CG iterations per step (at most %d); largest |u - u_exact| = %.2f%% of U\n",
+                  mu, (unsigned long long)mixsph_sim_steps(s), mixsph_sim_time(s), s->dt, *dt_ratio,
+                  (double)iterations / (double)mixsph_sim_steps(s), most, 100.0 * worst);
+    mixsph_sim_destroy(s);
+    return worst;
+}
+
+static void test_channel_20x(void **state)
+{
+    (void)state;
+    double ratio;
+    const double e = channel_error(330.0, 0.4, &ratio);
+    assert_true(ratio >= 20.0); /* the time step the test is about */
+    /* reference: u = U eta (3 eta - 2) (header); tolerance 2 % of U */
+    assert_true(e <= 0.02);
+}
+
+static void test_channel_50x(void **state)
+{
+    (void)state;
+    double ratio;
+    const double e = channel_error(820.0, 1.2, &ratio);
+    assert_true(ratio >= 50.0);
+    /* reference: u = U eta (3 eta - 2) (header); tolerance 2 % of U */
+    assert_true(e <= 0.02);
+}
+
+/* A box of oil at rest under gravity with a shear velocity field imposed (white box), one step. */
+static const char *const BOX =
+    "{ \"name\": \"box_implicit\", \"gravity\": 9.81,\n"
+    "  \"numerics\": { \"dx\": 0.005, \"t_end\": 1.0, \"viscosity\": \"implicit\", \"viscous_tolerance\": 1e-10 },\n"
+    "  \"media\": { \"oil\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 20.0, \"mu\": %g, \"alpha_m\": 0.0 } },\n"
+    "  \"bodies\": { \"oil\": { \"medium\": \"oil\", \"polygon\": [[0.0, 0.0], [0.1, 0.0], [0.1, 0.05], [0.0, 0.05]] } },\n"
+    "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.1], [0.0, 0.0], [0.1, 0.0], [0.1, 0.1]], \"fluid_side\": \"left\" } },\n"
+    "  \"domain\": { \"x_min\": -0.05, \"x_max\": 0.15, \"z_min\": -0.05, \"z_max\": 0.15 } }\n";
+
+static void test_momentum_only_changed_by_walls(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create(BOX, 50.0);
+    struct particles *P = &s->P;
+    const size_t n = s->C.start[s->C.ncell];
+    for (size_t i = 0; i < n; i++) /* a shear field that the walls resist */
+        if (P->state[i] == MIXSPH_STATE_MOBILE) {
+            P->vx[i] = P->uvx[i] = 0.1 * sin(40.0 * P->z[i]);
+            P->vz[i] = P->uvz[i] = 0.05 * cos(30.0 * P->x[i]);
+        }
+    /* the operator at these positions (the momentum pass stores the couplings) */
+    assert_true(sim_density_pass(s) >= 0);
+    integrate_pressure_and_derived(s);
+    assert_int_equal(sim_momentum_pass(s), 0);
+    double *ux0 = calloc(n, sizeof(double)), *uz0 = calloc(n, sizeof(double));
+    assert_non_null(ux0);
+    assert_non_null(uz0);
+    for (size_t i = 0; i < n; i++) {
+        ux0[i] = P->vx[i];
+        uz0[i] = P->vz[i];
+    }
+    const struct pair_system S = sim_pair_system(s);
+    struct viscous_solver *V = viscous_create();
+    struct viscous_report rep;
+    const double dt = 10.0 * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0; /* 10 x the explicit limit */
+    assert_int_equal(viscous_solve(V, s->forces, &S, dt, 1e-10, 1000, &rep), 0);
+    assert_true(rep.converged);
+    /* momentum change of the mobile particles, and the force of the walls from the new field */
+    double *ux = calloc(n, sizeof(double)), *uz = calloc(n, sizeof(double));
+    double *lx = calloc(n, sizeof(double)), *lz = calloc(n, sizeof(double));
+    assert_true(ux && uz && lx && lz);
+    double dpx = 0.0, dpz = 0.0, scale = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        const int wall = P->state[i] == MIXSPH_STATE_WALL;
+        ux[i] = wall ? P->uvx[i] : P->vx[i];
+        uz[i] = wall ? P->uvz[i] : P->vz[i];
+        if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
+        dpx += P->m[i] * (P->vx[i] - ux0[i]);
+        dpz += P->m[i] * (P->vz[i] - uz0[i]);
+        scale += P->m[i] * hypot(ux0[i], uz0[i]);
+    }
+    assert_int_equal(forces_viscous_apply(s->forces, &S, ux, uz, lx, lz), 0);
+    double fx = 0.0, fz = 0.0;
+    for (size_t i = 0; i < n; i++)
+        if (P->state[i] == MIXSPH_STATE_MOBILE) {
+            fx -= dt * lx[i];
+            fz -= dt * lz[i];
+        }
+    print_message("momentum change (%.6e, %.6e), wall impulse (%.6e, %.6e), sum |m u| %.3e, %d iterations, "
+                  "residual %.2e\n", dpx, dpz, fx, fz, scale, rep.iterations, rep.residual);
+    /* reference: the pairs among mobile particles cancel exactly (w_ij = w_ji), so the change is
+     * the walls' impulse; tolerance: the solver's (1e-10 relative) on the momentum scale sum m|u|,
+     * times 100 for the round-off of the sums */
+    assert_true(fabs(dpx - fx) <= 1e-8 * scale);
+    assert_true(fabs(dpz - fz) <= 1e-8 * scale);
+    assert_true(fabs(fx) > 1e-3 * scale); /* the walls do act: the check is not 0 = 0 */
+    free(ux0);
+    free(uz0);
+    free(ux);
+    free(uz);
+    free(lx);
+    free(lz);
+    viscous_free(V);
+    mixsph_sim_destroy(s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_momentum_only_changed_by_walls),
+        cmocka_unit_test(test_channel_20x),
+        cmocka_unit_test(test_channel_50x),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
