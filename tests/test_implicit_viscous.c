@@ -171,7 +171,7 @@ static void test_momentum_only_changed_by_walls(void **state)
         dpz += P->m[i] * (P->vz[i] - uz0[i]);
         scale += P->m[i] * hypot(ux0[i], uz0[i]);
     }
-    assert_int_equal(forces_viscous_apply(s->forces, &S, ux, uz, lx, lz), 0);
+    assert_int_equal(forces_viscous_apply(s->forces, &S, ux, uz, lx, lz, NULL), 0);
     double fx = 0.0, fz = 0.0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_MOBILE) {

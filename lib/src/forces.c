@@ -99,6 +99,7 @@ struct pair_ctx {
     double *visc_w;       /* the viscous couplings of the lanes (implicit viscosity), or NULL */
     const double *in_x, *in_z; /* the velocity field a viscous operator is applied to */
     double *out_x, *out_z;     /* and its result */
+    double *out_diag;          /* and its diagonal, or NULL */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -116,7 +117,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->count = X->sum = X->weight = NULL;
     X->visc_w = NULL;
     X->in_x = X->in_z = NULL;
-    X->out_x = X->out_z = NULL;
+    X->out_x = X->out_z = X->out_diag = NULL;
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -379,45 +380,44 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
 }
 
 /* The viscous operator's pair sums over i's two ranges: for each component,
- * out_i += sum_j w_ij (in_i - in_j) and out_j -= w_ij (in_i - in_j) (diagonal: with in = NULL,
- * out_i += sum_j w_ij and out_j += w_ij). */
+ * out_i += sum_j w_ij (in_i - in_j) and out_j -= w_ij (in_i - in_j); with `diagonal` also
+ * diag_i += sum_j w_ij and diag_j += w_ij. */
 FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint32_t *restrict rng,
                                  const double *restrict wl, const int diagonal)
 {
     const double *restrict ux = X->in_x, *restrict uz = X->in_z;
-    double *restrict ox = X->out_x, *restrict oz = X->out_z;
-    const double uxi = diagonal ? 0.0 : ux[i], uzi = diagonal ? 0.0 : uz[i];
-    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0};
+    double *restrict ox = X->out_x, *restrict oz = X->out_z, *restrict od = X->out_diag;
+    const double uxi = ux[i], uzi = uz[i];
+    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}, sd[FORCES_CHUNK] = {0};
     for (int r = 0; r < 2; r++)
     for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
         const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
         double jx[FORCES_CHUNK], jz[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
             const double w = wl[k];
-            if (diagonal) {
-                sx[k] += w;
-                jx[k] = w;
-            } else {
-                const size_t j = jb + k;
-                const double dx = w * (uxi - ux[j]), dz = w * (uzi - uz[j]);
-                sx[k] += dx;
-                sz[k] += dz;
-                jx[k] = -dx;
-                jz[k] = -dz;
-            }
+            const double dx = w * (uxi - ux[j]), dz = w * (uzi - uz[j]);
+            sx[k] += dx;
+            sz[k] += dz;
+            jx[k] = -dx;
+            jz[k] = -dz;
+            if (diagonal) sd[k] += w;
         }
         chunk_add(ox, jb, m, jx);
-        if (!diagonal) chunk_add(oz, jb, m, jz);
+        chunk_add(oz, jb, m, jz);
+        if (diagonal) chunk_add(od, jb, m, wl);
         wl += FORCES_CHUNK;
     }
-    double tx = 0.0, tz = 0.0;
+    double tx = 0.0, tz = 0.0, td = 0.0;
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         tx += sx[k];
         tz += sz[k];
+        td += sd[k];
     }
     ox[i] += tx;
-    if (!diagonal) oz[i] += tz;
+    oz[i] += tz;
+    if (diagonal) od[i] += td;
 }
 
 FORCES_CLONES
@@ -425,7 +425,7 @@ static void viscous_band(const struct pair_ctx *X, const struct neighbours *NB, 
                          size_t b0, size_t b1)
 {
     (void)P;
-    const int diagonal = X->in_x == NULL;
+    const int diagonal = X->out_diag != NULL;
     for (size_t i = b0; i < b1; i++) {
         if (diagonal) viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 1);
         else viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 0);
@@ -652,20 +652,22 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
 }
 
 int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
-                         double *out_x, double *out_z)
+                         double *out_x, double *out_z, double *diag)
 {
     if (!F->visc_valid) return -1;
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     const size_t n = active_count(S);
     memset(out_x, 0, n * sizeof(double));
-    if (out_z) memset(out_z, 0, n * sizeof(double));
+    memset(out_z, 0, n * sizeof(double));
+    if (diag) memset(diag, 0, n * sizeof(double));
     X.visc_w = F->visc_w;
     X.fk_off = F->fk_off;
     X.in_x = in_x;
     X.in_z = in_z;
     X.out_x = out_x;
     X.out_z = out_z;
+    X.out_diag = diag;
     for_bands(S, viscous_band, &X);
     return 0;
 }

@@ -67,11 +67,11 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
 int forces_momentum(struct forces *F, const struct pair_system *S);
 
 /** The viscous operator of the last implicit momentum pass, out_i = sum_j w_ij (in_i - in_j)
- *  for both components, so that the viscous acceleration of a velocity field u is
- *  -out_i / m_i. With in_x = NULL its diagonal instead: out_x_i = sum_j w_ij (out_z unused).
- *  Arrays of the active particles. Returns -1 without a stored operator. */
+ *  for both components, so that the viscous acceleration of a velocity field u is -out_i / m_i;
+ *  with diag != NULL also its diagonal diag_i = sum_j w_ij. Arrays of the active particles.
+ *  Returns -1 without a stored operator. */
 int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
-                         double *out_x, double *out_z);
+                         double *out_x, double *out_z, double *diag);
 
 /** SPHERA's partial pressure smoothing with factor theta_P dt / h (docs/model.md section 3):
  *  pressures and densities of the non-wall particles relax toward their neighbours'. Returns -1

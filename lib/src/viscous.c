@@ -63,58 +63,61 @@ static int reserve(struct viscous_solver *V, size_t n)
     return 0;
 }
 
-/* s[0..3] = (a0.b0, a1.b1, a2.b2, a3.b3) over [0, n), in fixed blocks (a2, b2, a3, b3 may be
- * NULL: their sums are 0). */
-static void dots4(struct viscous_solver *V, size_t n, const double *a0, const double *b0, const double *a1,
-                  const double *b1, const double *a2, const double *b2, const double *a3, const double *b3,
-                  int n_threads, double s[4])
+/* Sum the per-block partial sums (4 per block) in block order. */
+static void block_sums(const struct viscous_solver *V, long nb, double s[4])
 {
-    const long nb = (long)((n + VISCOUS_BLOCK - 1) / VISCOUS_BLOCK);
-    double *part = V->partial;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (long bk = 0; bk < nb; bk++) {
-        const size_t i0 = (size_t)bk * VISCOUS_BLOCK, i1 = i0 + VISCOUS_BLOCK < n ? i0 + VISCOUS_BLOCK : n;
-        double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
-        for (size_t i = i0; i < i1; i++) {
-            t0 += a0[i] * b0[i];
-            t1 += a1[i] * b1[i];
-            if (a2) t2 += a2[i] * b2[i];
-            if (a3) t3 += a3[i] * b3[i];
-        }
-        part[4 * bk] = t0;
-        part[4 * bk + 1] = t1;
-        part[4 * bk + 2] = t2;
-        part[4 * bk + 3] = t3;
-    }
     s[0] = s[1] = s[2] = s[3] = 0.0;
     for (long bk = 0; bk < nb; bk++)
-        for (int k = 0; k < 4; k++) s[k] += part[4 * bk + k];
+        for (int k = 0; k < 4; k++) s[k] += V->partial[4 * bk + k];
 }
 
-/* q = A v on the mobile rows (0 on the prescribed ones); v is zero on the prescribed rows. */
+#define BLOCKS(n) ((long)(((n) + VISCOUS_BLOCK - 1) / VISCOUS_BLOCK))
+#define BLOCK_RANGE(bk, n, i0, i1)                                   \
+    const size_t i0 = (size_t)(bk) * VISCOUS_BLOCK;                  \
+    const size_t i1 = i0 + VISCOUS_BLOCK < (n) ? i0 + VISCOUS_BLOCK : (n)
+
+/* q = A p on the mobile rows (0 on the prescribed ones; p is zero there), and d = (p.q_x, p.q_z). */
 static int apply_a(struct viscous_solver *V, const struct forces *F, const struct pair_system *S, double dt,
-                   size_t n, const double *vx, const double *vz, double *qx, double *qz)
+                   size_t n, double d[2])
 {
-    if (forces_viscous_apply(F, S, vx, vz, qx, qz) != 0) return -1;
-    const double *mass = V->v[MASS];
+    double **v = V->v;
+    if (forces_viscous_apply(F, S, v[PX], v[PZ], v[QX], v[QZ], NULL) != 0) return -1;
     const unsigned char *mob = V->mobile;
+    const long nb = BLOCKS(n);
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        const double keep = mob[i] ? 1.0 : 0.0;
-        qx[i] = keep * (mass[i] * vx[i] + dt * qx[i]);
-        qz[i] = keep * (mass[i] * vz[i] + dt * qz[i]);
+    for (long bk = 0; bk < nb; bk++) {
+        BLOCK_RANGE(bk, n, i0, i1);
+        double tx = 0.0, tz = 0.0;
+        for (size_t i = i0; i < i1; i++) {
+            const double keep = mob[i] ? 1.0 : 0.0;
+            v[QX][i] = keep * (v[MASS][i] * v[PX][i] + dt * v[QX][i]);
+            v[QZ][i] = keep * (v[MASS][i] * v[PZ][i] + dt * v[QZ][i]);
+            tx += v[PX][i] * v[QX][i];
+            tz += v[PZ][i] * v[QZ][i];
+        }
+        double *part = V->partial + 4 * bk;
+        part[0] = tx;
+        part[1] = tz;
+        part[2] = part[3] = 0.0;
     }
+    double t[4];
+    block_sums(V, nb, t);
+    d[0] = t[0];
+    d[1] = t[1];
     return 0;
 }
 
-/* The right-hand side b, the preconditioner, the first guess (u* plus the last increment) and
- * its residual. Returns -1 when the operator is missing. */
-static int setup(struct viscous_solver *V, const struct forces *F, const struct pair_system *S, double dt, size_t n)
+/* The right-hand side b = m u* - dt L u_B, the preconditioner 1 / (m + dt diag L), the first
+ * guess u0 = u* plus the last increment, its residual r0 = b - A u0 = m (u* - u0) - dt L u_full
+ * (u_full: u0 on the mobile rows, the prescribed values elsewhere), z0 = M^-1 r0 and p0 = z0.
+ * d receives (|b|^2, |r0|^2, r0.z0 x, r0.z0 z). Two passes of the operator. */
+static int setup(struct viscous_solver *V, const struct forces *F, const struct pair_system *S, double dt, size_t n,
+                 double d[4])
 {
     const struct particles *P = S->P;
     double **v = V->v;
     unsigned char *mob = V->mobile;
-    /* the prescribed velocities, zero on the mobile rows, into U0 */
+    /* U0: the prescribed velocities, zero on the mobile rows; U: u_full */
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
         mob[i] = P->state[i] == MIXSPH_STATE_MOBILE;
@@ -122,34 +125,41 @@ static int setup(struct viscous_solver *V, const struct forces *F, const struct 
         v[MASS][i] = P->m[i];
         v[U0X][i] = mob[i] ? 0.0 : (wall ? P->uvx[i] : P->vx[i]);
         v[U0Z][i] = mob[i] ? 0.0 : (wall ? P->uvz[i] : P->vz[i]);
+        v[UX][i] = mob[i] ? P->vx[i] + P->visc_dvx[i] : v[U0X][i];
+        v[UZ][i] = mob[i] ? P->vz[i] + P->visc_dvz[i] : v[U0Z][i];
     }
-    if (forces_viscous_apply(F, S, v[U0X], v[U0Z], v[BX], v[BZ]) != 0) return -1;
-    if (forces_viscous_apply(F, S, NULL, NULL, v[MINV], NULL) != 0) return -1;
+    if (forces_viscous_apply(F, S, v[U0X], v[U0Z], v[BX], v[BZ], v[MINV]) != 0) return -1;
+    if (forces_viscous_apply(F, S, v[UX], v[UZ], v[RX], v[RZ], NULL) != 0) return -1;
+    const long nb = BLOCKS(n);
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (!mob[i]) {
-            v[BX][i] = v[BZ][i] = v[MINV][i] = 0.0;
-            v[UX][i] = v[UZ][i] = 0.0;
-            continue;
+    for (long bk = 0; bk < nb; bk++) {
+        BLOCK_RANGE(bk, n, i0, i1);
+        double t[4] = {0.0, 0.0, 0.0, 0.0};
+        for (size_t i = i0; i < i1; i++) {
+            if (!mob[i]) {
+                v[BX][i] = v[BZ][i] = v[MINV][i] = v[RX][i] = v[RZ][i] = 0.0;
+                v[ZX][i] = v[ZZ][i] = v[PX][i] = v[PZ][i] = 0.0;
+                v[UX][i] = v[UZ][i] = 0.0;
+                continue;
+            }
+            const double m = P->m[i];
+            v[BX][i] = m * P->vx[i] - dt * v[BX][i];
+            v[BZ][i] = m * P->vz[i] - dt * v[BZ][i];
+            v[MINV][i] = 1.0 / (m + dt * v[MINV][i]);
+            v[RX][i] = m * (P->vx[i] - v[UX][i]) - dt * v[RX][i];
+            v[RZ][i] = m * (P->vz[i] - v[UZ][i]) - dt * v[RZ][i];
+            v[U0X][i] = P->vx[i]; /* u*, kept for the increment */
+            v[U0Z][i] = P->vz[i];
+            v[ZX][i] = v[PX][i] = v[MINV][i] * v[RX][i];
+            v[ZZ][i] = v[PZ][i] = v[MINV][i] * v[RZ][i];
+            t[0] += v[BX][i] * v[BX][i] + v[BZ][i] * v[BZ][i];
+            t[1] += v[RX][i] * v[RX][i] + v[RZ][i] * v[RZ][i];
+            t[2] += v[RX][i] * v[ZX][i];
+            t[3] += v[RZ][i] * v[ZZ][i];
         }
-        v[BX][i] = P->m[i] * P->vx[i] - dt * v[BX][i];
-        v[BZ][i] = P->m[i] * P->vz[i] - dt * v[BZ][i];
-        v[MINV][i] = 1.0 / (P->m[i] + dt * v[MINV][i]);
-        v[U0X][i] = P->vx[i]; /* u*, kept for the increment */
-        v[U0Z][i] = P->vz[i];
-        v[UX][i] = P->vx[i] + P->visc_dvx[i];
-        v[UZ][i] = P->vz[i] + P->visc_dvz[i];
+        for (int k = 0; k < 4; k++) V->partial[4 * bk + k] = t[k];
     }
-    if (apply_a(V, F, S, dt, n, v[UX], v[UZ], v[RX], v[RZ]) != 0) return -1;
-#pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        v[RX][i] = v[BX][i] - v[RX][i];
-        v[RZ][i] = v[BZ][i] - v[RZ][i];
-        v[ZX][i] = v[MINV][i] * v[RX][i];
-        v[ZZ][i] = v[MINV][i] * v[RZ][i];
-        v[PX][i] = v[ZX][i];
-        v[PZ][i] = v[ZZ][i];
-    }
+    block_sums(V, nb, d);
     return 0;
 }
 
@@ -162,49 +172,55 @@ int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct
     report->residual = 0.0;
     report->converged = 1;
     if (reserve(V, n) != 0) return -1;
-    if (setup(V, F, S, dt, n) != 0) return -1;
-    double **v = V->v;
     double d[4];
-    dots4(V, n, v[BX], v[BX], v[BZ], v[BZ], v[RX], v[RX], v[RZ], v[RZ], S->n_threads, d);
-    const double b2 = d[0] + d[1];
-    double r2 = d[2] + d[3];
-    dots4(V, n, v[RX], v[ZX], v[RZ], v[ZZ], NULL, NULL, NULL, NULL, S->n_threads, d);
-    double rz_x = d[0], rz_z = d[1];
+    if (setup(V, F, S, dt, n, d) != 0) return -1;
+    double **v = V->v;
+    const double b2 = d[0];
+    double r2 = d[1], rz_x = d[2], rz_z = d[3];
     const double tol2 = tolerance * tolerance * b2;
     if (b2 == 0.0) { /* no force and nothing moving: the solution is at rest */
         for (size_t i = 0; i < n; i++) v[UX][i] = v[UZ][i] = 0.0;
         r2 = 0.0;
     }
+    const long nb = BLOCKS(n);
     int it = 0;
     while (r2 > tol2 && it < max_iterations) {
-        if (apply_a(V, F, S, dt, n, v[PX], v[PZ], v[QX], v[QZ]) != 0) return -1;
-        dots4(V, n, v[PX], v[QX], v[PZ], v[QZ], NULL, NULL, NULL, NULL, S->n_threads, d);
-        const double ax = d[0] > 0.0 ? rz_x / d[0] : 0.0, az = d[1] > 0.0 ? rz_z / d[1] : 0.0;
+        double pq[2];
+        if (apply_a(V, F, S, dt, n, pq) != 0) return -1;
+        const double ax = pq[0] > 0.0 ? rz_x / pq[0] : 0.0, az = pq[1] > 0.0 ? rz_z / pq[1] : 0.0;
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
-        for (size_t i = 0; i < n; i++) {
-            v[UX][i] += ax * v[PX][i];
-            v[UZ][i] += az * v[PZ][i];
-            v[RX][i] -= ax * v[QX][i];
-            v[RZ][i] -= az * v[QZ][i];
-            v[ZX][i] = v[MINV][i] * v[RX][i];
-            v[ZZ][i] = v[MINV][i] * v[RZ][i];
+        for (long bk = 0; bk < nb; bk++) {
+            BLOCK_RANGE(bk, n, i0, i1);
+            double t[4] = {0.0, 0.0, 0.0, 0.0};
+            for (size_t i = i0; i < i1; i++) {
+                v[UX][i] += ax * v[PX][i];
+                v[UZ][i] += az * v[PZ][i];
+                v[RX][i] -= ax * v[QX][i];
+                v[RZ][i] -= az * v[QZ][i];
+                v[ZX][i] = v[MINV][i] * v[RX][i];
+                v[ZZ][i] = v[MINV][i] * v[RZ][i];
+                t[0] += v[RX][i] * v[ZX][i];
+                t[1] += v[RZ][i] * v[ZZ][i];
+                t[2] += v[RX][i] * v[RX][i] + v[RZ][i] * v[RZ][i];
+            }
+            for (int k = 0; k < 4; k++) V->partial[4 * bk + k] = t[k];
         }
-        dots4(V, n, v[RX], v[ZX], v[RZ], v[ZZ], v[RX], v[RX], v[RZ], v[RZ], S->n_threads, d);
+        block_sums(V, nb, d);
         const double bx = rz_x > 0.0 ? d[0] / rz_x : 0.0, bz = rz_z > 0.0 ? d[1] / rz_z : 0.0;
         rz_x = d[0];
         rz_z = d[1];
-        r2 = d[2] + d[3];
+        r2 = d[2];
+        it++;
+        if (!(r2 > tol2)) break; /* converged: no next direction needed */
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
         for (size_t i = 0; i < n; i++) {
             v[PX][i] = v[ZX][i] + bx * v[PX][i];
             v[PZ][i] = v[ZZ][i] + bz * v[PZ][i];
         }
-        it++;
     }
     report->iterations = it;
     report->residual = b2 > 0.0 ? sqrt(r2 / b2) : sqrt(r2);
     report->converged = r2 <= tol2;
-    if (!(report->residual == report->residual)) report->converged = 0; /* NaN */
     const unsigned char *mob = V->mobile;
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
