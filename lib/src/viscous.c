@@ -20,6 +20,12 @@
  * the same sums for any thread count. */
 #define VISCOUS_BLOCK 2048
 
+/* The solver's vectors, per active particle (pairs: x and z components):
+ *   U   the iterate u (mobile rows; 0 on the prescribed ones)
+ *   U0  the prescribed field u_B during the set-up, then u* (for the increment)
+ *   R   the residual b - A u        Z  the preconditioned residual M^-1 r
+ *   P   the search direction        Q  A p
+ *   B   the right-hand side b       MINV  the inverse of the Jacobi diagonal   MASS  m */
 enum { UX, UZ, U0X, U0Z, RX, RZ, ZX, ZZ, PX, PZ, QX, QZ, BX, BZ, MINV, MASS, N_VEC };
 
 struct viscous_solver {
