@@ -139,11 +139,11 @@ static void check_derivative(int type, double w0_coef, double f0_coef, double en
         assert_true(fabs(F - dw / r) < 1e-6 * fabs(kernel_f(&K, 0.0)));
     }
     /* W(0) = a_d w0_coef with a_d the normalisation of kernel.h */
-    assert_true(fabs(kernel_w(&K, 0.0) - w0_coef / (KERNEL_PI * h * h)) < 1e-12 * kernel_w(&K, 0.0));
+    assert_true(fabs(kernel_w(&K, 0.0) - w0_coef / (GEOM_PI * h * h)) < 1e-12 * kernel_w(&K, 0.0));
     /* F(0) finite, so W'(r) = F r -> 0 at r = 0 */
     const double f0 = kernel_f(&K, 0.0);
     assert_true(isfinite(f0));
-    assert_true(fabs(f0 - f0_coef / (KERNEL_PI * h * h) / (h * h)) < 1e-12 * fabs(f0));
+    assert_true(fabs(f0 - f0_coef / (GEOM_PI * h * h) / (h * h)) < 1e-12 * fabs(f0));
     assert_true(fabs(kernel_f(&K, 1e-9 * h) - f0) < 1e-8 * fabs(f0));
     /* continuity at 2h: F(2h - e) -> 0 like e^end_order */
     const double fe = kernel_f(&K, 2.0 * h * (1.0 - 1e-4));

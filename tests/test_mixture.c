@@ -107,7 +107,7 @@ static void test_parse_dry(void **state)
     assert_int_equal(m->kind, MEDIUM_GRANULAR);
     assert_rel(m->rho0, (1.0 - POR) * RHO_S, 1e-15);   /* (5), dry: (1 - n) rho_s = 1722.5 */
     assert_rel(m->c, sqrt(K_S / RHO_S), 1e-15);         /* sqrt(K_s / rho_s) = 40 m/s, not of the mixture */
-    assert_rel(m->sin_phi, sin(PHI * KERNEL_PI / 180.0), 1e-15);
+    assert_rel(m->sin_phi, sin(PHI * GEOM_PI / 180.0), 1e-15);
     assert_true(m->eps_f_mu_f == 0.0);                  /* no pore fluid */
     assert_int_equal(m->saturated, 0);
     assert_true(m->mu_thr == MU_THR && m->mu0 == MU0);

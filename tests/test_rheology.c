@@ -16,6 +16,7 @@
 
 #include <cmocka.h>
 
+#include "geometry.h"
 #include "rheology.h"
 
 #define MU_THR 320.0e3 /* [Pa s] Vajont threshold viscosity (paper, Section 4) */
@@ -111,7 +112,7 @@ static void test_regime_mu1(void **state)
 static void test_apparent(void **state)
 {
     (void)state;
-    const double sin_phi = sin(35.0 * 3.14159265358979323846 / 180.0); /* 0.573576436351046 */
+    const double sin_phi = sin(35.0 * GEOM_PI / 180.0); /* 0.573576436351046 */
     const double sigma = 1000.0;                      /* [Pa] */
     const double epsmu = 0.35 * 1.0e-3;               /* eps_f mu_f [Pa s]: porosity 0.35, water */
     assert_true(rheology_apparent(sigma, sin_phi, 0.0, epsmu, MU_THR) == MU_THR);

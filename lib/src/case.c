@@ -14,8 +14,6 @@
 #include "case_schema.h"
 #include "status.h"
 
-#define KERNEL_PI_ 3.14159265358979323846
-
 #define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
 
 /* ---- files ------------------------------------------------------------------------------ */
@@ -199,7 +197,7 @@ static mixsph_status read_granular(const struct case_reader *r, const cJSON *it,
 {
     TRY(case_schema_read(r, it, path, section("media.granular"), 0, md));
     TRY(read_sound_speed(r, it, path, md->rho_grain, &md->c));
-    md->sin_phi = sin(md->phi_deg * KERNEL_PI_ / 180.0);
+    md->sin_phi = sin(md->phi_deg * GEOM_PI / 180.0);
     md->pore_fluid = -1;
     const cJSON *fluid = item(it, "pore_fluid");
     if (fluid) {

@@ -4,6 +4,8 @@
 #define MIXSPH_GEOMETRY_H
 #include <stddef.h>
 
+#define GEOM_PI 3.14159265358979323846 /* the one definition of pi in the library */
+
 struct polyline {
     size_t n;     /* vertices */
     double *x;    /* [m] */

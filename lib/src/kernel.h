@@ -20,7 +20,7 @@
 #define MIXSPH_KERNEL_H
 #include <math.h>
 
-#define KERNEL_PI 3.14159265358979323846
+#include "geometry.h"
 
 enum kernel_type { KERNEL_CUBIC_SPLINE = 0, KERNEL_WENDLAND_C2 = 1 };
 
@@ -41,10 +41,10 @@ static inline struct kernel kernel_make_type(double h, int type)
     k.inv_h = 1.0 / h;
     k.r2max = 4.0 * h * h;
     if (type == KERNEL_WENDLAND_C2) {
-        k.a_d = 7.0 / (4.0 * KERNEL_PI * h * h);
+        k.a_d = 7.0 / (4.0 * GEOM_PI * h * h);
         k.f_fac = -5.0 * k.a_d / (h * h);
     } else {
-        k.a_d = 10.0 / (7.0 * KERNEL_PI * h * h);
+        k.a_d = 10.0 / (7.0 * GEOM_PI * h * h);
         k.f_fac = k.a_d / (h * h);
     }
     return k;
