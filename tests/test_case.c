@@ -266,9 +266,15 @@ static void test_overrides(void **state)
     /* a misspelt leaf is added, then refused by the validation as an unknown key */
     const mixsph_override typo[] = {{"numerics.dxx", 0.01}};
     EXPECT_OVERRIDE_ERROR(typo, ORIGIN ": numerics.dxx: unknown key");
+    /* a string key takes a number only where it is a choice with numbers (numerics.viscosity) */
     const mixsph_override string[] = {{"walls.tank.fluid_side", 1.0}};
-    EXPECT_OVERRIDE_ERROR(string, ORIGIN ": override walls.tank.fluid_side: ",
-                    "not a number or a Boolean");
+    EXPECT_OVERRIDE_ERROR(string, ORIGIN ": walls.tank.fluid_side: expected a string");
+    const mixsph_override implicit[] = {{"numerics.viscosity", 1.0}};
+    assert_int_equal(case_parse(BASE, ORIGIN, implicit, 1, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(c.viscosity_implicit, 1);
+    case_free(&c);
+    const mixsph_override no_choice[] = {{"numerics.viscosity", 2.0}};
+    EXPECT_OVERRIDE_ERROR(no_choice, ORIGIN ": numerics.viscosity: 2 is not the number of a choice", "\"implicit\"");
     const mixsph_override object[] = {{"numerics", 1.0}};
     EXPECT_OVERRIDE_ERROR(object, ORIGIN ": override numerics: ", "not a number or a Boolean");
     /* an override is validated like the file: out of range */

@@ -76,8 +76,9 @@ static mixsph_status apply_override(const struct case_reader *r, cJSON *root, co
     if (!ov->key || strlen(ov->key) >= sizeof path) return FAIL(r, "%s: override key missing or too long", r->origin);
     if (!isfinite(ov->value)) return FAIL(r, "%s: override %s: value is not finite", r->origin, ov->key);
     strcpy(path, ov->key);
-    cJSON *node = root;
+    cJSON *node = root, *parent = NULL;
     for (char *save = NULL, *tok = strtok_r(path, ".", &save); tok; tok = strtok_r(NULL, ".", &save)) {
+        parent = node;
         char *rest = save && *save ? save : NULL;
         if (!rest && cJSON_IsObject(node) && !cJSON_GetObjectItemCaseSensitive(node, tok)) {
             /* a parameter the case does not declare would reach nothing (no "$name" uses it) */
@@ -106,6 +107,18 @@ static mixsph_status apply_override(const struct case_reader *r, cJSON *root, co
         if (ov->value != 0.0 && ov->value != 1.0)
             return FAIL(r, "%s: override %s: a Boolean key takes 0 or 1", r->origin, ov->key);
         node->type = ov->value != 0.0 ? cJSON_True : cJSON_False;
+    } else if (cJSON_IsString(node)) {
+        /* a choice that also takes its number (numerics.viscosity); validation refuses the rest */
+        cJSON *num = cJSON_CreateNumber(ov->value);
+        if (!num) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+        num->string = node->string; /* the key's name moves to the new item */
+        node->string = NULL;
+        if (!parent || !cJSON_ReplaceItemViaPointer(parent, node, num)) {
+            node->string = num->string;
+            num->string = NULL;
+            cJSON_Delete(num);
+            return FAIL(r, "%s: override %s: the key is not a number or a Boolean", r->origin, ov->key);
+        }
     } else {
         return FAIL(r, "%s: override %s: the key is not a number or a Boolean", r->origin, ov->key);
     }

@@ -98,7 +98,7 @@ static const struct case_key numerics_keys[] = {
      .meaning = "the Monaghan term also between particles of different media (below)"},
     {.key = "av_separating", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_separating),
      .meaning = "the Monaghan term also on separating pairs, not only approaching ones (below)"},
-    {.key = "viscosity", .type = CASE_CHOICE, DEF(0), .choices = viscous_schemes,
+    {.key = "viscosity", .type = CASE_CHOICE, DEF(0), .choices = viscous_schemes, .numeric_choice = 1,
      .field = CASE_FIELD(case_def, viscosity_implicit),
      .meaning = "the laminar viscous term: explicit (in the momentum pass, time step bounded by cfl_visc) or "
                 "implicit (backward Euler, solved by conjugate gradients; no viscous time-step bound)"},
@@ -344,6 +344,10 @@ void case_schema_range_text(const struct case_key *k, int unicode, char *buf, si
         for (const struct case_choice *c = k->choices; c->name && at < len; c++)
             at += (size_t)snprintf(buf + at, len - at, unicode ? "%s`\"%s\"`" : "%s\"%s\"",
                                    c == k->choices ? "" : c[1].name ? ", " : " or ", c->name);
+        if (k->numeric_choice)
+            for (const struct case_choice *c = k->choices; c->name && at < len; c++)
+                at += (size_t)snprintf(buf + at, len - at, "%s%d%s", c == k->choices ? " (or " : ", ", c->value,
+                                       c[1].name ? "" : ")");
         break;
     }
     case CASE_NUMBERS: snprintf(buf, len, "at least %s", lo); break;
@@ -509,6 +513,17 @@ mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj
     case CASE_STRING:
     case CASE_CHOICE:
     case CASE_NAME:
+        if (k->type == CASE_CHOICE && k->numeric_choice && cJSON_IsNumber(it)) {
+            for (const struct case_choice *c = k->choices; c->name; c++)
+                if (it->valuedouble == (double)c->value) {
+                    if (f) *(int *)f = c->value;
+                    return MIXSPH_OK;
+                }
+            char list[256];
+            case_schema_range_text(k, 0, list, sizeof list);
+            return FAIL(r, "%s: %s: %g is not the number of a choice (expected %s)", r->origin, kp, it->valuedouble,
+                        list);
+        }
         if (!cJSON_IsString(it)) return FAIL(r, "%s: %s: expected a string", r->origin, kp);
         if (k->type == CASE_CHOICE) {
             TRY(read_choice(r, it, kp, k, &iv));

@@ -54,6 +54,8 @@ struct case_key {
     size_t field;             /* CASE_FIELD(struct, member) of the field it fills, 0: none */
     const struct case_choice *choices; /* CASE_CHOICE: NULL-terminated */
     unsigned only;            /* sections with variants: the variants (bits) it belongs to, 0 = all */
+    int numeric_choice;       /* CASE_CHOICE: a number equal to a choice's value selects it too (so that a
+                                 numeric override such as --set numerics.viscosity=1 can) */
 };
 
 /* A key a case file may no longer use, and why. */
