@@ -11,7 +11,7 @@
  *     uses them as "$NAME" values, so any case file that declares them works, whatever its
  *     media, bodies and walls are called. One the host sets and the case does not declare is an
  *     fmi2Error naming it (the glue checks);
- *   - the numerical ones (dx, output_interval, pressure_smoothing, av_wall) override the
+ *   - the numerical ones (dx, output_interval, pressure_smoothing, av_wall, implicit_viscosity) override the
  *     numerics and output keys every case has; threads is the library's thread count.
  * A parameter the host never sets gets no override: it keeps the case file's value, so an
  * instance with no parameter set runs exactly what `mixsph run CASE` runs.
@@ -67,7 +67,7 @@ static const struct real_param real_params[N_REAL_PARAMS] = {
 };
 
 /* Boolean parameters: passed to the case as 0/1 overrides of `key` when the host sets them. */
-enum { B_SATURATED, B_TENSION_CUTOFF, B_AV_WALL, N_BOOL_PARAMS };
+enum { B_SATURATED, B_TENSION_CUTOFF, B_AV_WALL, B_IMPLICIT_VISCOSITY, N_BOOL_PARAMS };
 static const struct {
     fmi2ValueReference vr;
     const char *name, *key;
@@ -76,6 +76,8 @@ static const struct {
     [B_SATURATED] = {VR_saturated, "saturated", "parameters.saturated", START_saturated},
     [B_TENSION_CUTOFF] = {VR_tension_cutoff, "tension_cutoff", "parameters.tension_cutoff", START_tension_cutoff},
     [B_AV_WALL] = {VR_av_wall, "av_wall", "numerics.av_wall", START_av_wall},
+    [B_IMPLICIT_VISCOSITY] = {VR_implicit_viscosity, "implicit_viscosity", "numerics.viscosity", /* 0/1: its choices */
+                              START_implicit_viscosity},
 };
 
 /* Outputs read from the library by name. */

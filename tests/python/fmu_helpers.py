@@ -34,6 +34,7 @@ CASE_KEYS = {
     "output_interval": "output.monitor_interval",
     "pressure_smoothing": "numerics.pressure_smoothing",
     "av_wall": "numerics.av_wall",
+    "implicit_viscosity": "numerics.viscosity",
 }
 
 ENV = {"OMP_NUM_THREADS": "1", "OMP_WAIT_POLICY": "PASSIVE"}
