@@ -1,7 +1,8 @@
 /* viscous.c - see viscous.h.
  *
- * Unknowns: the mobile particles (state MOBILE) among the active ones; everything else in the
- * active range (wall particles, grains held fixed) is prescribed. With u = u_U + u_B,
+ * Unknowns: the mobile particles and the grains held fixed (they take forces and kicks as in the
+ * explicit scheme, they are only not drifted) among the active ones; wall particles and the
+ * fixed grains of a hold_fixed medium (no forces) are prescribed. With u = u_U + u_B,
  *     A u_U = b,   A v = m v + dt L v restricted to the mobile rows (v zero on the prescribed),
  *     b = m u* - dt L u_B,
  * where (L v)_i = sum_j w_ij (v_i - v_j) is forces_viscous_apply. A is symmetric (w_ij = w_ji)
@@ -126,7 +127,10 @@ static int setup(struct viscous_solver *V, const struct forces *F, const struct 
     /* U0: the prescribed velocities, zero on the mobile rows; U: u_full */
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
-        mob[i] = P->state[i] == MIXSPH_STATE_MOBILE;
+        /* grains held fixed take their forces like mobile ones (they are only not drifted), but
+         * those of a hold_fixed medium take none */
+        mob[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
+                 (P->state[i] == MIXSPH_STATE_FIXED && !S->media[P->medium[i]].hold_fixed);
         const int wall = P->state[i] == MIXSPH_STATE_WALL;
         v[MASS][i] = P->m[i];
         v[U0X][i] = mob[i] ? 0.0 : (wall ? P->uvx[i] : P->vx[i]);
