@@ -30,10 +30,11 @@
  *     same with mu0 = 20 kPa s (0.70 dx at 0.1 s) and still 0.34 dx with phi = 60 deg, so it is
  *     neither the creep of mu0 nor the friction angle: by t = 0.01 s only 56 of the 186 grains
  *     are in the limited regime (mu = mu0), 124 are frictional (mu_app < mu0) and by 0.05 s 76
- *     have mu < 100 Pa s (the start-up's acoustic velocity noise, with c = 40 m/s, gives strain
- *     rates at which sigma' sin(phi) / (2 sqrt(II_D)) < mu0). The heap is then held only by the
- *     frictional stress, which the Morris Laplacian with particle-wise viscosities (forces.c) is
- *     not the divergence of. The test asserts what holds today (all grains mobile after the
+ *     have mu < 100 Pa s (presumably the start-up's acoustic velocity noise, c = 40 m/s, gives
+ *     strain rates at which sigma' sin(phi) / (2 sqrt(II_D)) < mu0). The heap is then held only
+ *     by the frictional stress; the likely cause, not verified, is that the Morris Laplacian with
+ *     pairwise harmonic-mean viscosities (forces.c) is not the divergence of that stress where mu
+ *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts what holds today (all grains mobile after the
  *     first step, within 0.1 dx at t = 0.02 s, no grain through the floor) and the criterion over
  *     0.1 s is kept as a known failure: `test_granular known_failures` (CTest
  *     test_granular_known_failures, WILL_FAIL) fails while the heap moves, so CTest reports it
