@@ -34,9 +34,9 @@
  *     strain rates at which sigma' sin(phi) / (2 sqrt(II_D)) < mu0). The heap is then held only
  *     by the frictional stress; the likely cause, not verified, is that the Morris Laplacian with
  *     pairwise harmonic-mean viscosities (forces.c) is not the divergence of that stress where mu
- *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts what holds today (all grains mobile after the
- *     first step, within 0.1 dx at t = 0.02 s, no grain through the floor) and the criterion over
- *     0.1 s is kept as a known failure: `test_granular known_failure heap_mobile` (CTest
+ *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts
+ *     what holds today (all grains mobile after the first step, within 0.1 dx at t = 0.02 s, no
+ *     grain through the floor) and the criterion over 0.1 s is kept as a known failure: `test_granular known_failure heap_mobile` (CTest
  *     test_granular_known_heap_mobile, WILL_FAIL) fails while the heap moves, so CTest reports
  *     it the day the rheology holds the heap.
  * (b) A square column collapses with the Vajont rheology (mu_thr = 320 kPa s, mu0 = 5 kPa s):
@@ -253,13 +253,14 @@ static void test_heap_mobile_at_rest(void **state)
  * criterion is therefore 1.04 <= run-out <= 1.96.
  * THE MODEL DOES NOT MEET IT at the resolution of the test: 1.00 r0 at dx = 0.0125 (r0 / 16);
  * 1.16 r0 at dx = 0.01 (r0 / 20), so the run-out is not converged in dx and grows toward the
- * experiments with resolution. The criterion is kept as a known failure (test_column_runout,
- * run by `test_granular known_failure column_runout`, CTest test_granular_known_column_runout); test_column_collapse asserts what is defensible at this
- * resolution: the run-out lies between half the column width (it spreads) and the glass-bead
+ * experiments with resolution. The criterion is kept as a known failure (test_column_runout, run
+ * by `test_granular known_failure column_runout`, CTest test_granular_known_column_runout);
+ * test_column_collapse asserts what is defensible at this resolution: the run-out lies between half the column width (it spreads) and the glass-bead
  * edge of the band (1.96: no more mobile than the most mobile experiment), the deposit stops and
  * is no steeper than phi.
  * The deposit does not freeze: with mu0 = 5 kPa s the slowly shearing grains are a Newtonian
- * fluid of viscosity mu0 and keep creeping (docs/model.md section 6), so "stopped" is the KE criterion.
+ * fluid of viscosity mu0 and keep creeping (docs/model.md section 6), so "stopped" is the KE
+ * criterion.
  * Measured (2 threads on the shared 2-core machine):
  *   dx = 0.01   (400 grains): KE < 2% at t = 0.57 s (97,870 steps, 110 s wall, 92 s CPU), front
  *               0.427 m (moved 1.16 r0); creeping on: front 0.460 m at 1.0 s, 0.468 m at 1.2 s,
@@ -267,7 +268,7 @@ static void test_heap_mobile_at_rest(void **state)
  *   dx = 0.0125 (256 grains, used here): KE < 2% at t = 0.53 s (58,241 steps, 44 s wall, 39 s
  *               CPU), front 0.393 m (moved 1.0 r0), height 0.146 m, steepest slope 24.7 deg.
  * So the model gives a run-out of 1.0 r0 (dx = 0.0125) to 1.16 r0 (dx = 0.01) when it stops, 17%
- * and 3% short of the experiments' 1.2 r0, and creeps on to 1.34 r0 at 1.2 s (dx = 0.01). */
+ * and 3% short of the band's lower edge (1.2 r0, Lube et al.), and creeps on to 1.34 r0 at 1.2 s (dx = 0.01). */
 
 #define COL_DX 0.0125
 #define COL_W 0.2     /* column width r0 [m] */

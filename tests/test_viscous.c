@@ -18,8 +18,8 @@
  *   (c) the cubic spline at h = 1.3 dx (the smoothing length of the bundled cases) does not: its
  *       continuity density drifts in shear (measured: mean pressure 200 -> 240 Pa at t = 0.3 s,
  *       313 Pa at 0.6 s; dp/dx 291-319 Pa/m over 0.2-0.3 s, +21..+33%; velocity error 1.5% of U
- *       at t = 0.2 s, 2.5% at 0.3 s, 15% at 0.6 s, 2.01% on the means over 0.2-0.3 s; the same at dx = 0.002; with c = 5 m/s dp/dx is
- *       still +10..+18% and the velocity error 3-5% of U).
+ *       at t = 0.2 s, 2.5% at 0.3 s, 15% at 0.6 s, 2.01% on the means over 0.2-0.3 s; the same
+ *       at dx = 0.002; with c = 5 m/s dp/dx is still +10..+18% and the velocity error 3-5% of U).
  * Why: the kernel sum of a square lattice sheared by a strain gamma (x -> x + gamma z) is not
  * invariant. Summed exactly on the lattice (the continuity equation integrates d/dt of it),
  * sum_j dx^2 W(r_ij) / sum at gamma = 0 - 1 = C gamma^2 for small gamma, with
