@@ -36,9 +36,10 @@
  *     pairwise harmonic-mean viscosities (forces.c) is not the divergence of that stress where mu
  *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts
  *     what holds today (all grains mobile after the first step, within 0.1 dx at t = 0.02 s, no
- *     grain through the floor) and the criterion over 0.1 s is kept as a known failure: `test_granular known_failure heap_mobile` (CTest
- *     test_granular_known_heap_mobile, WILL_FAIL) fails while the heap moves, so CTest reports
- *     it the day the rheology holds the heap.
+ *     grain through the floor) and the criterion over 0.1 s is kept as a known failure:
+ *     `test_granular known_failure heap_mobile` (CTest test_granular_known_heap_mobile,
+ *     WILL_FAIL) fails while the heap moves, so CTest reports it the day the rheology holds the
+ *     heap.
  * (b) A square column collapses with the Vajont rheology (mu_thr = 320 kPa s, mu0 = 5 kPa s):
  *     it spreads, stops, and its final surface is no steeper than phi; its run-out against the
  *     experiments' is a known failure at the test's resolution (see the comment of (b) below). */
@@ -255,9 +256,9 @@ static void test_heap_mobile_at_rest(void **state)
  * 1.16 r0 at dx = 0.01 (r0 / 20), so the run-out is not converged in dx and grows toward the
  * experiments with resolution. The criterion is kept as a known failure (test_column_runout, run
  * by `test_granular known_failure column_runout`, CTest test_granular_known_column_runout);
- * test_column_collapse asserts what is defensible at this resolution: the run-out lies between half the column width (it spreads) and the glass-bead
- * edge of the band (1.96: no more mobile than the most mobile experiment), the deposit stops and
- * is no steeper than phi.
+ * test_column_collapse asserts what is defensible at this resolution: the run-out lies between
+ * half the column width (it spreads) and the glass-bead edge of the band (1.96: no more mobile
+ * than the most mobile experiment), the deposit stops and is no steeper than phi.
  * The deposit does not freeze: with mu0 = 5 kPa s the slowly shearing grains are a Newtonian
  * fluid of viscosity mu0 and keep creeping (docs/model.md section 6), so "stopped" is the KE
  * criterion.
