@@ -15,27 +15,44 @@
  *   (a) Wendland C2 at h = 1.3 dx and (b) the default cubic spline at h = 1.5 dx: both must meet
  *       the analytical flow within 2% of U and dp/dx within 5% (measured: (a) 1.49% of U, dp/dx
  *       -1.2%; (b) 0.75% of U, dp/dx +2.5%; mean density within 6e-5 rho0 of rho0 in both);
- *   (c) the cubic spline at h = 1.3 dx (the smoothing length of the bundled cases) does not: its
- *       continuity density drifts in shear (measured: mean pressure 200 -> 240 Pa at t = 0.3 s,
- *       313 Pa at 0.6 s; dp/dx 291-319 Pa/m over 0.2-0.3 s, +21..+33%; velocity error 1.5% of U
- *       at t = 0.2 s, 2.5% at 0.3 s, 15% at 0.6 s, 2.01% on the means over 0.2-0.3 s; the same
- *       at dx = 0.002; with c = 5 m/s dp/dx is still +10..+18% and the velocity error 3-5% of U).
- * Why: the kernel sum of a square lattice sheared by a strain gamma (x -> x + gamma z) is not
- * invariant. Summed exactly on the lattice (the continuity equation integrates d/dt of it),
- * sum_j dx^2 W(r_ij) / sum at gamma = 0 - 1 = C gamma^2 for small gamma, with
- *     C = 0.030 (cubic spline, h = 1.3 dx), 0.0047 (cubic, h = 1.5 dx), 0.0018 (cubic, 2 dx),
- *     C = -0.001 (Wendland C2, h = 1.3 dx)
- * (at gamma = 0.2). In the channel the strain grows as gamma = (U t / H)(6 eta - 2), so the
- * continuity density of the cubic spline at 1.3 dx rises by C <gamma^2> = 4 C (U t / H)^2
- * (4.3e-4 rho0 at t = 0.3 s, i.e. 43 Pa at c = 10 m/s), unevenly over the height, and with it a
- * spurious pressure field. Not the resolution (the strain does not depend on dx), not the Morris
- * operator (its lattice coefficient -sum_j V_j F z_ij^2 r^2/(r^2 + eta^2) is 1.000 for the cubic
- * spline at 1.3 dx, 0.963 for Wendland C2, within 1% of that up to gamma = 0.3 for both; the
- * eta term takes the cubic's 1.0105 to 1.000), not the walls (the same walls pass with the other
- * two kernels). Remedies belong to the operator: a density diffusion term in the continuity
- * equation (delta-SPH, Antuono et al. 2010) or h >= 1.5 dx with the cubic spline; the test (c)
- * asserts the mechanism (the mean density rise against 4 C (U t / H)^2) so that it fails when it
- * changes, and prints the velocity error.
+ *   (c) the cubic spline at h = 1.3 dx (the smoothing length of the bundled cases) does not
+ *       (measured: dp/dx 291-319 Pa/m over 0.2-0.3 s, +21..+33%; velocity error 1.5% of U at
+ *       t = 0.2 s, 2.5% at 0.3 s, 15% at 0.6 s, 2.01% on the means over 0.2-0.3 s; the same at
+ *       dx = 0.002).
+ * Why: the zeroth-order error of the symmetric pressure gradient, times the absolute pressure.
+ * The momentum equation's -1/rho_i sum_j V_j (p_i + p_j) grad_i W_ij (forces.c) contains
+ * -2 p_i / rho_i sum_j V_j grad_i W_ij, which vanishes on the initial square lattice but not on
+ * a lattice deformed by a curved velocity profile: with u'' != 0 the rows above and below a
+ * particle are displaced unequally (by u' t z + u'' t z^2 / 2). Summed on such a lattice
+ * (x_j = x_i + I dx + u' t z + u'' t z^2 / 2, z = J dx, u'' = 6 U / H^2), sum_j V_j F (x_i - x_j)
+ * at mid-depth is -0.16, -0.20, -0.23 1/m at t = 0.2, 0.25, 0.3 s for the cubic spline at
+ * h = 1.3 dx, -0.033..-0.041 at 1.5 dx and within +-0.005 for Wendland C2 at 1.3 dx: with the
+ * 200 Pa background pressure of the case a spurious force equivalent to a pressure gradient of
+ * 65, 80, 94 Pa/m, which the pressure field balances: dp/dx = 240 + that, i.e. 305-334 Pa/m
+ * predicted against 291-319 Pa/m measured (cubic at 1.5 dx: 13-16 Pa/m predicted, +6 Pa/m
+ * measured). Confirmed by changing only the background pressure (cubic, 1.3 dx, 0.2-0.3 s):
+ * 50 Pa: dp/dx 255-270 Pa/m, velocity error 0.8-1.0% of U; 200 Pa: 291-319 Pa/m, 1.5-2.5%;
+ * 1000 Pa: 463-571 Pa/m, 6.7-8.5%. Not the resolution (the deformation does not depend on dx),
+ * not the Morris viscous operator (its lattice coefficient -sum_j V_j F z_ij^2 r^2/(r^2 + eta^2)
+ * is 1.000 for the cubic spline at 1.3 dx, 0.963 for Wendland C2, within 1% of that up to a
+ * shear strain of 0.3 for both; the eta term takes the cubic's 1.0105 to 1.000), not the eta
+ * term, not the walls (the same walls pass with the other two kernels), and not cured by a
+ * density diffusion term (delta-SPH with delta = 0.1 tried on a scratch build: no change) nor by
+ * the partial pressure smoothing (theta_P = 0.1: no change).
+ * Side effect, which (c) asserts: the continuity density of the cubic spline at 1.3 dx also
+ * drifts in shear. The kernel sum of a square lattice sheared by a strain gamma
+ * (x -> x + gamma z) is not invariant: sum_j dx^2 W(r_ij) / (its value at gamma = 0) - 1 =
+ * C gamma^2, with C = 0.030 (cubic spline, h = 1.3 dx), 0.0047 (cubic, 1.5 dx), 0.0018 (cubic,
+ * 2 dx), -0.001 (Wendland C2, 1.3 dx) at gamma = 0.2, and the continuity equation integrates
+ * d/dt of it. In the channel gamma = (U t / H)(6 eta - 2), so the mean density rises by
+ * C <gamma^2> = 4 C (U t / H)^2 (4.3e-4 rho0 at t = 0.3 s: the mean pressure climbs from 200 Pa
+ * to 240 Pa at 0.3 s and 313 Pa at 0.6 s, which enlarges the error above).
+ * Remedies belong to the operator (lib/src, not changed here): a pressure gradient that is exact
+ * for a uniform pressure, e.g. -1/rho_i sum_j V_j (p_j - p_i) grad_i W_ij, or the symmetric form
+ * with the kernel gradient corrected by L_i^-1 (Bonet & Lok 1999; the code already builds L_i for
+ * the grains' strain rate), or particle shifting that keeps the lattice regular; or, in a case,
+ * h >= 1.5 dx with the cubic spline, Wendland C2, or a background pressure no larger than needed.
+ * (c) fails when the density drift changes, which an operator change of this kind would show.
  *
  * Measured: the mean vx of the particles with 0.2 < x < 0.3 m in z-bins of dx, averaged over 11
  * instants t = 0.20, 0.21, ..., 0.30 s, against the mean of u(z_i) over the same samples; the
