@@ -1,25 +1,48 @@
 /* test_granular.c - dry granular media with the mixture rheology (Manenti et al. 2018, eqs. (10),
- * (12) and Fig. 1; MODEL.md section 6: "the granular column collapse and the resting heap tests
- * tell whether it is right"). Dry sand: rho_s = 2650 kg/m3, K_s = 4.24e6 Pa (c = 40 m/s),
- * porosity 0.35 (mixture density 1722.5 kg/m3), phi = 35 deg, on a no-slip floor.
+ * (12) and Fig. 1; docs/model.md section 6: the three regimes of mu_thr and mu0). Dry sand:
+ * rho_s = 2650 kg/m3, K_s = 4.24e6 Pa (c = 40 m/s), porosity 0.35 (mixture density
+ * 1722.5 kg/m3), phi = 35 deg, on a no-slip floor.
  *
- * (a) A heap below the angle of repose stays at rest. With the limiting viscosity active
- *     (mu0 < mu_thr) the model turns slowly deforming grains into a Newtonian fluid of viscosity
- *     mu0, so a heap below phi creeps (strain rate ~ tau / (2 mu0)): that is the model, not a
- *     defect, and the resting heap is tested with the limit off (mu0 = 1e12 Pa s) and the
- *     threshold of Run 7, mu_thr = 5 kPa s.
- *     Every grain stays held fixed, so no particle moves at all; the test can still fail: it
- *     asserts that all grains are evaluated (fixed_particles = number of grains at every sample)
- *     and that dt is the viscous bound of the fixed grains. The test runs the issue's full 1 s at
- *     dx = 0.01 (about 190 grains, 172k steps). Measured once at dx = 0.005 (744 grains + 360 wall
- *     particles, 687,039 steps, 13 min on one core): no grain moved over the full 1 s, all 744
- *     fixed at every sample, while the fixed grains' pressures relax slowly (mean 517 -> 497 Pa
+ * (a) A heap below the angle of repose stays at rest, held fixed. With the limiting viscosity
+ *     active (mu0 < mu_thr) the model turns slowly deforming grains into a Newtonian fluid of
+ *     viscosity mu0, so a heap below phi creeps (strain rate ~ tau / (2 mu0)): that is the model,
+ *     not a defect, and this heap is run with the limit off (mu0 = 1e12 Pa s) and the threshold
+ *     of Run 7, mu_thr = 5 kPa s.
+ *     Every grain stays held fixed, and fixed grains are never drifted, so no particle can move:
+ *     what this test can fail on is that all grains are evaluated (fixed_particles = number of
+ *     grains at every sample) and that dt is the viscous bound of the fixed grains; test (a2)
+ *     checks a heap that the rheology must hold with mobile grains. The test runs the full 1 s
+ *     at dx = 0.01 (about 190 grains, 172k steps). Measured once at dx = 0.005 (744 grains + 360
+ *     wall particles, 687,039 steps, 13 min on one core): no grain moved over the full 1 s, all
+ *     744 fixed at every sample, while the fixed grains' pressures relax slowly (mean 517 -> 497 Pa
  *     at 0.2 s -> 439 Pa at 1 s, largest change of one grain 148 Pa at 0.2 s, 337 Pa at 1 s).
- *     With the Vajont values instead (mu_thr = 320 kPa s, mu0 = 5 kPa s) the same heap is all
- *     mobile by t = 0.05 s and does not creep steadily but accelerates: largest displacement
- *     0.34, 0.90, 1.59, 2.46 dx and KE 0.005, 0.007, 0.016, 0.032 J at t = 0.05, 0.1, 0.15, 0.2 s.
+ * (a2) The same heap with MOBILE grains: mu_thr = 1e12 Pa s (the case reader's largest value; a
+ *     grain is held fixed only where mu_app >= mu_thr, i.e. at an exactly zero strain rate, so
+ *     after the first step none is) and the Vajont limiting viscosity mu0 = 5 kPa s. The
+ *     reference is rest: below phi the rheology holds the heap, up to the creep of the limited
+ *     regime, a Newtonian fluid of viscosity mu0. That creep is bounded by the lubrication
+ *     estimate of a viscous layer of depth d on a slope S, surface speed rho g S d^2 / (2 mu0):
+ *     with S = tan 25 deg, d up to the heap's height 0.093 m, at most 6.8 mm/s, i.e. 0.068 dx
+ *     in 0.1 s. So the criterion is: every grain within 0.1 dx of its start over 0.1 s.
+ *     THE MODEL DOES NOT MEET IT (measured, dx = 0.01, 186 grains): largest displacement 0.03,
+ *     0.14, 0.32, 0.53, 0.76 dx at t = 0.02, 0.04, ..., 0.1 s (mean 0.005 -> 0.19 dx), kinetic
+ *     energy growing from 0.0013 to 0.034 J, the fastest grains those at the apex; nearly the
+ *     same with mu0 = 20 kPa s (0.70 dx at 0.1 s) and still 0.34 dx with phi = 60 deg, so it is
+ *     neither the creep of mu0 nor the friction angle: by t = 0.01 s only 56 of the 186 grains
+ *     are in the limited regime (mu = mu0), 124 are frictional (mu_app < mu0) and by 0.05 s 76
+ *     have mu < 100 Pa s (presumably the start-up's acoustic velocity noise, c = 40 m/s, gives
+ *     strain rates at which sigma' sin(phi) / (2 sqrt(II_D)) < mu0). The heap is then held only
+ *     by the frictional stress; the likely cause, not verified, is that the Morris Laplacian with
+ *     pairwise harmonic-mean viscosities (forces.c) is not the divergence of that stress where mu
+ *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts
+ *     what holds today (all grains mobile after the first step, within 0.1 dx at t = 0.02 s, no
+ *     grain through the floor) and the criterion over 0.1 s is kept as a known failure:
+ *     `test_granular known_failure heap_mobile` (CTest test_granular_known_heap_mobile,
+ *     WILL_FAIL) fails while the heap moves, so CTest reports it the day the rheology holds the
+ *     heap.
  * (b) A square column collapses with the Vajont rheology (mu_thr = 320 kPa s, mu0 = 5 kPa s):
- *     it spreads, stops, and its final surface is no steeper than phi. */
+ *     it spreads, stops, and its final surface is no steeper than phi; its run-out against the
+ *     experiments' is a known failure at the test's resolution (see the comment of (b) below). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -66,14 +89,15 @@ static size_t output(const mixsph_sim *s, const char *name)
 #define HEAP_DX 0.01 /* [m] */
 #define HEAP_T 1.0  /* [s] simulated, as the issue asks */
 
-/* Triangle of base 0.4 m and slopes of 25 deg (height 0.2 tan 25 = 0.0933 m), below phi = 35. */
-static const char *const HEAP_CASE =
+/* Triangle of base 0.4 m and slopes of 25 deg (height 0.2 tan 25 = 0.0933 m), below phi = 35;
+ * mu_thr and mu0 filled in (%g, %g). */
+static const char *const HEAP_CASE_FMT =
     "{\n"
     "  \"name\": \"heap_at_rest\",\n"
     "  \"gravity\": 9.81,\n"
     "  \"numerics\": { \"dx\": 0.01, \"t_end\": 1.0 },\n"
     "  \"media\": { \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
-    "\"mu_thr\": 5.0e3, \"mu0\": 1.0e12 } },\n"
+    "\"mu_thr\": %g, \"mu0\": %g } },\n"
     "  \"bodies\": { \"heap\": { \"medium\": \"sand\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.2, 0.0932615]] } },\n"
     "  \"walls\": { \"floor\": { \"polyline\": [[-0.05, 0.0], [0.45, 0.0]], \"fluid_side\": \"left\", \"slip\": \"no-slip\" } },\n"
     "  \"domain\": { \"x_min\": -0.15, \"x_max\": 0.55, \"z_min\": -0.05, \"z_max\": 0.25 },\n"
@@ -83,7 +107,9 @@ static const char *const HEAP_CASE =
 static void test_heap_at_rest(void **state)
 {
     (void)state;
-    mixsph_sim *s = create(HEAP_CASE, "heap_at_rest.json");
+    char text[2048];
+    snprintf(text, sizeof text, HEAP_CASE_FMT, 5.0e3, 1.0e12);
+    mixsph_sim *s = create(text, "heap_at_rest.json");
     const size_t n = mixsph_sim_particles(s);
     const size_t out_fixed = output(s, "fixed_particles"), out_dt = output(s, "dt"), out_ke = output(s, "kinetic_energy");
     /* initial positions by id */
@@ -136,21 +162,114 @@ static void test_heap_at_rest(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* ---- (a2) heap of mobile grains ------------------------------------------------------------ */
+
+#define MOBILE_MU_THR 1.0e12 /* [Pa s]: the case reader's largest value, never reached while moving */
+#define MOBILE_MU0 5.0e3     /* [Pa s]: the Vajont limiting viscosity */
+#define MOBILE_T 0.1         /* [s]: the lubrication creep of mu0 stays below 0.068 dx (header) */
+#define MOBILE_T_NOW 0.02    /* [s]: the part of it the model meets today (header) */
+
+/* Run the heap of mobile grains to t_end, sampling every 0.01 s; returns the largest
+ * displacement of any grain [m] at any sample up to t_end. Asserts the premise at every sample:
+ * no grain held fixed after the first step, every grain at mu <= mu0, none lost or through the
+ * floor. */
+static double mobile_heap(double t_end)
+{
+    char text[2048];
+    snprintf(text, sizeof text, HEAP_CASE_FMT, MOBILE_MU_THR, MOBILE_MU0);
+    mixsph_sim *s = create(text, "heap_mobile.json");
+    const size_t n = mixsph_sim_particles(s);
+    const size_t out_fixed = output(s, "fixed_particles"), out_ke = output(s, "kinetic_energy");
+    mixsph_particles_view v;
+    assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
+    double *x0 = calloc(v.n, sizeof *x0), *z0 = calloc(v.n, sizeof *z0);
+    assert_non_null(x0);
+    assert_non_null(z0);
+    for (size_t i = 0; i < v.n; i++) {
+        assert_true(v.id[i] < v.n);
+        x0[v.id[i]] = v.x[i];
+        z0[v.id[i]] = v.z[i];
+    }
+    double worst = 0.0;
+    for (int k = 1; k <= (int)lround(t_end / 0.01); k++) {
+        advance(s, 0.01 * k);
+        assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
+        double now = 0.0, mean = 0.0;
+        int limited = 0;
+        for (size_t i = 0; i < v.n; i++) {
+            if (v.state[i] == MIXSPH_STATE_WALL) continue;
+            assert_int_equal(v.state[i], MIXSPH_STATE_MOBILE); /* premise: mobile grains */
+            assert_true(v.mu[i] <= MOBILE_MU0);                 /* regimes "limited" or "frictional" */
+            assert_true(v.z[i] > 0.0);                          /* none through the floor */
+            const double d = hypot(v.x[i] - x0[v.id[i]], v.z[i] - z0[v.id[i]]);
+            now = fmax(now, d);
+            mean += d / (double)n;
+            limited += v.mu[i] == MOBILE_MU0;
+        }
+        assert_true(mixsph_sim_output_value(s, out_fixed) == 0.0);
+        worst = fmax(worst, now);
+        print_message("  t = %.2f s: %llu steps, largest displacement %.3f dx, mean %.4f dx, %d of %zu grains at mu0, "
+                      "KE %.3g J\n",
+                      mixsph_sim_time(s), (unsigned long long)mixsph_sim_steps(s), now / HEAP_DX, mean / HEAP_DX, limited,
+                      n, mixsph_sim_output_value(s, out_ke));
+    }
+    free(x0);
+    free(z0);
+    mixsph_sim_destroy(s);
+    return worst;
+}
+
+/* (a2) what the model meets today: mobile grains, at rest to 0.1 dx over the first 0.02 s. */
+static void test_heap_mobile(void **state)
+{
+    (void)state;
+    const double worst = mobile_heap(MOBILE_T_NOW);
+    /* reference: at rest (slope 25 deg < phi = 35 deg, up to the creep of mu0: below 0.014 dx by
+     * t = 0.02 s, header); tolerance 0.1 dx (issue). Over the first 0.02 s only: the model
+     * leaves it at t = 0.035 s (header) */
+    assert_true(worst <= 0.1 * HEAP_DX);
+}
+
+/* (a2) the criterion: at rest to 0.1 dx over 0.1 s. A known failure (header). */
+static void test_heap_mobile_at_rest(void **state)
+{
+    (void)state;
+    const double worst = mobile_heap(MOBILE_T);
+    /* reference: at rest (slope 25 deg < phi = 35 deg, up to the creep of mu0: below 0.068 dx
+     * by t = 0.1 s, header); tolerance 0.1 dx (issue) */
+    assert_true(worst <= 0.1 * HEAP_DX);
+}
+
 /* ---- (b) column collapse ------------------------------------------------------------------- */
 
-/* A 0.2 x 0.2 m column (aspect ratio a = 1) against a left wall on a no-slip floor, run until the
- * kinetic energy has fallen below 2% of its maximum (cap 1.2 s). Experiments on dry granular
- * columns (Lube et al. 2005, J. Fluid Mech. 538; Lajeunesse et al. 2005, Phys. Fluids 17) give a
- * run-out (x_inf - r0) / r0 of about 1.2 a for a < 1.7, i.e. 1.2 here: the test asserts only
- * that the front moved by more than 0.5 r0 and prints the run-out.
+/* A 0.2 x 0.2 m column (aspect ratio a = H0 / r0 = 1) against a left wall on a no-slip floor, run
+ * until the kinetic energy has fallen below 2% of its maximum (cap 1.2 s). The run-out is
+ * measured between the outermost grain's centre now and the column's last grain's centre at t = 0.
+ * Reference: dry granular columns collapsing in a channel (quasi-2D) spread to a normalised
+ * run-out (r_inf - r0) / r0 = lambda a on the linear branch (small a), with lambda = 1.2 for sand,
+ * rice and sugar (Lube et al. 2005, Phys. Rev. E 72, 041301) and 1.8 for glass beads (Lajeunesse
+ * et al. 2005, Phys. Fluids 17, 103302), both fits as collected by Lagree, Staron & Popinet 2011,
+ * J. Fluid Mech. 686, 378, eq. (3.1): at a = 1 the band 1.2 to 1.8. Tolerance: the kernel support
+ * 2h = 2.6 dx on either side (0.16 r0 at dx = 0.0125), to which SPH resolves a front; the
+ * criterion is therefore 1.04 <= run-out <= 1.96.
+ * THE MODEL DOES NOT MEET IT at the resolution of the test: 1.00 r0 at dx = 0.0125 (r0 / 16);
+ * 1.16 r0 at dx = 0.01 (r0 / 20), so the run-out is not converged in dx and grows toward the
+ * experiments with resolution. The criterion is kept as a known failure (test_column_runout, run
+ * by `test_granular known_failure column_runout`, CTest test_granular_known_column_runout);
+ * test_column_collapse asserts what is defensible at this resolution: the run-out lies between
+ * half the column width (it spreads) and the glass-bead edge of the band (1.96: no more mobile
+ * than the most mobile experiment), the deposit stops and is no steeper than phi.
  * The deposit does not freeze: with mu0 = 5 kPa s the slowly shearing grains are a Newtonian
- * fluid of viscosity mu0 and keep creeping (MODEL.md section 6), so "stopped" is the KE criterion.
+ * fluid of viscosity mu0 and keep creeping (docs/model.md section 6), so "stopped" is the KE
+ * criterion.
  * Measured (2 threads on the shared 2-core machine):
  *   dx = 0.01   (400 grains): KE < 2% at t = 0.57 s (97,870 steps, 110 s wall, 92 s CPU), front
  *               0.427 m (moved 1.16 r0); creeping on: front 0.460 m at 1.0 s, 0.468 m at 1.2 s,
  *               KE 0.009-0.013 J against a maximum of 5.7 J at 0.14 s;
  *   dx = 0.0125 (256 grains, used here): KE < 2% at t = 0.53 s (58,241 steps, 44 s wall, 39 s
- *               CPU), front 0.393 m (moved 1.0 r0), height 0.146 m, steepest slope 24.7 deg. */
+ *               CPU), front 0.393 m (moved 1.0 r0), height 0.146 m, steepest slope 24.7 deg.
+ * So the model gives a run-out of 1.0 r0 (dx = 0.0125) to 1.16 r0 (dx = 0.01) when it stops, 17%
+ * and 3% short of the band's lower edge (1.2 r0, Lube et al.), and creeps on to 1.34 r0 at 1.2 s (dx = 0.01). */
 
 #define COL_DX 0.0125
 #define COL_W 0.2     /* column width r0 [m] */
@@ -173,9 +292,11 @@ static const char *const COLUMN_CASE =
     "  \"output\": { \"monitor_interval\": 0.01 }\n"
     "}\n";
 
-static void test_column_collapse(void **state)
+/* Run the column collapse and return its run-out (r_inf - r0) / r0; asserts that no grain crosses
+ * the wall or the floor, that it stops (KE criterion) and that its final surface is no steeper
+ * than phi. */
+static double column_collapse(void)
 {
-    (void)state;
     mixsph_sim *s = create(COLUMN_CASE, "column_collapse.json");
     const size_t n = mixsph_sim_particles(s);
     assert_int_equal(n, 256); /* 16 x 16 grains */
@@ -234,23 +355,66 @@ static void test_column_collapse(void **state)
     print_message("final height %.3f m (%.2f H0); steepest slope %.1f deg at x = %.2f m (phi = %.0f deg)\n", height,
                   height / COL_H, atan(slope_max) * 180.0 / PI, x_slope, PHI);
     print_message("run-out (x_inf - r0) / r0 = %.2f (front particle against the column's last particle); experiments "
-                  "give about 1.2 a = 1.2 for a = 1 (Lube et al. 2005, Lajeunesse et al. 2005)\n",
+                  "give 1.2 a (Lube et al. 2005) to 1.8 a (Lajeunesse et al. 2005), a = 1\n",
                   (front - front0) / COL_W);
 
-    /* it spread: the front moved by more than half the column width (experiments: 1.2 r0) */
-    assert_true(front - front0 > 0.5 * COL_W);
     /* it stopped: KE below 2% of its maximum before the cap */
     assert_true(stopped);
     /* reference: a deposit at rest is no steeper than the angle of internal friction phi = 35 deg
      * (Coulomb); method above; no tolerance beyond the 4-bin baseline */
     assert_true(slope_max <= tan(PHI * PI / 180.0));
     mixsph_sim_destroy(s);
+    return (front - front0) / COL_W;
 }
 
-int main(void)
+/* The experiments' band at a = 1 (comment above): lambda = 1.2 (Lube) to 1.8 (Lajeunesse). */
+#define RUNOUT_LO 1.2
+#define RUNOUT_HI 1.8
+#define FRONT_TOL (2.0 * 1.3 * COL_DX / COL_W) /* 2h / r0: the front is resolved to the kernel support */
+
+/* (b) what holds at this resolution: it spreads, but no farther than the most mobile experiment. */
+static void test_column_collapse(void **state)
 {
+    (void)state;
+    const double runout = column_collapse();
+    /* reference: at least half the column width (it spreads) and at most the glass-bead edge of
+     * the experiments' band, 1.8 a (Lajeunesse et al. 2005), plus 2h / r0 (comment above) */
+    assert_true(runout > 0.5);
+    assert_true(runout <= RUNOUT_HI + FRONT_TOL);
+}
+
+/* (b) the criterion: within the experiments' band, to 2h. A known failure (comment above). */
+static void test_column_runout(void **state)
+{
+    (void)state;
+    const double runout = column_collapse();
+    print_message("run-out %.3f r0 against the experiments' %.1f to %.1f r0, tolerance 2h = %.3f r0\n", runout, RUNOUT_LO,
+                  RUNOUT_HI, FRONT_TOL);
+    /* reference: lambda a with lambda = 1.2 (Lube et al. 2005) to 1.8 (Lajeunesse et al. 2005),
+     * a = 1; tolerance 2h / r0 = 0.16 (the kernel support) */
+    assert_true(runout >= RUNOUT_LO - FRONT_TOL && runout <= RUNOUT_HI + FRONT_TOL);
+}
+
+/* `test_granular` runs the tests the model meets; `test_granular known_failure NAME` one of the
+ * criteria it does not meet yet (header): heap_mobile or column_runout. CTest runs each of these
+ * on its own and expects it to fail (WILL_FAIL), so each reports the day the model meets it. */
+int main(int argc, char **argv)
+{
+    if (argc > 2 && strcmp(argv[1], "known_failure") == 0) {
+        if (strcmp(argv[2], "heap_mobile") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_heap_mobile_at_rest)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
+        if (strcmp(argv[2], "column_runout") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_column_runout)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
+        fprintf(stderr, "test_granular: unknown known_failure '%s' (heap_mobile, column_runout)\n", argv[2]);
+        return 2;
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_heap_at_rest),
+        cmocka_unit_test(test_heap_mobile),
         cmocka_unit_test(test_column_collapse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
