@@ -89,6 +89,22 @@ static size_t output(const mixsph_sim *s, const char *name)
 #define HEAP_DX 0.01 /* [m] */
 #define HEAP_T 1.0  /* [s] simulated, as the issue asks */
 
+/* The particles' current positions by id (caller frees *x0, *z0). */
+static void positions_by_id(const mixsph_sim *s, double **x0, double **z0)
+{
+    mixsph_particles_view v;
+    assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
+    *x0 = calloc(v.n, sizeof **x0);
+    *z0 = calloc(v.n, sizeof **z0);
+    assert_non_null(*x0);
+    assert_non_null(*z0);
+    for (size_t i = 0; i < v.n; i++) {
+        assert_true(v.id[i] < v.n);
+        (*x0)[v.id[i]] = v.x[i];
+        (*z0)[v.id[i]] = v.z[i];
+    }
+}
+
 /* Triangle of base 0.4 m and slopes of 25 deg (height 0.2 tan 25 = 0.0933 m), below phi = 35;
  * mu_thr and mu0 filled in (%g, %g). */
 static const char *const HEAP_CASE_FMT =
@@ -113,16 +129,9 @@ static void test_heap_at_rest(void **state)
     const size_t n = mixsph_sim_particles(s);
     const size_t out_fixed = output(s, "fixed_particles"), out_dt = output(s, "dt"), out_ke = output(s, "kinetic_energy");
     /* initial positions by id */
+    double *x0, *z0;
+    positions_by_id(s, &x0, &z0);
     mixsph_particles_view v;
-    assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
-    double *x0 = calloc(v.n, sizeof *x0), *z0 = calloc(v.n, sizeof *z0);
-    assert_non_null(x0);
-    assert_non_null(z0);
-    for (size_t i = 0; i < v.n; i++) {
-        assert_true(v.id[i] < v.n);
-        x0[v.id[i]] = v.x[i];
-        z0[v.id[i]] = v.z[i];
-    }
     /* the time step is the viscous bound of the fixed grains with min(mu0, mu_thr) = 5 kPa s:
      * 0.05 * 2 h^2 rho / mu = 0.1 * 0.013^2 * 1722.5 / 5000 = 5.82e-6 s (h = 1.3 dx; rho within
      * 0.1% of the mixture density), not the acoustic 0.1 * 2h / c = 6.5e-5 s: the grains are
@@ -180,16 +189,9 @@ static double mobile_heap(double t_end)
     mixsph_sim *s = create(text, "heap_mobile.json");
     const size_t n = mixsph_sim_particles(s);
     const size_t out_fixed = output(s, "fixed_particles"), out_ke = output(s, "kinetic_energy");
+    double *x0, *z0;
+    positions_by_id(s, &x0, &z0);
     mixsph_particles_view v;
-    assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
-    double *x0 = calloc(v.n, sizeof *x0), *z0 = calloc(v.n, sizeof *z0);
-    assert_non_null(x0);
-    assert_non_null(z0);
-    for (size_t i = 0; i < v.n; i++) {
-        assert_true(v.id[i] < v.n);
-        x0[v.id[i]] = v.x[i];
-        z0[v.id[i]] = v.z[i];
-    }
     double worst = 0.0;
     for (int k = 1; k <= (int)lround(t_end / 0.01); k++) {
         advance(s, 0.01 * k);
