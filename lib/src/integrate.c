@@ -6,6 +6,10 @@
  *   a^{n+1}   = A(x^{n+1}, rho^{n+1}, v^{n+1/2})     (EOS, wall pressure, momentum pass)
  *   v^{n+1}   = v^{n+1/2} + dt/2 a^{n+1}
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
+ * With numerics.viscosity = "implicit" the momentum pass leaves the viscous term out and the step
+ * is symplectic Euler around the implicit viscous step (viscous.h; see viscous_step below):
+ *   v* = v^n + dt a^n,  v^{n+1} = V_dt(v*),  x^{n+1} = x^n + dt v^{n+1},  then as above without
+ *   the last kick, so that the particles move with the velocity the viscous step balanced.
  * Granular particles: after the density pass and the velocity-gradient pass (their strain rate
  * from v^{n+1/2}) mixture.c decides their regime; a fixed grain has its velocity zeroed, still
  * gets forces and the kicks, is not drifted, and enters dt with the viscosity it will have once
