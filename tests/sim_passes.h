@@ -11,9 +11,7 @@
 static inline int sim_density_pass(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
-    const int bad = forces_density_rate(s->forces, &S);
-    if (s->mixture) forces_velocity_gradient(&S, mixture_gradient(s->mixture));
-    return bad;
+    return integrate_density_rates(s, &S);
 }
 
 /* Momentum pass. Returns forces_momentum's value. */

@@ -151,9 +151,7 @@ struct pair_system sim_pair_system(mixsph_sim *s)
 
 static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.ncell]; }
 
-/* The density pass and, with granular media, the grains' velocity gradient. Returns 1 if a
- * non-finite rate appeared at a mobile particle, -1 when out of memory. */
-static int density_rates(mixsph_sim *s, const struct pair_system *S)
+int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 {
     const int bad = forces_density_rate(s->forces, S);
     if (bad >= 0 && s->mixture) forces_velocity_gradient(S, mixture_gradient(s->mixture));
@@ -198,7 +196,7 @@ static mixsph_status viscous_step(mixsph_sim *s, double dt)
     if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const struct pair_system S = sim_pair_system(s);
     if (!forces_viscous_ready(s->forces)) { /* a restored state: the couplings at its positions */
-        if (density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0)
+        if (integrate_density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0)
             return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     }
     struct viscous_report *rep = &s->viscous_last;
@@ -217,7 +215,7 @@ static mixsph_status viscous_step(mixsph_sim *s, double dt)
 mixsph_status integrate_initial_rates(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
-    const int bad = density_rates(s, &S);
+    const int bad = integrate_density_rates(s, &S);
     if (bad < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     pressures_and_regimes(s, &S, 0);
@@ -279,7 +277,7 @@ mixsph_status integrate_step(mixsph_sim *s)
         if (st != MIXSPH_OK) return st;
     }
     const struct pair_system S = sim_pair_system(s);
-    int bad_rho = density_rates(s, &S);
+    int bad_rho = integrate_density_rates(s, &S);
     if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
 #pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {

@@ -14,6 +14,11 @@ mixsph_status integrate_rebuild_lists(mixsph_sim *s);
  *  near-wall flags, from the pair ranges' last build. */
 mixsph_status integrate_build_gather_lists(mixsph_sim *s);
 
+/** The density pass and, with granular media, the grains' velocity gradient, over S (from
+ *  sim_pair_system). Returns 1 if a non-finite rate appeared at a mobile particle, -1 when out of
+ *  memory, 0 otherwise. */
+int integrate_density_rates(mixsph_sim *s, const struct pair_system *S);
+
 /** The next time step from criterion (4). */
 double integrate_time_step(const mixsph_sim *s);
 
