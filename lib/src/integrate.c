@@ -7,7 +7,7 @@
  *   v^{n+1}   = v^{n+1/2} + dt/2 a^{n+1}
  * In the density-velocity (acoustic) pair this is velocity Verlet, stable for omega dt < 2.
  * With numerics.viscosity = "implicit" the momentum pass leaves the viscous term out and the step
- * is symplectic Euler around the implicit viscous step (viscous.h; see viscous_step below):
+ * is symplectic Euler around the implicit viscous step (viscous.h; see implicit_viscous_step below):
  *   v* = v^n + dt a^n,  v^{n+1} = V_dt(v*),  x^{n+1} = x^n + dt v^{n+1},  then as above without
  *   the last kick, so that the particles move with the velocity the viscous step balanced.
  * Granular particles: after the density pass and the velocity-gradient pass (their strain rate
@@ -191,7 +191,7 @@ static void kick_velocities(mixsph_sim *s, double dt)
  * explicit leapfrog, would move them with an unbalanced half kick of the other forces: 2.4 % of
  * the lid speed in the lid-driven channel at 20 times the explicit viscous time step). A solve
  * that misses its tolerance stops the run. */
-static mixsph_status viscous_step(mixsph_sim *s, double dt)
+static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt)
 {
     if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const struct pair_system S = sim_pair_system(s);
@@ -199,8 +199,11 @@ static mixsph_status viscous_step(mixsph_sim *s, double dt)
         if (integrate_density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0)
             return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     }
+    if (!s->wall_mirror && !(s->wall_mirror = walls_mirror_create()))
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     struct viscous_report *rep = &s->viscous_last;
-    if (viscous_solve(s->viscous, s->forces, &S, dt, s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, rep) != 0)
+    if (viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->cfg, s->walls, s->t, dt, s->cfg.viscous_tolerance,
+                     s->cfg.viscous_max_iterations, rep) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
     s->viscous_iterations += (uint64_t)rep->iterations;
     if (!rep->converged)
@@ -241,7 +244,7 @@ mixsph_status integrate_step(mixsph_sim *s)
     const int implicit = s->cfg.viscosity_implicit;
     if (implicit) { /* kick with the other forces over the whole step, then the viscous step */
         kick_velocities(s, dt);
-        const mixsph_status st = viscous_step(s, dt);
+        const mixsph_status st = implicit_viscous_step(s, dt);
         if (st != MIXSPH_OK) return st;
     }
     walls_move(&s->cfg, s->walls, P, s->t, dt);

@@ -277,6 +277,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
     mixture_free(s->mixture);
     forces_free(s->forces);
     viscous_free(s->viscous);
+    walls_mirror_free(s->wall_mirror);
     particles_free(&s->P);
     cells_free(&s->C);
     neighbours_free(&s->NB);

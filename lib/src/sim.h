@@ -51,6 +51,7 @@ struct mixsph_sim {
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
     struct forces *forces;        /* the pair loops' cache and scratch */
     struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
+    struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
     struct viscous_report viscous_last; /* the last solve */
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */

@@ -16,7 +16,8 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 3u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments */
+#define STATE_VERSION 4u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
+                            4: the increments of the implicit step's first stage */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */

@@ -13,6 +13,7 @@
 #include <stddef.h>
 
 #include "forces.h"
+#include "walls.h"
 
 struct viscous_solver;
 
@@ -26,11 +27,23 @@ struct viscous_report {
 struct viscous_solver *viscous_create(void);
 void viscous_free(struct viscous_solver *V);
 
-/** Solve for the mobile particles' velocities (P->vx, P->vz, updated in place; P->visc_dvx,
- *  visc_dvz receive the increment for the next warm start) after forces_momentum stored the
- *  couplings. Stops at ||r|| <= tolerance ||b|| or after max_iterations. Returns -1 when out of
+/** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
+ *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
+ *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
+ *  built and timed by the caller (NULL: the walls keep uvx, uvz). Stops at ||r|| <= tolerance ||b|| or after max_iterations. Returns -1 when out of
  *  memory, 0 otherwise (convergence is in the report). */
-int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S, double dt,
-                  double tolerance, int max_iterations, struct viscous_report *report);
+/** The implicit viscous step over dt from t (walls not yet moved): TR-BDF2, a trapezoidal stage
+ *  to t + gamma dt and a BDF2 stage to t + dt, each a solve of the form of viscous_solve with the
+ *  walls' mirror (M, rebuilt here at the current positions) at the stage's time. Updates
+ *  P->vx, P->vz, P->visc_dvx, visc_dvz (the increment over the step, the next step's warm start)
+ *  and the wall particles' uvx, uvz. The report sums the two stages' iterations and keeps the
+ *  larger residual. Returns -1 when out of memory, 0 otherwise. */
+int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
+                 struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
+                 double tolerance, int max_iterations, struct viscous_report *report);
+
+int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
+                  const struct wall_mirror *M, double dt, double tolerance, int max_iterations,
+                  struct viscous_report *report);
 
 #endif

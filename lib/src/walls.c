@@ -80,6 +80,19 @@ long walls_generate(const struct case_def *cfg, const struct wall_state *ws, dou
     return added;
 }
 
+/* The velocity of a moving wall at the end of the step from t_from by dt: its motion law's, or
+ * an external velocity (co-simulation input), which is constant over the step. */
+static void step_end_velocity(const struct motion *m, const struct wall_state *ws, double t_from, double dt,
+                              double *vx, double *vz)
+{
+    if (ws->ext) {
+        *vx = ws->ext_vx;
+        *vz = ws->ext_vz;
+    } else {
+        case_motion_velocity(m, t_from + dt, vx, vz);
+    }
+}
+
 /* Move the walls from t_from by dt: each moving wall translates by its velocity at mid-step
  * (exact for a law linear over the step), then takes the velocity and acceleration at t+dt. */
 void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct particles *P, double t_from, double dt)
@@ -92,13 +105,13 @@ void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct pa
         const struct motion *m = &cfg->motions[mo];
         struct wall_state *ws = &wstate[w];
         double vx, vz;
-        if (ws->ext) { /* external velocity (co-simulation input): constant over the step */
-            vx = ws->vx = ws->ext_vx;
-            vz = ws->vz = ws->ext_vz;
+        step_end_velocity(m, ws, t_from, dt, &ws->vx, &ws->vz);
+        if (ws->ext) {
+            vx = ws->vx;
+            vz = ws->vz;
             ws->ax = ws->az = 0.0;
         } else {
             case_motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
-            case_motion_velocity(m, t_from + dt, &ws->vx, &ws->vz);
             case_motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
         }
         dxw[w] = vx * dt;
@@ -157,6 +170,22 @@ void walls_clip(const struct case_def *cfg, const struct wall_state *wstate, con
     }
 }
 
+/* The kernel weight of a non-wall neighbour at (rx, rz) from a wall particle in the
+ * extrapolation onto it. */
+static inline double extrapolation_weight(const struct kernel *K, int wendland, double rx, double rz)
+{
+    const double q = kernel_q(K, rx * rx + rz * rz);
+    return wendland ? kernel_w_q(K, q, 1) : kernel_w_q(K, q, 0);
+}
+
+/* A wall particle's velocity in the viscous terms from the fluid's kernel average: the mirror
+ * about the wall's velocity (no-slip: the average at the wall is its velocity) or the average
+ * itself (free slip: no shear across it). */
+static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
+{
+    return noslip ? 2.0 * v_wall - v_fluid : v_fluid;
+}
+
 void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state *wstate, const struct kernel *K,
                              const struct gather *G, double dx, struct particles *P, size_t n, int n_threads)
 {
@@ -174,8 +203,7 @@ void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) { /* the non-wall neighbours */
             const size_t j = G->list[k];
             const double rx = xi - P->x[j], rz = zi - P->z[j];
-            const double q = kernel_q(K, rx * rx + rz * rz);
-            const double wgt = wendland ? kernel_w_q(K, q, 1) : kernel_w_q(K, q, 0);
+            const double wgt = extrapolation_weight(K, wendland, rx, rz);
             sw += wgt;
             sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
             svx += P->vx[j] * wgt;
@@ -186,8 +214,8 @@ void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state
         if (sw > 0.0) {
             const double pw = sp / sw;
             P->p[i] = pw > 0.0 ? pw : 0.0;
-            P->uvx[i] = noslip ? 2.0 * ws->vx - svx / sw : svx / sw;
-            P->uvz[i] = noslip ? 2.0 * ws->vz - svz / sw : svz / sw;
+            P->uvx[i] = mirror_velocity(noslip, ws->vx, svx / sw);
+            P->uvz[i] = mirror_velocity(noslip, ws->vz, svz / sw);
             P->rho[i] = srho / sw;
         } else {
             P->p[i] = 0.0;
@@ -197,5 +225,105 @@ void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state
         }
         P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
         P->inv_rho[i] = 1.0 / P->rho[i];
+    }
+}
+
+struct wall_mirror *walls_mirror_create(void) { return calloc(1, sizeof(struct wall_mirror)); }
+
+void walls_mirror_free(struct wall_mirror *M)
+{
+    if (!M) return;
+    free(M->weight);
+    free(M->cx);
+    free(M->cz);
+    free(M->sign);
+    free(M);
+}
+
+static int mirror_reserve(struct wall_mirror *M, size_t n, size_t n_list)
+{
+    if (M->cap_list < n_list) {
+        const size_t cap = n_list + n_list / 4 + 64;
+        double *w = realloc(M->weight, cap * sizeof(double));
+        if (!w) return -1;
+        M->weight = w;
+        M->cap_list = cap;
+    }
+    if (M->cap_n < n) {
+        const size_t cap = n + n / 4 + 64;
+        double *cx = realloc(M->cx, cap * sizeof(double));
+        if (!cx) return -1;
+        M->cx = cx;
+        double *cz = realloc(M->cz, cap * sizeof(double));
+        if (!cz) return -1;
+        M->cz = cz;
+        signed char *sg = realloc(M->sign, cap);
+        if (!sg) return -1;
+        M->sign = sg;
+        M->cap_n = cap;
+    }
+    return 0;
+}
+
+int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const struct kernel *K,
+                       const struct gather *G, const struct particles *P, size_t n, int n_threads)
+{
+    if (mirror_reserve(M, n, G->start[n]) != 0) return -1;
+    const int wendland = K->type == KERNEL_WENDLAND_C2;
+#pragma omp parallel for schedule(static) num_threads(n_threads)
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        double sw = 0.0;
+        for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
+            const size_t j = G->list[k];
+            M->weight[k] = extrapolation_weight(K, wendland, P->x[i] - P->x[j], P->z[i] - P->z[j]);
+            sw += M->weight[k];
+        }
+        const int noslip = cfg->walls[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
+        if (sw > 0.0) {
+            for (size_t k = G->start[i]; k < G->start[i + 1]; k++) M->weight[k] /= sw;
+            M->sign[i] = noslip ? -1 : 1;
+        } else { /* no fluid around it: the wall's velocity */
+            M->sign[i] = 0;
+        }
+    }
+    return 0;
+}
+
+void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *wstate,
+                     const struct particles *P, size_t n, double t_from, double dt, int n_threads)
+{
+    double vx[CASE_MAX_WALLS], vz[CASE_MAX_WALLS];
+    for (size_t w = 0; w < cfg->n_walls; w++) {
+        const int mo = cfg->walls[w].motion;
+        vx[w] = wstate[w].vx;
+        vz[w] = wstate[w].vz;
+        if (mo >= 0 && dt > 0.0) step_end_velocity(&cfg->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
+    }
+#pragma omp parallel for schedule(static) num_threads(n_threads)
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        const size_t w = particles_wall_index(P, i);
+        const int noslip = cfg->walls[w].slip == WALL_NO_SLIP;
+        M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
+        M->cz[i] = M->sign[i] ? mirror_velocity(noslip, vz[w], 0.0) : vz[w];
+    }
+}
+
+void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, const struct particles *P, size_t n,
+                        int with_constant, double *vx, double *vz, int n_threads)
+{
+    const double c = with_constant ? 1.0 : 0.0;
+#pragma omp parallel for schedule(static) num_threads(n_threads)
+    for (size_t i = 0; i < n; i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        double ax = 0.0, az = 0.0;
+        for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
+            const size_t j = G->list[k];
+            ax += M->weight[k] * vx[j];
+            az += M->weight[k] * vz[j];
+        }
+        vx[i] = c * M->cx[i] + M->sign[i] * ax;
+        vz[i] = c * M->cz[i] + M->sign[i] * az;
     }
 }

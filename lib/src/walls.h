@@ -48,4 +48,36 @@ void walls_clip(const struct case_def *cfg, const struct wall_state *ws, const d
 void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state *ws, const struct kernel *K,
                              const struct gather *G, double dx, struct particles *P, size_t n, int n_threads);
 
+/* The wall particles' velocity in the viscous terms as the affine map of the non-wall
+ * velocities that walls_extrapolate_fluid evaluates, for a solve whose unknowns are those
+ * velocities (viscous.h): wall particle g takes
+ *     u_g = c_g + s_g sum_k a_gk u_k,   a_gk = W_gk / sum_k W_gk over its non-wall neighbours,
+ * with s_g = -1, c_g = 2 v_w (no-slip) or s_g = +1, c_g = 0 (free slip), v_w its wall's
+ * velocity at the end of the step; a wall particle with no non-wall neighbour takes v_w. */
+struct wall_mirror {
+    double *weight;      /* a_gk, aligned with the gather list */
+    double *cx, *cz;     /* c_g [m/s] */
+    signed char *sign;   /* s_g */
+    size_t cap_list, cap_n;
+};
+
+struct wall_mirror *walls_mirror_create(void);
+void walls_mirror_free(struct wall_mirror *M);
+
+/** The map's weights and signs at the current positions, over the first n particles. Needs the
+ *  gather lists of G. Returns -1 when out of memory. */
+int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const struct kernel *K,
+                       const struct gather *G, const struct particles *P, size_t n, int n_threads);
+
+/** The map's constants with the walls' velocities at t_from + dt (dt > 0: by their motion law or
+ *  external velocity over the step from t_from, walls not yet moved) or their current ones
+ *  (dt = 0). */
+void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws,
+                     const struct particles *P, size_t n, double t_from, double dt, int n_threads);
+
+/** Overwrite the wall rows of (vx, vz) with the map of their non-wall rows: c_g + s_g a u
+ *  (with_constant) or s_g a u (its linear part). */
+void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, const struct particles *P, size_t n,
+                        int with_constant, double *vx, double *vz, int n_threads);
+
 #endif
