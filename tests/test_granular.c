@@ -40,6 +40,10 @@
  *     `test_granular known_failure heap_mobile` (CTest test_granular_known_heap_mobile,
  *     WILL_FAIL) fails while the heap moves, so CTest reports it the day the rheology holds the
  *     heap.
+ * (a3) The heap with the implicit viscous step and mu0 off (mu0 = mu_thr): the grains carry their
+ *     full frictional viscosity. With mu_thr = 1e12 Pa s it stays at rest over 1 s (the criterion
+ *     of (a2), met); with the Vajont mu_thr = 320 kPa s it holds until about 0.35 s and then
+ *     slumps (a known failure, `test_granular known_failure heap_implicit_vajont`).
  * (b) A square column collapses with the Vajont rheology (mu_thr = 320 kPa s, mu0 = 5 kPa s):
  *     it spreads, stops, and its final surface is no steeper than phi; its run-out against the
  *     experiments' is a known failure at the test's resolution (see the comment of (b) below). */
@@ -242,6 +246,80 @@ static void test_heap_mobile_at_rest(void **state)
     assert_true(worst <= 0.1 * HEAP_DX);
 }
 
+/* ---- (a3) the heap with the implicit viscous step and no limiting viscosity ------------------ */
+
+/* The heap of (a2) with numerics.viscosity = "implicit" and mu0 off, so the grains carry their
+ * full frictional viscosity up to mu_thr, which no explicit step could take (dt ~ rho h^2 / mu).
+ * Returns the largest displacement [m] at any 0.05 s sample to t_end; *mobile_least receives the
+ * fewest mobile grains at a sample (the heap is not merely held fixed). */
+static double implicit_heap(double mu_thr, double t_end, size_t *mobile_least)
+{
+    char text[2048];
+    snprintf(text, sizeof text, HEAP_CASE_FMT, mu_thr, mu_thr);
+    const mixsph_override ov[] = {{"numerics.viscosity", 1.0}};
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = mixsph_sim_create_from_text(text, "heap_implicit.json", ov, 1, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    double *x0, *z0;
+    positions_by_id(s, &x0, &z0);
+    mixsph_particles_view v;
+    double worst = 0.0;
+    *mobile_least = SIZE_MAX;
+    for (int k = 1; k <= (int)lround(t_end / 0.05); k++) {
+        advance(s, 0.05 * k);
+        assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
+        double now = 0.0;
+        size_t mobile = 0, grains = 0;
+        for (size_t i = 0; i < v.n; i++) {
+            if (v.state[i] == MIXSPH_STATE_WALL) continue;
+            assert_true(v.state[i] != MIXSPH_STATE_LOST);
+            now = fmax(now, hypot(v.x[i] - x0[v.id[i]], v.z[i] - z0[v.id[i]]));
+            mobile += v.state[i] == MIXSPH_STATE_MOBILE;
+            grains++;
+        }
+        worst = fmax(worst, now);
+        if (mobile < *mobile_least) *mobile_least = mobile;
+        print_message("  mu_thr = mu0 = %g Pa s: t = %.2f s, %llu steps, largest displacement %.3f dx, %zu of %zu "
+                      "grains mobile\n",
+                      mu_thr, mixsph_sim_time(s), (unsigned long long)mixsph_sim_steps(s), now / HEAP_DX, mobile, grains);
+    }
+    free(x0);
+    free(z0);
+    mixsph_sim_destroy(s);
+    return worst;
+}
+
+/* mu_thr = 1e12 Pa s: only grains at an exactly zero strain rate are held, the rest carry
+ * sigma' sin(phi) / (2 sqrt(II_D)) uncapped. Measured: 68 of 186 grains mobile, none moved by
+ * 0.001 dx over 1 s. */
+static void test_heap_implicit_frictional(void **state)
+{
+    (void)state;
+    size_t mobile = 0;
+    const double worst = implicit_heap(1.0e12, 1.0, &mobile);
+    assert_true(mobile > 0); /* the rheology holds mobile grains, not only fixed ones */
+    /* reference: at rest (slope 25 deg < phi = 35 deg; no creep without mu0); tolerance 0.1 dx
+     * (issue) over 1 s */
+    assert_true(worst <= 0.1 * HEAP_DX);
+}
+
+/* mu_thr = 320 kPa s (the Vajont case's): mobile grains carry at most mu_thr. Measured: within
+ * 0.004 dx to t = 0.35 s with 70-118 grains held fixed, then within 0.05 s every grain is
+ * mobile and the heap slumps, 3.1 dx by t = 1 s. Not explained yet (a mobile grain at 320 kPa s
+ * creeps at about 1e-4 m/s by the lubrication estimate of (a2), 0.01 dx in 1 s). A known
+ * failure: `test_granular known_failure heap_implicit_vajont`. */
+static void test_heap_implicit_vajont(void **state)
+{
+    (void)state;
+    size_t mobile = 0;
+    const double worst = implicit_heap(320.0e3, 1.0, &mobile);
+    /* reference: at rest (slope 25 deg < phi = 35 deg); tolerance 0.1 dx (issue) over 1 s */
+    assert_true(worst <= 0.1 * HEAP_DX);
+}
+
 /* ---- (b) column collapse ------------------------------------------------------------------- */
 
 /* A 0.2 x 0.2 m column (aspect ratio a = H0 / r0 = 1) against a left wall on a no-slip floor, run
@@ -407,16 +485,22 @@ int main(int argc, char **argv)
             const struct CMUnitTest known[] = {cmocka_unit_test(test_heap_mobile_at_rest)};
             return cmocka_run_group_tests(known, NULL, NULL);
         }
+        if (strcmp(argv[2], "heap_implicit_vajont") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_heap_implicit_vajont)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
         if (strcmp(argv[2], "column_runout") == 0) {
             const struct CMUnitTest known[] = {cmocka_unit_test(test_column_runout)};
             return cmocka_run_group_tests(known, NULL, NULL);
         }
-        fprintf(stderr, "test_granular: unknown known_failure '%s' (heap_mobile, column_runout)\n", argv[2]);
+        fprintf(stderr, "test_granular: unknown known_failure '%s' (heap_mobile, heap_implicit_vajont, column_runout)\n",
+                argv[2]);
         return 2;
     }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_heap_at_rest),
         cmocka_unit_test(test_heap_mobile),
+        cmocka_unit_test(test_heap_implicit_frictional),
         cmocka_unit_test(test_column_collapse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -99,7 +99,7 @@ static double channel_error(double mu, double t_end, double *dt_ratio)
         worst = fmax(worst, fabs(su[b] - sa[b]) / cnt[b] / U_LID);
     }
     print_message("mu = %g Pa s: %llu steps to t = %.3f s, dt = %.3g s = %.1f x the explicit viscous limit, "
-                  "%.1f CG iterations per step (at most %d); largest |u - u_exact| = %.2f%% of U\n",
+                  "%.1f solver iterations per step (at most %d); largest |u - u_exact| = %.2f%% of U\n",
                   mu, (unsigned long long)mixsph_sim_steps(s), mixsph_sim_time(s), s->dt, *dt_ratio,
                   (double)iterations / (double)mixsph_sim_steps(s), most, 100.0 * worst);
     mixsph_sim_destroy(s);

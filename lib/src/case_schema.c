@@ -101,7 +101,7 @@ static const struct case_key numerics_keys[] = {
     {.key = "viscosity", .type = CASE_CHOICE, DEF(0), .choices = viscous_schemes, .numeric_choice = 1,
      .field = CASE_FIELD(case_def, viscosity_implicit),
      .meaning = "the laminar viscous term: explicit (in the momentum pass, time step bounded by cfl_visc) or "
-                "implicit (backward Euler, solved by conjugate gradients; no viscous time-step bound)"},
+                "implicit (SDIRK2 with the walls in the solve, by BiCGSTAB; no viscous time-step bound)"},
     {.key = "viscous_tolerance", .type = CASE_NUMBER, RANGE(0, 1, 1e-2, 0), DEF(1e-6), .unit = "-",
      .field = CASE_FIELD(case_def, viscous_tolerance),
      .meaning = "implicit viscosity: relative residual ‖b − A u‖ / ‖b‖ at which a solve stops"},

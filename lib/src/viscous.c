@@ -121,20 +121,39 @@ static void fill_wall_rows(const struct solve_ctx *c, int with_constant, double 
 }
 
 /* out = A in on the unknown rows (0 on the others); `in` is zero on the prescribed non-wall rows
- * and gets its wall rows filled (the linear part of the mirror). */
-static int apply_a(const struct solve_ctx *c, int in, int out)
+ * and gets its wall rows filled (the linear part of the mirror). With dot >= 0, d receives the
+ * per-component products (v[dot] . out) and, with dot2 >= 0, (v[dot2] . out) too (d[2], d[3])
+ * and (out . out) (d[4], d[5]), summed in fixed blocks. */
+static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2, double d[N_SUMS])
 {
     double **v = c->V->v;
     fill_wall_rows(c, 0, v[in], v[in + 1]);
     if (forces_viscous_apply(c->F, c->S, v[in], v[in + 1], v[out], v[out + 1], NULL) != 0) return -1;
     const unsigned char *mob = c->V->mobile;
-    const double dt = c->dt;
+    const double kappa = c->dt;
+    const long nb = BLOCKS(c->n);
+    double *ox = v[out], *oz = v[out + 1];
+    const double *ix = v[in], *iz = v[in + 1], *mass = v[MASS];
+    const double *ax = v[dot < 0 ? out : dot], *az = v[dot < 0 ? out + 1 : dot + 1];
+    const double *bx = v[dot2 < 0 ? out : dot2], *bz = v[dot2 < 0 ? out + 1 : dot2 + 1];
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
-        const double keep = mob[i] ? 1.0 : 0.0;
-        v[out][i] = keep * (v[MASS][i] * v[in][i] + dt * v[out][i]);
-        v[out + 1][i] = keep * (v[MASS][i] * v[in + 1][i] + dt * v[out + 1][i]);
+    for (long bk = 0; bk < nb; bk++) {
+        BLOCK_RANGE(bk, c->n, i0, i1);
+        double t[N_SUMS] = {0.0};
+        for (size_t i = i0; i < i1; i++) {
+            const double keep = mob[i] ? 1.0 : 0.0;
+            ox[i] = keep * (mass[i] * ix[i] + kappa * ox[i]);
+            oz[i] = keep * (mass[i] * iz[i] + kappa * oz[i]);
+            t[0] += ax[i] * ox[i];
+            t[1] += az[i] * oz[i];
+            t[2] += bx[i] * ox[i];
+            t[3] += bz[i] * oz[i];
+            t[4] += ox[i] * ox[i];
+            t[5] += oz[i] * oz[i];
+        }
+        for (int k = 0; k < N_SUMS; k++) c->V->partial[N_SUMS * bk + k] = t[k];
     }
+    block_sums(c->V, nb, d);
     return 0;
 }
 
@@ -210,79 +229,91 @@ static int setup(const struct solve_ctx *c)
     return 0;
 }
 
-/* y = M^-1 p (zero on the prescribed rows, where MINV is 0). */
-static void precondition(const struct solve_ctx *c, int in, int out)
-{
-    double **v = c->V->v;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
-        v[out][i] = v[MINV][i] * v[in][i];
-        v[out + 1][i] = v[MINV][i] * v[in + 1][i];
-    }
-}
-
 static double ratio(double a, double b) { return b != 0.0 ? a / b : 0.0; }
 
-/* BiCGSTAB from the set-up's u0, r0 (= r^_0): returns the iterations, -1 when out of memory;
- * *r2 receives the final ||r||^2. */
+/* BiCGSTAB from the set-up's u0, r0 (= r^_0), right-preconditioned by M^-1; per iteration two
+ * operator passes and three vector passes, each with its dot products. Returns the iterations,
+ * -1 when out of memory; *r2 receives the final ||r||^2. */
 static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, double *r2)
 {
     double **v = c->V->v;
-    double d[6];
-    const int rr[1] = {RX};
-    dots(c, 1, rr, rr, d);
+    const size_t n = c->n;
+    const long nb = BLOCKS(n);
+    double d[N_SUMS];
+    const int rr[2] = {RX, RHX};
+    dots(c, 2, rr, rr + 0, d); /* (r, r), (r^, r) with r^ = r */
     *r2 = d[0] + d[1];
+    double rho_new[2] = {d[0], d[1]};
     double rho[2] = {1.0, 1.0}, alpha[2] = {1.0, 1.0}, omega[2] = {1.0, 1.0};
     int it = 0;
     while (*r2 > tol2 && it < max_iterations) {
-        const int pair_rh_r[1] = {RHX}, pair_r[1] = {RX};
-        dots(c, 1, pair_rh_r, pair_r, d);
         double beta[2];
         for (int k = 0; k < 2; k++) {
-            beta[k] = ratio(d[k], rho[k]) * ratio(alpha[k], omega[k]);
-            rho[k] = d[k];
+            beta[k] = ratio(rho_new[k], rho[k]) * ratio(alpha[k], omega[k]);
+            rho[k] = rho_new[k];
         }
+        /* p = r + beta (p - omega v), y = M^-1 p */
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (size_t i = 0; i < c->n; i++) {
+        for (size_t i = 0; i < n; i++) {
             v[PX][i] = v[RX][i] + beta[0] * (v[PX][i] - omega[0] * v[VX][i]);
             v[PZ][i] = v[RZ][i] + beta[1] * (v[PZ][i] - omega[1] * v[VZ][i]);
+            v[YX][i] = v[MINV][i] * v[PX][i];
+            v[YZ][i] = v[MINV][i] * v[PZ][i];
         }
-        precondition(c, PX, YX);
-        if (apply_a(c, YX, VX) != 0) return -1;
-        const int pair_rh[1] = {RHX}, pair_v[1] = {VX};
-        dots(c, 1, pair_rh, pair_v, d);
+        if (apply_a(c, YX, VX, RHX, -1, d) != 0) return -1; /* v = A y, (r^, v) */
         for (int k = 0; k < 2; k++) alpha[k] = ratio(rho[k], d[k]);
+        /* u += alpha y, s = r - alpha v, z = M^-1 s, (s, s) */
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (size_t i = 0; i < c->n; i++) {
-            v[UX][i] += alpha[0] * v[YX][i];
-            v[UZ][i] += alpha[1] * v[YZ][i];
-            v[SX][i] = v[RX][i] - alpha[0] * v[VX][i];
-            v[SZ][i] = v[RZ][i] - alpha[1] * v[VZ][i];
+        for (long bk = 0; bk < nb; bk++) {
+            BLOCK_RANGE(bk, n, i0, i1);
+            double t[2] = {0.0, 0.0};
+            for (size_t i = i0; i < i1; i++) {
+                v[UX][i] += alpha[0] * v[YX][i];
+                v[UZ][i] += alpha[1] * v[YZ][i];
+                v[SX][i] = v[RX][i] - alpha[0] * v[VX][i];
+                v[SZ][i] = v[RZ][i] - alpha[1] * v[VZ][i];
+                v[ZX][i] = v[MINV][i] * v[SX][i];
+                v[ZZ][i] = v[MINV][i] * v[SZ][i];
+                t[0] += v[SX][i] * v[SX][i];
+                t[1] += v[SZ][i] * v[SZ][i];
+            }
+            double *part = c->V->partial + N_SUMS * bk;
+            part[0] = t[0];
+            part[1] = t[1];
+            for (int k = 2; k < N_SUMS; k++) part[k] = 0.0;
         }
+        block_sums(c->V, nb, d);
         it++;
-        const int ss[1] = {SX};
-        dots(c, 1, ss, ss, d);
         if (!(d[0] + d[1] > tol2)) { /* converged at the half step */
             *r2 = d[0] + d[1];
-            memcpy(v[RX], v[SX], c->n * sizeof(double));
-            memcpy(v[RZ], v[SZ], c->n * sizeof(double));
             break;
         }
-        precondition(c, SX, ZX);
-        if (apply_a(c, ZX, TX) != 0) return -1;
-        const int ta[2] = {TX, TX}, tb[2] = {SX, TX};
-        dots(c, 2, ta, tb, d);
-        omega[0] = ratio(d[0], d[2]);
-        omega[1] = ratio(d[1], d[3]);
+        if (apply_a(c, ZX, TX, SX, -1, d) != 0) return -1; /* t = A z, (s, t), (t, t) */
+        omega[0] = ratio(d[0], d[4]);
+        omega[1] = ratio(d[1], d[5]);
+        /* u += omega z, r = s - omega t, (r, r), (r^, r) */
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (size_t i = 0; i < c->n; i++) {
-            v[UX][i] += omega[0] * v[ZX][i];
-            v[UZ][i] += omega[1] * v[ZZ][i];
-            v[RX][i] = v[SX][i] - omega[0] * v[TX][i];
-            v[RZ][i] = v[SZ][i] - omega[1] * v[TZ][i];
+        for (long bk = 0; bk < nb; bk++) {
+            BLOCK_RANGE(bk, n, i0, i1);
+            double t[4] = {0.0, 0.0, 0.0, 0.0};
+            for (size_t i = i0; i < i1; i++) {
+                v[UX][i] += omega[0] * v[ZX][i];
+                v[UZ][i] += omega[1] * v[ZZ][i];
+                v[RX][i] = v[SX][i] - omega[0] * v[TX][i];
+                v[RZ][i] = v[SZ][i] - omega[1] * v[TZ][i];
+                t[0] += v[RX][i] * v[RX][i];
+                t[1] += v[RZ][i] * v[RZ][i];
+                t[2] += v[RHX][i] * v[RX][i];
+                t[3] += v[RHZ][i] * v[RZ][i];
+            }
+            double *part = c->V->partial + N_SUMS * bk;
+            for (int k = 0; k < 4; k++) part[k] = t[k];
+            part[4] = part[5] = 0.0;
         }
-        dots(c, 1, rr, rr, d);
+        block_sums(c->V, nb, d);
         *r2 = d[0] + d[1];
+        rho_new[0] = d[2];
+        rho_new[1] = d[3];
     }
     return it;
 }

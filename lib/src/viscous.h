@@ -1,13 +1,14 @@
-/* viscous.h - the implicit viscous step (numerics.viscosity = "implicit"; docs/numerics.md):
- * backward Euler for the velocity under the viscous operator of the momentum equation, with the
- * operator (positions, viscosities, kernel factors) frozen over the step,
- *     m_i u_i + dt sum_j w_ij (u_i - u_j) = m_i u*_i        for the mobile particles i,
- * u* the velocity after the step's other forces, w_ij >= 0 the couplings of the momentum pass
- * (forces.h). Wall particles (at their no-slip mirror or free-slip velocity) and grains held
- * fixed enter as prescribed velocities. The system is symmetric positive definite; it is solved
- * matrix-free by a Jacobi-preconditioned conjugate gradient, warm-started from the last step's
- * viscous increment (kept per particle). Dot products are summed in fixed blocks, so results do
- * not depend on the thread count. */
+/* viscous.h - the implicit viscous step (numerics.viscosity = "implicit"; docs/numerics.md
+ * section 2b): the velocity under the viscous operator of the momentum equation, with the
+ * operator (positions, viscosities, kernel factors) frozen over the step, by a two-stage SDIRK
+ * whose stages are backward-Euler-like solves
+ *     m_i u_i + kappa sum_j w_ij (u_i - u_j) = m_i w_i        for the unknown particles i,
+ * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
+ * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
+ * of a hold_fixed medium are prescribed. The system is solved matrix-free by BiCGSTAB with a
+ * Jacobi preconditioner, each stage warm-started from its increment of the last step (kept per
+ * particle). Dot products are summed in fixed blocks, so results do not depend on the thread
+ * count. */
 #ifndef MIXSPH_VISCOUS_H
 #define MIXSPH_VISCOUS_H
 #include <stddef.h>

@@ -237,6 +237,7 @@ void walls_mirror_free(struct wall_mirror *M)
     free(M->cx);
     free(M->cz);
     free(M->sign);
+    free(M->rows);
     free(M);
 }
 
@@ -260,6 +261,9 @@ static int mirror_reserve(struct wall_mirror *M, size_t n, size_t n_list)
         signed char *sg = realloc(M->sign, cap);
         if (!sg) return -1;
         M->sign = sg;
+        size_t *rows = realloc(M->rows, cap * sizeof(size_t));
+        if (!rows) return -1;
+        M->rows = rows;
         M->cap_n = cap;
     }
     return 0;
@@ -269,10 +273,13 @@ int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const 
                        const struct gather *G, const struct particles *P, size_t n, int n_threads)
 {
     if (mirror_reserve(M, n, G->start[n]) != 0) return -1;
+    M->n_rows = 0;
+    for (size_t i = 0; i < n; i++)
+        if (P->state[i] == MIXSPH_STATE_WALL) M->rows[M->n_rows++] = i;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
 #pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+    for (size_t r = 0; r < M->n_rows; r++) {
+        const size_t i = M->rows[r];
         double sw = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
             const size_t j = G->list[k];
@@ -300,9 +307,10 @@ void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const st
         vz[w] = wstate[w].vz;
         if (mo >= 0 && dt > 0.0) step_end_velocity(&cfg->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
     }
+    (void)n;
 #pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+    for (size_t r = 0; r < M->n_rows; r++) {
+        const size_t i = M->rows[r];
         const size_t w = particles_wall_index(P, i);
         const int noslip = cfg->walls[w].slip == WALL_NO_SLIP;
         M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
@@ -314,9 +322,11 @@ void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, con
                         int with_constant, double *vx, double *vz, int n_threads)
 {
     const double c = with_constant ? 1.0 : 0.0;
+    (void)P;
+    (void)n;
 #pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+    for (size_t r = 0; r < M->n_rows; r++) {
+        const size_t i = M->rows[r];
         double ax = 0.0, az = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
             const size_t j = G->list[k];

@@ -58,6 +58,8 @@ struct wall_mirror {
     double *weight;      /* a_gk, aligned with the gather list */
     double *cx, *cz;     /* c_g [m/s] */
     signed char *sign;   /* s_g */
+    size_t *rows;        /* the wall particles among the first n, in order */
+    size_t n_rows;
     size_t cap_list, cap_n;
 };
 
