@@ -1,8 +1,10 @@
 /* budget.c - see budget.h. The estimates are "about": a body's particles are its area (clipped to
  * its z_min..z_max) over dx^2, which the lattice fill meets to within its boundary rows; overlapping
- * bodies count twice, so the estimate errs on the high side only there. The steps use the largest
- * time step criterion (4) allows at rest (integrate.h), so the estimate is a lower bound: a case it
- * refuses would take at least that many steps. */
+ * bodies count twice, so the estimate errs on the high side only there (tests/test_budget.c: within
+ * 10 % for the bundled cases). The steps use the largest time step criterion (4) allows at rest at
+ * the reference density (integrate.h), so the estimate is a lower bound up to the density
+ * variation of a weakly compressible run (about 1 %): a case it refuses would take about that
+ * many steps or more. */
 #include "budget.h"
 
 #include <math.h>
