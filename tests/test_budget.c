@@ -49,12 +49,7 @@ static double body_sites(const struct case_def *c, size_t k)
 {
     const struct body *bd = &c->bodies[k];
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY, n = 0.0;
-    for (size_t j = 0; j < bd->polygon.n; j++) {
-        x0 = fmin(x0, bd->polygon.x[j]);
-        x1 = fmax(x1, bd->polygon.x[j]);
-        z0 = fmin(z0, bd->polygon.z[j]);
-        z1 = fmax(z1, bd->polygon.z[j]);
-    }
+    geom_grow_box(&bd->polygon, &x0, &x1, &z0, &z1);
     for (long kk = (long)floor(z0 / c->dx) - 1; kk <= (long)ceil(z1 / c->dx) + 1; kk++)
         for (long i = (long)floor(x0 / c->dx) - 1; i <= (long)ceil(x1 / c->dx) + 1; i++) {
             const double x = (i + 0.5) * c->dx, z = (kk + 0.5) * c->dx;

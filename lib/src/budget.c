@@ -27,16 +27,6 @@ static double box_sites(double x0, double x1, double z0, double z1, double dx)
     return (floor((x1 - x0) / dx) + 3.0) * (floor((z1 - z0) / dx) + 3.0);
 }
 
-static void polyline_box(const struct polyline *p, double *x0, double *x1, double *z0, double *z1)
-{
-    for (size_t k = 0; k < p->n; k++) {
-        *x0 = fmin(*x0, p->x[k]);
-        *x1 = fmax(*x1, p->x[k]);
-        *z0 = fmin(*z0, p->z[k]);
-        *z1 = fmax(*z1, p->z[k]);
-    }
-}
-
 /* Particles of body k. */
 static double body_particles(const struct case_def *c, size_t k)
 {
@@ -55,7 +45,7 @@ static double wall_sites(const struct case_def *c, size_t k)
 {
     const double depth = c->wall_layers * c->dx;
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
-    polyline_box(&c->walls[k].line, &x0, &x1, &z0, &z1);
+    geom_grow_box(&c->walls[k].line, &x0, &x1, &z0, &z1);
     return box_sites(x0 - depth, x1 + depth, z0 - depth, z1 + depth, c->dx);
 }
 
@@ -82,7 +72,7 @@ void budget_estimate(const struct case_def *c, struct budget *b)
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
     for (size_t k = 0; k < c->n_bodies; k++) {
         b->particles += body_particles(c, k);
-        polyline_box(&c->bodies[k].polygon, &x0, &x1, &z0, &z1);
+        geom_grow_box(&c->bodies[k].polygon, &x0, &x1, &z0, &z1);
     }
     if (c->n_bodies > 0) b->lattice_sites = box_sites(x0, x1, z0, z1, c->dx);
     for (size_t k = 0; k < c->n_walls; k++) {
@@ -171,7 +161,7 @@ mixsph_status budget_check(const struct case_def *c, char *err, size_t err_len)
         num(b.steps, est, sizeof est);
         num(c->max_steps, lim, sizeof lim);
         return status_set(err, err_len, MIXSPH_ERR_CASE,
-                          "%s: numerics.t_end: %s s gives at least %s time steps (criterion (4) at dx = %g m), " OVER,
+                          "%s: numerics.t_end: %s s gives about %s time steps (criterion (4) at dx = %g m), " OVER,
                           c->origin, val, est, c->dx, lim, "numerics.max_steps");
     }
     return MIXSPH_OK;

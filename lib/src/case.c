@@ -543,12 +543,7 @@ static mixsph_status read_domain_rules(const struct case_reader *r, const struct
     for (size_t k = 0; k < c->n_bodies && c->has_domain; k++) {
         const struct body *bd = &c->bodies[k];
         double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
-        for (size_t j = 0; j < bd->polygon.n; j++) {
-            x0 = fmin(x0, bd->polygon.x[j]);
-            x1 = fmax(x1, bd->polygon.x[j]);
-            z0 = fmin(z0, bd->polygon.z[j]);
-            z1 = fmax(z1, bd->polygon.z[j]);
-        }
+        geom_grow_box(&bd->polygon, &x0, &x1, &z0, &z1);
         z0 = fmax(z0, bd->z_min);
         z1 = fmin(z1, bd->z_max);
         const double *d = c->domain;

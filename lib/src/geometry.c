@@ -118,6 +118,16 @@ double geom_polygon_area_in_band(const struct polyline *poly, double z_min, doub
     return 0.5 * fabs(twice);
 }
 
+void geom_grow_box(const struct polyline *p, double *x0, double *x1, double *z0, double *z1)
+{
+    for (size_t k = 0; k < p->n; k++) {
+        *x0 = fmin(*x0, p->x[k]);
+        *x1 = fmax(*x1, p->x[k]);
+        *z0 = fmin(*z0, p->z[k]);
+        *z1 = fmax(*z1, p->z[k]);
+    }
+}
+
 double geom_polyline_length(const struct polyline *line)
 {
     double len = 0.0;
