@@ -6,9 +6,11 @@
  *              [--no-csv]
  *
  * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
- * on stdout and summary.json in the output folder. SIGINT or SIGTERM (Ctrl-C) stops the run at the
- * next progress step with a checkpoint (a second one kills at once). Exit codes: 0 ok, 2 bad usage or input,
- * 3 unstable run, 4 out of memory or output failure. */
+ * on stdout and summary.json in the output folder. SIGINT or SIGTERM (Ctrl-C) stops the run before
+ * the next time step with a checkpoint, and the creation of the simulation at once (the library
+ * polls the flag the handler sets; a second signal kills at once). Exit codes: 0 ok, 2 bad usage or
+ * input, 3 unstable run, 4 out of memory or output failure, 128 + the signal (130 SIGINT, 143
+ * SIGTERM) stopped by a signal. */
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -45,6 +47,24 @@ static void usage(FILE *f)
 static volatile sig_atomic_t stop_signal = 0;
 
 static void on_stop_signal(int sig) { stop_signal = sig; }
+
+/* The library's interrupt poll (mixsph_interrupt): has a stop signal arrived? */
+static int stop_requested(void *user)
+{
+    (void)user;
+    return stop_signal != 0;
+}
+
+static void install_stop_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_stop_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESETHAND | SA_RESTART; /* a second signal has its default effect */
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
 
 static int exit_code(mixsph_status st)
 {
@@ -257,8 +277,14 @@ static int cmd_run(int argc, char **argv)
         return 2;
     }
     mixsph_sim *s = NULL;
-    mixsph_status st = restart ? mixsph_sim_create_from_checkpoint(restart, &s, err, sizeof err)
-                               : mixsph_sim_create(case_path, sets, n_sets, &s, err, sizeof err);
+    install_stop_handlers();
+    const mixsph_interrupt interrupt = {stop_requested, NULL};
+    mixsph_status st = restart ? mixsph_sim_create_from_checkpoint_interruptible(restart, &interrupt, &s, err, sizeof err)
+                               : mixsph_sim_create_interruptible(case_path, sets, n_sets, &interrupt, &s, err, sizeof err);
+    if (st == MIXSPH_ERR_INTERRUPTED) {
+        fprintf(stderr, "mixsph: stopped by signal %d while creating the simulation (%s)\n", (int)stop_signal, err);
+        return 128 + (int)stop_signal;
+    }
     if (st != MIXSPH_OK) {
         fprintf(stderr, "mixsph: %s\n", err);
         return exit_code(st);
@@ -297,15 +323,9 @@ static int cmd_run(int argc, char **argv)
     double last_print = 0.0, last_ckpt = t0;
     unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
-    struct sigaction sa;
-    memset(&sa, 0, sizeof sa);
-    sa.sa_handler = on_stop_signal;
-    sigemptyset(&sa.sa_mask);
-    sa.sa_flags = SA_RESETHAND | SA_RESTART; /* a second signal has its default effect */
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
     for (int c = 1; c <= chunks && st == MIXSPH_OK && !stop_signal; c++) {
         st = mixsph_sim_advance_to(s, t_end * c / chunks);
+        if (st == MIXSPH_ERR_INTERRUPTED) st = MIXSPH_OK; /* a signal, between two steps: stopped below */
         if (st == MIXSPH_OK && ckpt_every >= 0.0 && c < chunks && mixsph_sim_steps(s) > ckpt_step &&
             now() - last_ckpt >= ckpt_every) {
             st = mixsph_sim_write_checkpoint(s, ckpt);

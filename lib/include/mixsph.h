@@ -19,14 +19,16 @@
 extern "C" {
 #endif
 
-/** Status codes, from one list, ordered by severity. */
+/** Status codes, from one list, ordered by severity; the last, MIXSPH_ERR_INTERRUPTED, is no
+ *  failure of the case: the host asked the call to stop (mixsph_interrupt). */
 #define MIXSPH_STATUS_LIST(X)                                                         \
     X(MIXSPH_OK, "ok")                                                                \
     X(MIXSPH_ERR_ARG, "invalid argument")                                             \
     X(MIXSPH_ERR_CASE, "invalid case file")                                           \
     X(MIXSPH_ERR_IO, "input/output error")                                            \
     X(MIXSPH_ERR_UNSTABLE, "unstable run (non-finite value or collapsed time step)")  \
-    X(MIXSPH_ERR_NOMEM, "out of memory")
+    X(MIXSPH_ERR_NOMEM, "out of memory")                                              \
+    X(MIXSPH_ERR_INTERRUPTED, "interrupted by the host")
 
 typedef enum {
 #define MIXSPH_X_ENUM(name, text) name,
@@ -64,6 +66,30 @@ mixsph_status mixsph_sim_create(const char *case_path, const mixsph_override *ov
 mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *origin,
                                           const mixsph_override *ov, size_t n_ov,
                                           mixsph_sim **out, char *err, size_t err_len);
+
+/**
+ * A host's request to stop a long call. `requested(user)` returns nonzero once the host wants the
+ * library to stop; the library polls it while it creates a simulation (every lattice row of the
+ * bodies' and walls' fill, and between the phases of the creation) and before every step of
+ * mixsph_sim_advance_to, and the call then returns MIXSPH_ERR_INTERRUPTED. A simulation stopped in
+ * mixsph_sim_advance_to is at the end of a whole step (it can be saved or continued). The library
+ * installs no signal handler: a host (the mixsph executable, the FMU) sets a flag in its own handler
+ * and passes a function that reads it.
+ */
+typedef int (*mixsph_interrupt_fn)(void *user);
+typedef struct {
+    mixsph_interrupt_fn requested; /**< NULL: never interrupted */
+    void *user;                    /**< passed to `requested` */
+} mixsph_interrupt;
+
+/** As mixsph_sim_create, polling `interrupt` (may be NULL) during the creation; the simulation
+ *  keeps it for mixsph_sim_advance_to. */
+mixsph_status mixsph_sim_create_interruptible(const char *case_path, const mixsph_override *ov, size_t n_ov,
+                                              const mixsph_interrupt *interrupt, mixsph_sim **out, char *err,
+                                              size_t err_len);
+
+/** Poll `interrupt` (NULL: nothing) before every step of mixsph_sim_advance_to from now on. */
+void mixsph_sim_set_interrupt(mixsph_sim *s, const mixsph_interrupt *interrupt);
 
 /** Destroy a simulation and close its files (NULL-safe). */
 void mixsph_sim_destroy(mixsph_sim *s);
@@ -172,6 +198,9 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path);
 /** Create a simulation from a checkpoint file (restart). A missing file or one that is not a
  *  mixsph checkpoint is MIXSPH_ERR_ARG, a failed read MIXSPH_ERR_IO. */
 mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len);
+/** As mixsph_sim_create_from_checkpoint, polling `interrupt` (may be NULL) while the case is rebuilt. */
+mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
+                                                              mixsph_sim **out, char *err, size_t err_len);
 
 /** As mixsph_sim_set_output_dir for a simulation restored from a checkpoint, continuing the
  *  run's files in `dir`: monitors.csv keeps its rows up to the restored state and is appended

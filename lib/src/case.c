@@ -11,6 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "budget.h"
 #include "case_schema.h"
 #include "status.h"
 
@@ -139,10 +140,45 @@ static const cJSON *item(const cJSON *obj, const char *key) { return cJSON_GetOb
 
 static const struct case_section *section(const char *id) { return case_schema_find(id); }
 
-static mixsph_status copy_name(const struct case_reader *r, const char *path, const char *name, char *dst)
+/* Names end up in CSV headers, file names, JSON and FMU variable lookups unquoted: a plain
+ * identifier (a letter or '_', then letters, digits, '_' or '-') can be written anywhere safely. */
+static int plain_identifier(const char *name)
 {
+    const unsigned char *c = (const unsigned char *)name;
+    if (!((*c >= 'A' && *c <= 'Z') || (*c >= 'a' && *c <= 'z') || *c == '_')) return 0;
+    for (c++; *c; c++)
+        if (!((*c >= 'A' && *c <= 'Z') || (*c >= 'a' && *c <= 'z') || (*c >= '0' && *c <= '9') || *c == '_' ||
+              *c == '-'))
+            return 0;
+    return 1;
+}
+
+#define NAME_RULE "a letter or '_', then letters, digits, '_' or '-'"
+
+/* A name as a C string literal for a message (quotes, backslashes and control characters escaped),
+ * cut short to fit. */
+static void quoted_name(const char *name, char *buf, size_t len)
+{
+    size_t at = 0;
+    buf[at++] = '"';
+    for (const unsigned char *c = (const unsigned char *)name; *c && at + 8 < len; c++) {
+        if (*c == '"' || *c == '\\') at += (size_t)snprintf(buf + at, len - at, "\\%c", *c);
+        else if (*c == '\n') at += (size_t)snprintf(buf + at, len - at, "\\n");
+        else if (*c < 0x20 || *c >= 0x7f) at += (size_t)snprintf(buf + at, len - at, "\\x%02x", *c);
+        else buf[at++] = (char)*c;
+    }
+    snprintf(buf + at, len - at, "\"");
+}
+
+/* Name `name` of an entry of section `sec` ("media", ...) into dst. */
+static mixsph_status copy_name(const struct case_reader *r, const char *sec, const char *name, char *dst)
+{
+    char q[2 * CASE_NAME_LEN + 16];
+    quoted_name(name, q, sizeof q);
     if (strlen(name) == 0 || strlen(name) >= CASE_NAME_LEN)
-        return FAIL(r, "%s: %s: name must have 1 to %d characters", r->origin, path, CASE_NAME_LEN - 1);
+        return FAIL(r, "%s: %s: the name %s must have 1 to %d characters", r->origin, sec, q, CASE_NAME_LEN - 1);
+    if (!plain_identifier(name))
+        return FAIL(r, "%s: %s: the name %s is not a plain identifier (expected " NAME_RULE ")", r->origin, sec, q);
     strcpy(dst, name);
     return MIXSPH_OK;
 }
@@ -151,10 +187,11 @@ static mixsph_status copy_name(const struct case_reader *r, const char *path, co
 static mixsph_status entry(const struct case_reader *r, const cJSON *it, const char *sec, size_t n, size_t max,
                            char *path, size_t len, char *name)
 {
+    TRY(copy_name(r, sec, it->string, name)); /* first: the path would hold the name */
     snprintf(path, len, "%s.%s", sec, it->string);
     if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, path);
     if (n == max) return FAIL(r, "%s: %s: at most %zu entries", r->origin, sec, max);
-    return copy_name(r, path, it->string, name);
+    return MIXSPH_OK;
 }
 
 static int find_medium(const struct case_def *c, const char *name)
@@ -440,6 +477,11 @@ static mixsph_status read_full_scale(const struct case_reader *r, const cJSON *r
     return MIXSPH_OK;
 }
 
+double case_profile_bin_count(const struct monitor_def *md)
+{
+    return fmax(1.0, ceil((md->x_max - md->x_min) / md->bin));
+}
+
 double case_full_scale_z(const struct case_def *c, double z)
 {
     return c->full_scale.on ? c->full_scale.z_scale * z + c->full_scale.z_offset : z;
@@ -467,9 +509,14 @@ static mixsph_status substitute(const struct case_reader *r, const cJSON *params
             if (!cJSON_IsNumber(p))
                 return FAIL(r, "%s: %s: '%s' is not one of the numeric parameters", r->origin, path, it->valuestring);
             cJSON *num = cJSON_CreateNumber(p->valuedouble);
-            const int ok = num && (it->string ? cJSON_ReplaceItemInObjectCaseSensitive(node, it->string, num)
-                                              : cJSON_ReplaceItemViaPointer(node, it, num));
-            if (!ok) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+            if (!num) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+            /* replace this very item (not the first of its name: that loops on a duplicate key) */
+            num->string = it->string;
+            it->string = NULL;
+            if (!cJSON_ReplaceItemViaPointer(node, it, num)) {
+                cJSON_Delete(num);
+                return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+            }
             it = num;
         } else if (cJSON_IsObject(it) || cJSON_IsArray(it)) {
             TRY(substitute(r, params, it, path, len));
@@ -490,10 +537,70 @@ static mixsph_status apply_parameters(const struct case_reader *r, cJSON *root)
     return substitute(r, params, root, path, sizeof path);
 }
 
+/* A body that lies wholly outside the case's domain would be dropped by the fill: refuse it. */
+static mixsph_status read_domain_rules(const struct case_reader *r, const struct case_def *c)
+{
+    for (size_t k = 0; k < c->n_bodies && c->has_domain; k++) {
+        const struct body *bd = &c->bodies[k];
+        double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
+        geom_grow_box(&bd->polygon, &x0, &x1, &z0, &z1);
+        z0 = fmax(z0, bd->z_min);
+        z1 = fmin(z1, bd->z_max);
+        const double *d = c->domain;
+        if (!(x1 > d[0] && x0 < d[1] && z1 > d[2] && z0 < d[3] && z1 > z0))
+            return FAIL(r, "%s: bodies.%s: lies wholly outside the domain [%g, %g] x [%g, %g] (within its z_min..z_max)",
+                        r->origin, bd->name, d[0], d[1], d[2], d[3]);
+    }
+    return MIXSPH_OK;
+}
+
+/* ---- duplicate keys --------------------------------------------------------------------------
+ * cJSON keeps every member of an object, and which of two equal keys a lookup finds is an
+ * accident of the parser: a key given twice is refused. */
+static int name_cmp(const void *a, const void *b) { return strcmp(*(const char *const *)a, *(const char *const *)b); }
+
+static mixsph_status refuse_duplicates(const struct case_reader *r, const cJSON *node, char *path, size_t len)
+{
+    size_t n = 0, k = 0;
+    for (const cJSON *it = node->child; it; it = it->next) n++;
+    if (cJSON_IsObject(node) && n > 1) {
+        const char **names = malloc(n * sizeof *names);
+        if (!names) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+        for (const cJSON *it = node->child; it; it = it->next) names[k++] = it->string ? it->string : "";
+        qsort(names, n, sizeof *names, name_cmp);
+        for (k = 1; k < n && strcmp(names[k], names[k - 1]) != 0; k++) continue;
+        if (k < n) {
+            char q[2 * CASE_NAME_LEN + 16];
+            quoted_name(names[k], q, sizeof q);
+            const mixsph_status st = FAIL(r, "%s: %s: the key %s is given twice in one object (expected each key "
+                                             "once)", r->origin, *path ? path : "the case", q);
+            free(names);
+            return st;
+        }
+        free(names);
+    }
+    k = 0;
+    for (const cJSON *it = node->child; it; it = it->next, k++) {
+        if (!cJSON_IsObject(it) && !cJSON_IsArray(it)) continue;
+        const size_t l0 = strlen(path);
+        if (it->string) snprintf(path + l0, len - l0, "%s%s", l0 ? "." : "", it->string);
+        else snprintf(path + l0, len - l0, "[%zu]", k);
+        TRY(refuse_duplicates(r, it, path, len));
+        path[l0] = '\0';
+    }
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_root(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     if (!cJSON_IsObject(root)) return FAIL(r, "%s: the case must be a JSON object", r->origin);
     TRY(case_schema_read(r, root, "", section("case"), 0, c));
+    if (!plain_identifier(c->name)) {
+        char q[2 * CASE_NAME_LEN + 16];
+        quoted_name(c->name, q, sizeof q);
+        return FAIL(r, "%s: name: %s is not a plain identifier (expected " NAME_RULE "; it names the output folder)",
+                    r->origin, q);
+    }
     TRY(read_numerics(r, root, c));
     const cJSON *d = item(root, "domain");
     if (d) {
@@ -511,8 +618,13 @@ static mixsph_status read_root(const struct case_reader *r, const cJSON *root, s
     c->monitor_interval = c->t_end / 200.0;
     c->snapshot_interval = 0.0;
     const cJSON *o = item(root, "output");
-    if (o) TRY(case_schema_read(r, o, "output", section("output"), 0, c));
-    return MIXSPH_OK;
+    cJSON *none = o ? NULL : cJSON_CreateObject(); /* the output keys' defaults */
+    if (!o && !none) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    const mixsph_status st = case_schema_read(r, o ? o : none, "output", section("output"), 0, c);
+    cJSON_Delete(none);
+    if (st != MIXSPH_OK) return st;
+    TRY(read_domain_rules(r, c));
+    return budget_check(c, r->err, r->err_len);
 }
 
 mixsph_status case_parse(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,
@@ -529,7 +641,8 @@ mixsph_status case_parse(const char *json_text, const char *origin, const mixsph
         for (const char *p = json_text; where && p < where; p++) line += *p == '\n';
         return FAIL(&r, "%s: line %zu: not valid JSON", r.origin, line);
     }
-    mixsph_status st = MIXSPH_OK;
+    char path[512] = "";
+    mixsph_status st = refuse_duplicates(&r, root, path, sizeof path);
     for (size_t k = 0; k < n_ov && st == MIXSPH_OK; k++) st = apply_override(&r, root, &ov[k]);
     if (st == MIXSPH_OK) st = apply_parameters(&r, root);
     if (st == MIXSPH_OK) st = read_root(&r, root, c);

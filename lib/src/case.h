@@ -136,6 +136,14 @@ struct case_def {
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */
     double monitor_interval;  /* [s] */
     double snapshot_interval; /* [s], 0 = none */
+    /* the resource budget (budget.h): limits on what the case asks for, checked from the case
+     * alone before anything is allocated; numerics.max_* and output.max_* */
+    double max_particles;       /* fluid, granular and wall particles [-] */
+    double max_lattice_sites;   /* lattice sites scanned to fill the bodies and walls [-] */
+    double max_steps;           /* estimated time steps to t_end [-] */
+    double max_monitor_rows;    /* rows of monitors.csv [-] */
+    double max_profile_bins;    /* bins of one profile monitor [-] */
+    double max_snapshot_bytes;  /* bytes of all particle snapshots (CSV and HDF5) [B] */
     size_t n_media, n_bodies, n_walls, n_motions, n_monitors;
     struct medium media[CASE_MAX_MEDIA];
     struct body bodies[CASE_MAX_BODIES];
@@ -158,6 +166,10 @@ void case_free(struct case_def *c);
 double case_full_scale_z(const struct case_def *c, double z);
 /** The error (13) [%] of a full-scale elevation Z against the case's reference (NAN without one). */
 double case_full_scale_error(const struct case_def *c, double Z);
+
+/** Number of x bins of a profile monitor: ceil(width / bin), at least 1 (not finite when the
+ *  bin is too small to count them; the budget refuses that). */
+double case_profile_bin_count(const struct monitor_def *md);
 
 /** Velocity of a motion law at time t (linear between rows, held at the ends). */
 void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz);

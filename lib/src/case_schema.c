@@ -63,7 +63,7 @@ static const struct case_key top_keys[] = {
     {.key = "monitors", .type = CASE_OBJECT, .meaning = "measured outputs, keyed by name (at most 16)"},
     {.key = "full_scale", .type = CASE_OBJECT,
      .meaning = "map of lab elevations to full scale and the error (13) of the run-up"},
-    {.key = "output", .type = CASE_OBJECT, .meaning = "output intervals"},
+    {.key = "output", .type = CASE_OBJECT, .meaning = "output intervals and the limits of the output's size"},
 };
 
 static const struct case_key numerics_keys[] = {
@@ -109,6 +109,16 @@ static const struct case_key numerics_keys[] = {
      .field = CASE_FIELD(case_def, viscous_max_iterations),
      .meaning = "implicit viscosity: iteration budget of one solve; a solve that does not reach its tolerance "
                 "within it stops the run"},
+    {.key = "max_particles", .type = CASE_NUMBER, RANGE(1, 0, 1e12, 0), DEF(1e7), .unit = "-",
+     .field = CASE_FIELD(case_def, max_particles),
+     .meaning = "limit of the resource budget (below): fluid, granular and wall particles, estimated from the "
+                "bodies' areas and the walls' lengths and layers"},
+    {.key = "max_lattice_sites", .type = CASE_NUMBER, RANGE(1, 0, 1e15, 0), DEF(1e9), .unit = "-",
+     .field = CASE_FIELD(case_def, max_lattice_sites),
+     .meaning = "limit of the resource budget: lattice sites scanned to fill the bodies' and walls' bounding boxes"},
+    {.key = "max_steps", .type = CASE_NUMBER, RANGE(1, 0, 1e15, 0), DEF(1e9), .unit = "-",
+     .field = CASE_FIELD(case_def, max_steps),
+     .meaning = "limit of the resource budget: time steps to t_end, estimated from criterion (4) at rest"},
 };
 
 #define DOMAIN_FIELD(k) (offsetof(struct case_def, domain) + (k) * sizeof(double) + 1)
@@ -267,6 +277,15 @@ static const struct case_key output_keys[] = {
      .field = CASE_FIELD(case_def, monitor_interval), .meaning = "time between rows of monitors.csv"},
     {.key = "snapshot_interval", .type = CASE_NUMBER, RANGE(0, 0, 1e6, 0), DEF(0), .def_text = "0 (none)",
      .unit = "s", .field = CASE_FIELD(case_def, snapshot_interval), .meaning = "time between particle snapshots"},
+    {.key = "max_monitor_rows", .type = CASE_NUMBER, RANGE(1, 0, 1e15, 0), DEF(1e6), .unit = "-",
+     .field = CASE_FIELD(case_def, max_monitor_rows),
+     .meaning = "limit of the resource budget: rows of monitors.csv, t_end / monitor_interval + 1"},
+    {.key = "max_profile_bins", .type = CASE_NUMBER, RANGE(1, 0, 1e12, 0), DEF(1e5), .unit = "-",
+     .field = CASE_FIELD(case_def, max_profile_bins),
+     .meaning = "limit of the resource budget: x bins of one profile monitor, its width / bin"},
+    {.key = "max_snapshot_bytes", .type = CASE_NUMBER, RANGE(1, 0, 1e18, 0), DEF(2e10), .unit = "B",
+     .field = CASE_FIELD(case_def, max_snapshot_bytes),
+     .meaning = "limit of the resource budget: bytes of all particle snapshots (CSV and HDF5), estimated"},
 };
 
 #define SECTION(id_, title_, keys_) .id = (id_), .title = (title_), .keys = (keys_), .n_keys = COUNT(keys_)

@@ -72,6 +72,69 @@ int geom_path_crosses(double ax, double az, double bx, double bz, double cx, dou
     return 1;
 }
 
+/* Clip the polygon (xs, zs, n points) to the half-plane sign * (z - level) >= 0 (Sutherland-Hodgman)
+ * into (xo, zo); returns the number of points, at most 2 n. */
+static size_t clip_half_plane(const double *xs, const double *zs, size_t n, double level, double sign, double *xo,
+                              double *zo)
+{
+    size_t m = 0;
+    for (size_t i = 0, j = n - 1; i < n; j = i++) {
+        const double dj = sign * (zs[j] - level), di = sign * (zs[i] - level);
+        if ((dj >= 0.0) != (di >= 0.0)) { /* the edge j -> i crosses the level */
+            const double f = dj / (dj - di);
+            xo[m] = xs[j] + f * (xs[i] - xs[j]);
+            zo[m++] = level;
+        }
+        if (di >= 0.0) {
+            xo[m] = xs[i];
+            zo[m++] = zs[i];
+        }
+    }
+    return m;
+}
+
+double geom_polygon_area_in_band(const struct polyline *poly, double z_min, double z_max)
+{
+    const size_t n = poly->n, cap = 4 * n + 4;
+    if (n < 3 || !(z_max > z_min)) return 0.0;
+    double *buf = malloc(4 * cap * sizeof *buf);
+    if (!buf) return NAN;
+    double *x1 = buf, *z1 = buf + cap, *x2 = buf + 2 * cap, *z2 = buf + 3 * cap;
+    size_t m = n;
+    const double *xs = poly->x, *zs = poly->z;
+    if (isfinite(z_min)) {
+        m = clip_half_plane(xs, zs, m, z_min, 1.0, x1, z1);
+        xs = x1;
+        zs = z1;
+    }
+    if (isfinite(z_max) && m > 0) {
+        m = clip_half_plane(xs, zs, m, z_max, -1.0, x2, z2);
+        xs = x2;
+        zs = z2;
+    }
+    double twice = 0.0;
+    for (size_t i = 0, j = m ? m - 1 : 0; i < m; j = i++) twice += xs[j] * zs[i] - xs[i] * zs[j];
+    free(buf);
+    return 0.5 * fabs(twice);
+}
+
+void geom_grow_box(const struct polyline *p, double *x0, double *x1, double *z0, double *z1)
+{
+    for (size_t k = 0; k < p->n; k++) {
+        *x0 = fmin(*x0, p->x[k]);
+        *x1 = fmax(*x1, p->x[k]);
+        *z0 = fmin(*z0, p->z[k]);
+        *z1 = fmax(*z1, p->z[k]);
+    }
+}
+
+double geom_polyline_length(const struct polyline *line)
+{
+    double len = 0.0;
+    for (size_t k = 0; k + 1 < line->n; k++) len += hypot(line->x[k + 1] - line->x[k], line->z[k + 1] - line->z[k]);
+    return len;
+}
+
 void geom_free(struct polyline *p)
 {
     free(p->x);

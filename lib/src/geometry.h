@@ -25,6 +25,16 @@ double geom_signed_distance(const struct polyline *line, int side, double x, dou
 int geom_path_crosses(double ax, double az, double bx, double bz, double cx, double cz, double dx,
                       double dz, double *s);
 
+/** Area of the part of a polygon (closed implicitly, simple or not: the shoelace formula) that
+ *  lies in the band z_min <= z <= z_max (either may be infinite) [m2]. */
+double geom_polygon_area_in_band(const struct polyline *poly, double z_min, double z_max);
+
+/** Grow the box [*x0, *x1] x [*z0, *z1] to hold every vertex of p (start it at +inf, -inf). */
+void geom_grow_box(const struct polyline *p, double *x0, double *x1, double *z0, double *z1);
+
+/** Length of an open polyline [m]. */
+double geom_polyline_length(const struct polyline *line);
+
 void geom_free(struct polyline *p);
 
 #endif

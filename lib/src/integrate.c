@@ -49,16 +49,12 @@ double integrate_time_step(const mixsph_sim *s)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
-        double d = cfl * 2.0 * h / (cmax + u);
         double mu = implicit ? 0.0 : P->mu[i];
         if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
             const struct medium *m = &s->cfg.media[P->medium[i]];
             mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
         }
-        if (mu > 0.0) {
-            const double dv = cflv * 2.0 * h * h * P->rho[i] / mu;
-            if (dv < d) d = dv;
-        }
+        const double d = integrate_particle_dt(cfl, cflv, h, cmax, u, P->rho[i], mu);
         if (d < dt) dt = d;
     }
     return dt;

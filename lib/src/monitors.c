@@ -171,8 +171,8 @@ static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, 
                                    const char *note)
 {
     const struct particles *P = &s->P;
-    const size_t nb = (size_t)ceil((md->x_max - md->x_min) / md->bin);
-    double *top = malloc((nb ? nb : 1) * sizeof *top);
+    const size_t nb = (size_t)case_profile_bin_count(md); /* >= 1, within output.max_profile_bins (budget.c) */
+    double *top = malloc(nb * sizeof *top);
     if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
     for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {

@@ -751,6 +751,12 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
 
 mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
 {
+    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
+                                                              mixsph_sim **out, char *err, size_t err_len)
+{
     if (out) *out = NULL;
     if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
     if (access(path, R_OK) != 0)
@@ -791,7 +797,7 @@ mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **o
     quiet_off(&q);
     if (st == MIXSPH_OK) {
         char msg[900];
-        st = mixsph_sim_create_from_state(buf, len, out, msg, sizeof msg);
+        st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
         if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
         else (*out)->run_wall_s = run_wall;
     }

@@ -63,15 +63,25 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     }
     const long i0 = (long)floor(bx0 / dx) - 1, i1 = (long)ceil(bx1 / dx) + 1;
     const long k0 = (long)floor(bz0 / dx) - 1, k1 = (long)ceil(bz1 / dx) + 1;
+    size_t per_body[CASE_MAX_BODIES] = {0}; /* particles each body got */
     for (long k = k0; k <= k1; k++) {
+        if (sim_interrupted(s)) {
+            free(sites);
+            return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while filling the bodies", s->cfg.origin);
+        }
         for (long i = i0; i <= i1; i++) {
             const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
             int medium = -1;
+            size_t body = 0;
             for (size_t b = 0; b < s->cfg.n_bodies && medium < 0; b++) {
                 const struct body *bd = &s->cfg.bodies[b];
-                if (z >= bd->z_min && z <= bd->z_max && geom_inside_polygon(&bd->polygon, x, z)) medium = bd->medium;
+                if (z >= bd->z_min && z <= bd->z_max && geom_inside_polygon(&bd->polygon, x, z)) {
+                    medium = bd->medium;
+                    body = b;
+                }
             }
             if (medium < 0 || site_blocked(s, x, z)) continue;
+            per_body[body]++;
             if (n == cap) {
                 struct site *q = realloc(sites, 2 * cap * sizeof *sites);
                 if (!q) {
@@ -88,9 +98,18 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: bodies: no particle fits in the bodies at dx = %g", s->cfg.origin, dx);
     }
-    if (n > 50000000) {
+    /* a body that got no particle lies behind the walls, or within the bodies listed before it */
+    for (size_t b = 0; b < s->cfg.n_bodies; b++) {
+        if (per_body[b] > 0) continue;
         free(sites);
-        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: numerics.dx: %g gives %zu particles (limit 5e7)", s->cfg.origin, dx, n);
+        return SIM_FAIL(s, MIXSPH_ERR_CASE,
+                        "%s: bodies.%s: no particle of it lies on the fluid side of the walls (at least dx/2 from them) "
+                        "outside the bodies listed before it, at dx = %g m", s->cfg.origin, s->cfg.bodies[b].name, dx);
+    }
+    if ((double)n > s->cfg.max_particles) { /* the budget's estimate was below it (budget.c) */
+        free(sites);
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: numerics.dx: %g m gives %zu particles, over the limit of %g "
+                        "(numerics.max_particles)", s->cfg.origin, dx, n, s->cfg.max_particles);
     }
     qsort(sites, n, sizeof *sites, site_cmp);
     if (particles_alloc(&s->P, n + n / 2 + 1024) != 0) {
@@ -175,7 +194,9 @@ static mixsph_status sim_init(mixsph_sim *s)
     for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
     walls_start(&s->cfg, s->walls);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
-    const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->P);
+    const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->interrupt, &s->P);
+    if (n_wall == WALLS_INTERRUPTED)
+        return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while placing the wall particles", s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->n_wall = (size_t)n_wall;
     set_domain(s);
@@ -200,8 +221,10 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (s->P.state[i] == MIXSPH_STATE_LOST)
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
                             s->P.x[i], s->P.z[i]);
+    if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after sorting the particles", s->cfg.origin);
     if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
+    if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after the neighbour lists", s->cfg.origin);
     if ((st = integrate_build_gather_lists(s)) != MIXSPH_OK) return st;
     if ((st = integrate_initial_rates(s)) != MIXSPH_OK) return st;
     monitors_init(s);
@@ -239,11 +262,24 @@ static mixsph_status sim_keep_source(mixsph_sim *s, const char *text, const char
 mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov,
                                           size_t n_ov, mixsph_sim **out, char *err, size_t err_len)
 {
+    return sim_create_from_text(json_text, origin, ov, n_ov, NULL, out, err, err_len);
+}
+
+void mixsph_sim_set_interrupt(mixsph_sim *s, const mixsph_interrupt *interrupt)
+{
+    if (!s) return;
+    s->interrupt = interrupt ? *interrupt : (mixsph_interrupt){NULL, NULL};
+}
+
+mixsph_status sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,
+                                   const mixsph_interrupt *interrupt, mixsph_sim **out, char *err, size_t err_len)
+{
     if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: out is NULL");
     *out = NULL;
     if (n_ov > 0 && !ov) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: overrides are NULL");
     mixsph_sim *s = calloc(1, sizeof *s);
     if (!s) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    mixsph_sim_set_interrupt(s, interrupt);
     mixsph_status st = case_parse(json_text, origin, ov, n_ov, &s->cfg, s->err, sizeof s->err);
     if (st == MIXSPH_OK) st = sim_keep_source(s, json_text, origin, ov, n_ov);
     if (st == MIXSPH_OK) st = sim_init(s);
@@ -259,12 +295,19 @@ mixsph_status mixsph_sim_create_from_text(const char *json_text, const char *ori
 mixsph_status mixsph_sim_create(const char *case_path, const mixsph_override *ov, size_t n_ov, mixsph_sim **out,
                                 char *err, size_t err_len)
 {
+    return mixsph_sim_create_interruptible(case_path, ov, n_ov, NULL, out, err, err_len);
+}
+
+mixsph_status mixsph_sim_create_interruptible(const char *case_path, const mixsph_override *ov, size_t n_ov,
+                                              const mixsph_interrupt *interrupt, mixsph_sim **out, char *err,
+                                              size_t err_len)
+{
     if (out) *out = NULL;
     if (!case_path) return status_set(err, err_len, MIXSPH_ERR_ARG, "mixsph_sim_create: no case file given");
     char *text = NULL;
     mixsph_status st = case_read_file(case_path, &text, err, err_len);
     if (st != MIXSPH_OK) return st;
-    st = mixsph_sim_create_from_text(text, case_path, ov, n_ov, out, err, err_len);
+    st = sim_create_from_text(text, case_path, ov, n_ov, interrupt, out, err, err_len);
     free(text);
     return st;
 }
@@ -338,17 +381,32 @@ mixsph_status mixsph_sim_set_output_dir(mixsph_sim *s, const char *dir) { return
 
 mixsph_status mixsph_sim_resume_output_dir(mixsph_sim *s, const char *dir) { return sim_output_dir(s, dir, 1); }
 
+/* Outputs are due at whole multiples of their interval; an output is taken at the first step
+ * that reaches one, within SIM_OUTPUT_SLACK (the steps' sum of rounding errors). */
+#define SIM_OUTPUT_SLACK 1e-12
+
+/* The first multiple of `interval` after time t (beyond the slack), counted from t itself: however
+ * small the interval, one call reaches past t (an accumulated next += interval may not move at
+ * all once interval is below the spacing of doubles at t). */
+static double next_output_time(double t, double interval)
+{
+    const double k = floor((t + SIM_OUTPUT_SLACK) / interval) + 1.0;
+    const double next = k * interval;
+    return next > t + SIM_OUTPUT_SLACK ? next : nextafter(t + SIM_OUTPUT_SLACK, INFINITY);
+}
+
 /* Take the samples and snapshots that are due at the current time. */
 static mixsph_status sim_outputs_due(mixsph_sim *s)
 {
     mixsph_status st = monitors_profiles(s);
-    if (st == MIXSPH_OK && s->t >= s->next_sample - 1e-12) {
+    if (st == MIXSPH_OK && s->t >= s->next_sample - SIM_OUTPUT_SLACK) {
         st = monitors_sample(s);
-        while (s->next_sample <= s->t + 1e-12) s->next_sample += s->cfg.monitor_interval;
+        s->next_sample = next_output_time(s->t, s->cfg.monitor_interval);
     }
-    if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out_dir[0] && s->t >= s->next_snapshot - 1e-12) {
+    if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out_dir[0] &&
+        s->t >= s->next_snapshot - SIM_OUTPUT_SLACK) {
         st = output_snapshot(s); /* snap_NNNN.csv and run.h5 */
-        while (s->next_snapshot <= s->t + 1e-12) s->next_snapshot += s->cfg.snapshot_interval;
+        s->next_snapshot = next_output_time(s->t, s->cfg.snapshot_interval);
     }
     return st;
 }
@@ -379,6 +437,9 @@ mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
     if (!s) return MIXSPH_ERR_ARG;
     if (!isfinite(t)) return SIM_FAIL(s, MIXSPH_ERR_ARG, "advance_to: time %g is not finite", t);
     while (s->t < t) {
+        if (sim_interrupted(s))
+            return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "interrupted at t = %.9g s, step %llu", s->t,
+                            (unsigned long long)s->step);
         mixsph_status st = mixsph_sim_step(s);
         if (st != MIXSPH_OK) return st;
     }

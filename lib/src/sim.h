@@ -82,8 +82,22 @@ struct mixsph_sim {
     double run_wall_s;            /* wall time stepping this run since t = 0, incl. before a restart [s] */
     int csv_snapshots_off;        /* no snap_NNNN.csv (run.h5 only) */
 
+    mixsph_interrupt interrupt;   /* the host's request to stop, polled during creation and stepping */
     char err[1024];
 };
+
+/** Has the host asked to stop (mixsph_interrupt)? */
+static inline int sim_interrupted(const mixsph_sim *s)
+{
+    return s->interrupt.requested && s->interrupt.requested(s->interrupt.user);
+}
+
+/** mixsph_sim_create_from_text polling `interrupt` (may be NULL) during the creation. */
+mixsph_status sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,
+                                   const mixsph_interrupt *interrupt, mixsph_sim **out, char *err, size_t err_len);
+/** mixsph_sim_create_from_state polling `interrupt` (may be NULL) while the case is rebuilt (state.c). */
+mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
+                                    char *err, size_t err_len);
 
 /** What the pair loops of forces.h run over, from the simulation's current parts and options. */
 struct pair_system sim_pair_system(mixsph_sim *s);

@@ -395,6 +395,12 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
 
 mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
 {
+    return sim_create_from_state(buf, len, NULL, out, err, err_len);
+}
+
+mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
+                                    char *err, size_t err_len)
+{
     if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
     *out = NULL;
     struct reader r = {buf, len, 0, 0};
@@ -406,7 +412,7 @@ mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_s
     if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
     if (st == MIXSPH_OK) {
         for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
-        st = mixsph_sim_create_from_text(src.text, src.origin, ov, src.n_ov, out, err, err_len);
+        st = sim_create_from_text(src.text, src.origin, ov, src.n_ov, interrupt, out, err, err_len);
     }
     free(ov);
     source_free(&src);

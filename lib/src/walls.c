@@ -37,7 +37,8 @@ void walls_start(const struct case_def *cfg, struct wall_state *ws)
     }
 }
 
-long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, struct particles *P)
+long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
+                    struct particles *P)
 {
     const double depth = cfg->wall_layers * dx;
     long added = 0;
@@ -53,6 +54,7 @@ long walls_generate(const struct case_def *cfg, const struct wall_state *ws, dou
         const long i0 = (long)floor((xmin - depth) / dx) - 1, i1 = (long)ceil((xmax + depth) / dx) + 1;
         const long k0 = (long)floor((zmin - depth) / dx) - 1, k1 = (long)ceil((zmax + depth) / dx) + 1;
         for (long k = k0; k <= k1; k++) {
+            if (interrupt && interrupt->requested && interrupt->requested(interrupt->user)) return WALLS_INTERRUPTED;
             for (long i = i0; i <= i1; i++) {
                 const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
                 int at_end = 0;

@@ -23,10 +23,14 @@ struct wall_state {
 /** Velocity and acceleration of every wall at t = 0 from its motion law. */
 void walls_start(const struct case_def *cfg, struct wall_state *ws);
 
+#define WALLS_INTERRUPTED (-2L)
+
 /** Append the wall particles of every wall of the case at spacing dx (cfg->wall_layers layers
  *  deep, on the global lattice); their `medium` field holds their wall's index and they start
- *  with their wall's velocity. Returns the number added, or -1 when out of memory. */
-long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, struct particles *P);
+ *  with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row. Returns the
+ *  number added, -1 when out of memory, WALLS_INTERRUPTED when the host asked to stop. */
+long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
+                    struct particles *P);
 
 /** Signed distance of (x, z) to wall w at its current position (< 0 behind it), and whether the
  *  closest point is an end of the polyline. */

@@ -1,0 +1,168 @@
+/* budget.c - see budget.h. The estimates are "about": a body's particles are its area (clipped to
+ * its z_min..z_max) over dx^2, which the lattice fill meets to within its boundary rows; overlapping
+ * bodies count twice, so the estimate errs on the high side only there (tests/test_budget.c: within
+ * 10 % for the bundled cases). The steps use the largest time step criterion (4) allows at rest at
+ * the reference density (integrate.h), so the estimate is a lower bound up to the density
+ * variation of a weakly compressible run (about 1 %): a case it refuses would take about that
+ * many steps or more. */
+#include "budget.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "case_schema.h"
+#include "geometry.h"
+#include "integrate.h"
+#include "status.h"
+
+/* Bytes one particle adds to one snapshot: a row of snap_NNNN.csv (ten fields of 1-13 characters,
+ * about 90 bytes) and its values in run.h5 (seven doubles and three small integers, about 70). */
+#define BUDGET_SNAPSHOT_BYTES_PER_PARTICLE 160.0
+
+/* Lattice sites of the box [x0, x1] x [z0, z1] at spacing dx, as the fills scan it (one site of
+ * margin on each side). */
+static double box_sites(double x0, double x1, double z0, double z1, double dx)
+{
+    return (floor((x1 - x0) / dx) + 3.0) * (floor((z1 - z0) / dx) + 3.0);
+}
+
+/* Particles of body k. */
+static double body_particles(const struct case_def *c, size_t k)
+{
+    const struct body *bd = &c->bodies[k];
+    return geom_polygon_area_in_band(&bd->polygon, bd->z_min, bd->z_max) / (c->dx * c->dx);
+}
+
+/* Wall particles of wall k: a strip of wall_layers rows behind its length. */
+static double wall_particles(const struct case_def *c, size_t k)
+{
+    return geom_polyline_length(&c->walls[k].line) * c->wall_layers / c->dx;
+}
+
+/* Lattice sites scanned for wall k: its bounding box grown by the depth of its layers (walls.c). */
+static double wall_sites(const struct case_def *c, size_t k)
+{
+    const double depth = c->wall_layers * c->dx;
+    double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
+    geom_grow_box(&c->walls[k].line, &x0, &x1, &z0, &z1);
+    return box_sites(x0 - depth, x1 + depth, z0 - depth, z1 + depth, c->dx);
+}
+
+/* The largest time step criterion (4) allows with every particle at rest at its medium's
+ * reference density, a fixed grain counted with the largest viscosity it can have once mobile
+ * (as integrate_time_step counts it). */
+static double largest_time_step(const struct case_def *c)
+{
+    const double h = c->h_over_dx * c->dx;
+    double c_max = 0.0, dt = INFINITY;
+    for (size_t k = 0; k < c->n_media; k++) c_max = fmax(c_max, c->media[k].c);
+    for (size_t k = 0; k < c->n_media; k++) {
+        const struct medium *m = &c->media[k];
+        double mu = m->kind == MEDIUM_GRANULAR ? fmin(m->mu0, m->mu_thr) : m->mu;
+        if (c->viscosity_implicit) mu = 0.0;
+        dt = fmin(dt, integrate_particle_dt(c->cfl, c->cfl_visc, h, c_max, 0.0, m->rho0, mu));
+    }
+    return dt;
+}
+
+void budget_estimate(const struct case_def *c, struct budget *b)
+{
+    memset(b, 0, sizeof *b);
+    double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
+    for (size_t k = 0; k < c->n_bodies; k++) {
+        b->particles += body_particles(c, k);
+        geom_grow_box(&c->bodies[k].polygon, &x0, &x1, &z0, &z1);
+    }
+    if (c->n_bodies > 0) b->lattice_sites = box_sites(x0, x1, z0, z1, c->dx);
+    for (size_t k = 0; k < c->n_walls; k++) {
+        b->wall_particles += wall_particles(c, k);
+        b->lattice_sites += wall_sites(c, k);
+    }
+    b->steps = c->t_end / largest_time_step(c);
+    b->monitor_rows = floor(c->t_end / c->monitor_interval) + 1.0;
+    if (c->snapshot_interval > 0.0)
+        b->snapshot_bytes = (floor(c->t_end / c->snapshot_interval) + 1.0) * (b->particles + b->wall_particles) *
+                            BUDGET_SNAPSHOT_BYTES_PER_PARTICLE;
+}
+
+/* "over the limit of 1e7 (numerics.max_particles)" */
+#define OVER "over the limit of %s (%s)"
+
+/* Is the estimate within the limit? (A non-finite estimate is not.) */
+static int within(double estimate, double limit) { return estimate <= limit; }
+
+static void num(double v, char *buf, size_t len) { case_schema_number_text(v, buf, len); }
+
+mixsph_status budget_check(const struct case_def *c, char *err, size_t err_len)
+{
+    struct budget b;
+    budget_estimate(c, &b);
+    char est[32], lim[32], val[32];
+    num(c->dx, val, sizeof val);
+    num(c->max_particles, lim, sizeof lim);
+    if (!within(b.particles, c->max_particles)) {
+        num(b.particles, est, sizeof est);
+        return status_set(err, err_len, MIXSPH_ERR_CASE, "%s: numerics.dx: %s m gives about %s particles, " OVER,
+                          c->origin, val, est, lim, "numerics.max_particles");
+    }
+    if (!within(b.particles + b.wall_particles, c->max_particles)) {
+        size_t w = 0; /* name the wall that asks for the most */
+        for (size_t k = 1; k < c->n_walls; k++)
+            if (wall_particles(c, k) > wall_particles(c, w)) w = k;
+        char wl[32], len[32];
+        num(b.particles + b.wall_particles, est, sizeof est);
+        num(wall_particles(c, w), wl, sizeof wl);
+        num(geom_polyline_length(&c->walls[w].line), len, sizeof len);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: walls.%s.polyline: %s m long with %d layers at dx = %s m gives about %s wall "
+                          "particles, about %s particles in all, " OVER,
+                          c->origin, c->walls[w].name, len, c->wall_layers, val, wl, est, lim, "numerics.max_particles");
+    }
+    if (!within(b.lattice_sites, c->max_lattice_sites)) {
+        num(b.lattice_sites, est, sizeof est);
+        num(c->max_lattice_sites, lim, sizeof lim);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: numerics.dx: %s m gives about %s lattice sites to scan in the bounding boxes of the "
+                          "bodies and walls, " OVER,
+                          c->origin, val, est, lim, "numerics.max_lattice_sites");
+    }
+    for (size_t k = 0; k < c->n_monitors; k++) {
+        const struct monitor_def *md = &c->monitors[k];
+        if (md->kind != MONITOR_PROFILE) continue;
+        const double bins = case_profile_bin_count(md);
+        if (within(bins, c->max_profile_bins)) continue;
+        num(md->bin, val, sizeof val);
+        num(bins, est, sizeof est);
+        num(c->max_profile_bins, lim, sizeof lim);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: monitors.%s.bin: %s m over the width %g m gives about %s bins, " OVER, c->origin,
+                          md->name, val, md->x_max - md->x_min, est, lim, "output.max_profile_bins");
+    }
+    if (!within(b.monitor_rows, c->max_monitor_rows)) {
+        num(c->monitor_interval, val, sizeof val);
+        num(b.monitor_rows, est, sizeof est);
+        num(c->max_monitor_rows, lim, sizeof lim);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: output.monitor_interval: %s s to t_end = %g s gives about %s rows of monitors.csv, " OVER,
+                          c->origin, val, c->t_end, est, lim, "output.max_monitor_rows");
+    }
+    if (!within(b.snapshot_bytes, c->max_snapshot_bytes)) {
+        num(c->snapshot_interval, val, sizeof val);
+        num(b.snapshot_bytes, est, sizeof est);
+        num(c->max_snapshot_bytes, lim, sizeof lim);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: output.snapshot_interval: %s s to t_end = %g s gives about %s bytes of particle "
+                          "snapshots, " OVER,
+                          c->origin, val, c->t_end, est, lim, "output.max_snapshot_bytes");
+    }
+    if (!within(b.steps, c->max_steps)) {
+        num(c->t_end, val, sizeof val);
+        num(b.steps, est, sizeof est);
+        num(c->max_steps, lim, sizeof lim);
+        return status_set(err, err_len, MIXSPH_ERR_CASE,
+                          "%s: numerics.t_end: %s s gives about %s time steps (criterion (4) at dx = %g m), " OVER,
+                          c->origin, val, est, c->dx, lim, "numerics.max_steps");
+    }
+    return MIXSPH_OK;
+}
