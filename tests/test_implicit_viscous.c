@@ -164,7 +164,7 @@ static void test_momentum_only_changed_by_walls(void **state)
     struct wall_mirror *M = walls_mirror_create();
     assert_non_null(M);
     assert_int_equal(walls_mirror_build(M, &s->cfg, &s->K, &s->G, P, n, 1), 0);
-    walls_mirror_at(M, &s->cfg, s->walls, P, n, s->t, dt, 1);
+    walls_mirror_at(M, &s->cfg, s->walls, P, s->t, dt, 1);
     assert_int_equal(viscous_solve(V, s->forces, &S, M, dt, 1e-10, 1000, &rep), 0);
     assert_true(rep.converged);
     /* momentum change of the mobile particles, and the force of the walls from the new field */

@@ -109,7 +109,7 @@ static void fill_wall_rows(const struct solve_ctx *c, int with_constant, double 
 {
     const struct particles *P = c->S->P;
     if (c->M) {
-        walls_mirror_apply(c->M, c->S->G, P, c->n, with_constant, vx, vz, c->S->n_threads);
+        walls_mirror_apply(c->M, c->S->G, with_constant, vx, vz, c->S->n_threads);
         return;
     }
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
@@ -437,7 +437,7 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
         v[GX][i] = v[USX][i] + P->visc_d1x[i];
         v[GZ][i] = v[USZ][i] + P->visc_d1z[i];
     }
-    walls_mirror_at(M, cfg, ws, P, n, t, g * dt, threads);
+    walls_mirror_at(M, cfg, ws, P, t, g * dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess u* + the last step's increment */
     const double a = (1.0 - g) / g;
@@ -453,7 +453,7 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
         v[GX][i] = v[USX][i] + P->visc_dvx[i];
         v[GZ][i] = v[USZ][i] + P->visc_dvz[i];
     }
-    walls_mirror_at(M, cfg, ws, P, n, t, dt, threads);
+    walls_mirror_at(M, cfg, ws, P, t, dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     store(&c);
     return 0;

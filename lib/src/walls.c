@@ -300,7 +300,7 @@ int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const 
 }
 
 void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *wstate,
-                     const struct particles *P, size_t n, double t_from, double dt, int n_threads)
+                     const struct particles *P, double t_from, double dt, int n_threads)
 {
     double vx[CASE_MAX_WALLS], vz[CASE_MAX_WALLS];
     for (size_t w = 0; w < cfg->n_walls; w++) {
@@ -309,7 +309,6 @@ void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const st
         vz[w] = wstate[w].vz;
         if (mo >= 0 && dt > 0.0) step_end_velocity(&cfg->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
     }
-    (void)n;
 #pragma omp parallel for schedule(static) num_threads(n_threads)
     for (size_t r = 0; r < M->n_rows; r++) {
         const size_t i = M->rows[r];
@@ -320,12 +319,10 @@ void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const st
     }
 }
 
-void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, const struct particles *P, size_t n,
-                        int with_constant, double *vx, double *vz, int n_threads)
+void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
+                        double *vz, int n_threads)
 {
     const double c = with_constant ? 1.0 : 0.0;
-    (void)P;
-    (void)n;
 #pragma omp parallel for schedule(static) num_threads(n_threads)
     for (size_t r = 0; r < M->n_rows; r++) {
         const size_t i = M->rows[r];

@@ -79,11 +79,11 @@ int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const 
  *  external velocity over the step from t_from, walls not yet moved) or their current ones
  *  (dt = 0). */
 void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws,
-                     const struct particles *P, size_t n, double t_from, double dt, int n_threads);
+                     const struct particles *P, double t_from, double dt, int n_threads);
 
 /** Overwrite the wall rows of (vx, vz) with the map of their non-wall rows: c_g + s_g a u
  *  (with_constant) or s_g a u (its linear part). */
-void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, const struct particles *P, size_t n,
-                        int with_constant, double *vx, double *vz, int n_threads);
+void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
+                        double *vz, int n_threads);
 
 #endif
