@@ -379,6 +379,46 @@ static void test_output_dir(void **state)
     rmdir(dir);
 }
 
+/* numerics.lattice_z0 puts a layer boundary of the particle lattice at a given height, so a body
+ * whose flat top is that height is filled to it at any dx: the highest water particle sits at
+ * level - dx/2 for levels on and off the multiples of dx (reference: the lattice's definition,
+ * z = offset + (k + 1/2) dx; tolerance 1e-9 dx, rounding of the offset). Without the key the
+ * top is the multiple of dx + dx/2 below the level (the plain lattice). */
+static double top_water_z(double level, int anchored)
+{
+    char text[2048];
+    snprintf(text, sizeof text,
+             "{\"name\": \"level\", \"parameters\": {\"level\": %.17g}, \"gravity\": 9.81,\n"
+             " \"numerics\": {\"dx\": 0.02, \"t_end\": 0.1, \"wall_layers\": 3%s},\n"
+             " \"media\": {\"water\": {\"type\": \"fluid\", \"rho\": 1000.0, \"c\": 20.0, \"mu\": 1.0e-3, \"alpha_m\": 0.1}},\n"
+             " \"bodies\": {\"pool\": {\"medium\": \"water\", \"z_max\": \"$level\",\n"
+             "   \"polygon\": [[0.0, 0.0], [0.6, 0.0], [0.6, 0.6], [0.0, 0.6]]}},\n"
+             " \"walls\": {\"tank\": {\"polyline\": [[0.0, 0.6], [0.0, 0.0], [0.6, 0.0], [0.6, 0.6]], \"fluid_side\": \"left\"}},\n"
+             " \"output\": {\"monitor_interval\": 0.01}}\n",
+             level, anchored ? ", \"lattice_z0\": \"$level\"" : "");
+    mixsph_sim *s = NULL;
+    char err[512];
+    assert_int_equal(mixsph_sim_create_from_text(text, "level.json", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    mixsph_particles_view v;
+    assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
+    double top = -INFINITY;
+    for (size_t i = 0; i < v.n; i++)
+        if (v.state[i] != MIXSPH_STATE_WALL) top = fmax(top, v.z[i]);
+    mixsph_sim_destroy(s);
+    return top;
+}
+
+static void test_lattice_at_level(void **state)
+{
+    (void)state;
+    const double dx = 0.02, levels[] = {0.30, 0.305, 0.3113, 0.319, 0.2401};
+    for (size_t k = 0; k < sizeof levels / sizeof *levels; k++) {
+        assert_true(fabs(top_water_z(levels[k], 1) - (levels[k] - 0.5 * dx)) < 1e-9 * dx);
+        const double plain = top_water_z(levels[k], 0); /* highest (j + 1/2) dx at or below the level */
+        assert_true(fabs(plain - (floor(levels[k] / dx - 0.5 + 1e-9) + 0.5) * dx) < 1e-9 * dx);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -391,6 +431,7 @@ int main(void)
         cmocka_unit_test(test_unstable),
         cmocka_unit_test(test_output_dir),
         cmocka_unit_test(test_kinetic_energy_monitor),
+        cmocka_unit_test(test_lattice_at_level),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

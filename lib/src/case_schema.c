@@ -77,6 +77,10 @@ static const struct case_key numerics_keys[] = {
      .field = CASE_FIELD(case_def, cfl_visc), .meaning = "coefficient of the viscous time-step limit"},
     {.key = "t_end", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e6, 0), .unit = "s",
      .field = CASE_FIELD(case_def, t_end), .meaning = "end time"},
+    {.key = "lattice_z0", .type = CASE_NUMBER, ANYWHERE, DEF(0), .unit = "m", .field = CASE_FIELD(case_def, lattice_z0),
+     .meaning = "a height at which the particle lattice has a layer boundary: bodies and walls are filled at "
+                "z = z0 + (k + 1/2) dx (x = (i + 1/2) dx), so a flat top at z0, such as a reservoir level "
+                "(\"$reservoir_level\"), holds exactly its water at any dx"},
     {.key = "wall_layers", .type = CASE_INTEGER, RANGE(1, 0, 8, 0), DEF(3), .unit = "-",
      .field = CASE_FIELD(case_def, wall_layers),
      .meaning = "layers of wall particles behind each wall; at least ⌈2 h_over_dx⌉, to cover the kernel support 2h"},

@@ -135,6 +135,12 @@ double geom_polyline_length(const struct polyline *line)
     return len;
 }
 
+double geom_lattice_z_offset(double z0, double dx)
+{
+    const double off = z0 - dx * round(z0 / dx);
+    return fabs(off) < 1e-9 * dx ? 0.0 : off;
+}
+
 void geom_free(struct polyline *p)
 {
     free(p->x);

@@ -35,6 +35,12 @@ void geom_grow_box(const struct polyline *p, double *x0, double *x1, double *z0,
 /** Length of an open polyline [m]. */
 double geom_polyline_length(const struct polyline *line);
 
+/** The vertical offset of the particle lattice, z = offset + (k + 1/2) dx, that puts a layer
+ *  boundary at height z0: z0 minus the nearest multiple of dx, in [-dx/2, dx/2]. Exactly 0 when
+ *  z0 is a multiple of dx to within 1e-9 dx, so an aligned z0 leaves the lattice bit for bit as
+ *  the plain (k + 1/2) dx one. */
+double geom_lattice_z_offset(double z0, double dx);
+
 void geom_free(struct polyline *p);
 
 #endif

@@ -18,7 +18,7 @@
 
 /* A lattice site of a body, for the hydrostatic initialisation. */
 struct site {
-    long i, k;       /* lattice indices: x = (i + 1/2) dx, z = (k + 1/2) dx */
+    long i, k;       /* lattice indices: x = (i + 1/2) dx, z = z_offset + (k + 1/2) dx */
     int medium;
 };
 
@@ -47,7 +47,7 @@ static int site_blocked(const mixsph_sim *s, double x, double z)
  * p = sum over the sites above of rho0 g dx, plus half its own; rho from the EOS; m = rho dx^2. */
 static mixsph_status fill_bodies(mixsph_sim *s)
 {
-    const double dx = s->dx;
+    const double dx = s->dx, z_off = geom_lattice_z_offset(s->cfg.lattice_z0, dx);
     size_t n = 0, cap = 1024;
     struct site *sites = malloc(cap * sizeof *sites);
     if (!sites) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -62,7 +62,7 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         }
     }
     const long i0 = (long)floor(bx0 / dx) - 1, i1 = (long)ceil(bx1 / dx) + 1;
-    const long k0 = (long)floor(bz0 / dx) - 1, k1 = (long)ceil(bz1 / dx) + 1;
+    const long k0 = (long)floor((bz0 - z_off) / dx) - 1, k1 = (long)ceil((bz1 - z_off) / dx) + 1;
     size_t per_body[CASE_MAX_BODIES] = {0}; /* particles each body got */
     for (long k = k0; k <= k1; k++) {
         if (sim_interrupted(s)) {
@@ -70,7 +70,7 @@ static mixsph_status fill_bodies(mixsph_sim *s)
             return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while filling the bodies", s->cfg.origin);
         }
         for (long i = i0; i <= i1; i++) {
-            const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
+            const double x = (i + 0.5) * dx, z = z_off + (k + 0.5) * dx;
             int medium = -1;
             size_t body = 0;
             for (size_t b = 0; b < s->cfg.n_bodies && medium < 0; b++) {
@@ -123,7 +123,7 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         const double p = above + 0.5 * m->rho0 * s->cfg.g * dx;
         above += m->rho0 * s->cfg.g * dx;
         const double rho = eos_density(p, m->rho0, m->c);
-        particles_push(&s->P, (sites[q].i + 0.5) * dx, (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
+        particles_push(&s->P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
                        (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
         s->P.mu[s->P.n - 1] = m->mu;
     }

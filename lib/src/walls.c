@@ -40,7 +40,7 @@ void walls_start(const struct case_def *cfg, struct wall_state *ws)
 long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P)
 {
-    const double depth = cfg->wall_layers * dx;
+    const double depth = cfg->wall_layers * dx, z_off = geom_lattice_z_offset(cfg->lattice_z0, dx);
     long added = 0;
     for (size_t w = 0; w < cfg->n_walls; w++) {
         const struct wall *wl = &cfg->walls[w];
@@ -52,11 +52,11 @@ long walls_generate(const struct case_def *cfg, const struct wall_state *ws, dou
             zmax = fmax(zmax, wl->line.z[k]);
         }
         const long i0 = (long)floor((xmin - depth) / dx) - 1, i1 = (long)ceil((xmax + depth) / dx) + 1;
-        const long k0 = (long)floor((zmin - depth) / dx) - 1, k1 = (long)ceil((zmax + depth) / dx) + 1;
+        const long k0 = (long)floor((zmin - depth - z_off) / dx) - 1, k1 = (long)ceil((zmax + depth - z_off) / dx) + 1;
         for (long k = k0; k <= k1; k++) {
             if (interrupt && interrupt->requested && interrupt->requested(interrupt->user)) return WALLS_INTERRUPTED;
             for (long i = i0; i <= i1; i++) {
-                const double x = (i + 0.5) * dx, z = (k + 0.5) * dx;
+                const double x = (i + 0.5) * dx, z = z_off + (k + 0.5) * dx;
                 int at_end = 0;
                 const double d = geom_signed_distance(&wl->line, wl->side, x, z, &at_end);
                 if (at_end || d >= 0.0 || d < -depth) continue;
