@@ -4,6 +4,8 @@
                  (or .csv); resumable; writes the report at the end
   report OUT     the PNG reports and the scenario table of OUT's results
   optimise OUT   the paper's Section 2.2 procedure: mu_thr_min, then mu0_min, and the saving
+  emulate ...    a Gaussian-process emulator of the FMU: fit, predict, design, validate, risk,
+                 plot (python -m tools.dss emulate --help)
 
 Run with --help after a command for its options. Exit codes: 0 ok (a sweep with failed
 scenarios is still 0: they are recorded; see the summary), 1 the sweep or the optimisation
@@ -123,6 +125,9 @@ def build_parser():
     r.add_argument("--crest", type=float, metavar="Z")
     r.add_argument("--x", default="reservoir_level", help="parameter on the x axis (default reservoir_level)")
     r.add_argument("--y", help="output column (default max_run_up_Z when finite, else max_run_up)")
+
+    sub.add_parser("emulate", help="the FMU's emulator: fit, predict, design, validate, risk, plot "
+                                   "(emulate --help)", add_help=False)
 
     o = sub.add_parser("optimise", aliases=["optimize"], help="the paper's mu_thr / mu0 procedure")
     o.add_argument("out")
@@ -328,6 +333,10 @@ def cmd_optimise(args):
 
 
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv and argv[0] == "emulate":
+        from .emulate import main as emulate_main
+        return emulate_main(argv[1:])
     ap = build_parser()
     args = ap.parse_args(argv)
     os.environ.setdefault("OMP_WAIT_POLICY", "passive")

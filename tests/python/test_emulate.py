@@ -1,0 +1,295 @@
+"""Tests of the FMU emulator (tools/dss/emulator.py, design.py, emulate.py).
+
+Most run on stand-in models (known functions), without the FMU; the last ones use the FMU
+(build/LandslideWave.fmu, MIXSPH_BUILD_DIR or DSS_FMU) at the coarse dx = 0.05 m with a short
+stop time. Every reference and tolerance is stated beside its assertion.
+"""
+import json
+import os
+import pathlib
+import shutil
+import signal
+import subprocess
+import sys
+import time
+import zipfile
+
+import numpy as np
+import pandas as pd
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))
+
+from tools.dss import design as D  # noqa: E402
+from tools.dss import emulator as E  # noqa: E402
+from tools.dss import scenarios as S  # noqa: E402
+from tools.dss.store import ResultStore  # noqa: E402
+
+BUILD = pathlib.Path(os.environ.get("MIXSPH_BUILD_DIR", ROOT / "build"))
+ENV = dict(os.environ, OMP_NUM_THREADS="1", OMP_WAIT_POLICY="passive")
+
+
+def fmu_path():
+    p = pathlib.Path(os.environ.get("DSS_FMU", BUILD / "LandslideWave.fmu"))
+    if not p.is_file():
+        pytest.fail(f"{p} not found: build it with `cmake --build {BUILD} --target fmu`")
+    return str(p)
+
+
+def emulate(*args, check=True, timeout=600):
+    cmd = [sys.executable, "-m", "tools.dss", "emulate", *map(str, args)]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, capture_output=True, text=True, timeout=timeout)
+    if check and p.returncode != 0:
+        raise AssertionError(f"{' '.join(cmd)} exited {p.returncode}\n{p.stdout}\n{p.stderr}")
+    return p
+
+
+# ---- stand-in models ----------------------------------------------------------------------------
+
+def smooth3(X):
+    """A known smooth function of 3 inputs on the unit cube (range about 1.7)."""
+    a, b, c = X[:, 0], X[:, 1], X[:, 2]
+    return np.sin(3 * a) + 0.5 * b ** 2 + 0.3 * np.cos(2 * np.pi * c) * a
+
+
+def fitted(X, y, names, kinds=None, mode="product", box=None):
+    df = pd.DataFrame(X, columns=names)
+    df["y"] = y
+    df["status"] = "ok"
+    em = E.from_results(df, outputs=["y"], inputs=names, box=box)
+    em.fit_output("y", mode=mode)
+    return em
+
+
+def standin_runup(s):
+    """A stand-in of the FMU's run-up over (reservoir_level, phi, saturated)."""
+    a = (s["reservoir_level"] - 0.40) / 0.12
+    b = (s["phi"] - 25.0) / 15.0
+    return 0.6 + 0.1 * a + 0.03 * np.sin(3 * b) + 0.02 * s["saturated"] * a
+
+
+STANDIN_DISTS = ["reservoir_level=uniform:0.40:0.52", "phi=uniform:25:40", "saturated=choice:0,1"]
+
+
+def run_standin_design(out, log, delay, budget):
+    """A design on the stand-in; each evaluated scenario id is appended to LOG (what the kill
+    test counts); after the start batch every run takes DELAY s."""
+    dists = [S.Distribution(*S.split_assignment(d)) for d in STANDIN_DISTS]
+    des = D.Design(out, dists, {"dx": 0.05}, 1.6, budget=budget, target_error=0.0, n_init=6,
+                   n_workers=2, folds=3, restarts=0, progress=False)
+
+    def evaluate(scen, on_result):
+        for s in scen:
+            if des.state["batches"] and len(des.state["batches"]) > 1:
+                time.sleep(delay)
+            with open(log, "a") as f:
+                f.write(s[S.ID] + "\n")
+                f.flush()
+                os.fsync(f.fileno())
+            on_result({**s, "status": "ok", "error": "", "max_run_up": standin_runup(s),
+                       "wall_time_s": delay, "finished_at": f"{time.time():.6f}"})
+    return des.run(evaluate)
+
+
+# ---- without the FMU ---------------------------------------------------------------------------
+
+def test_gp_recovers_a_smooth_function_of_three_inputs_with_calibrated_intervals():
+    from scipy.stats import qmc
+    X = qmc.LatinHypercube(d=3, seed=1).random(30)
+    names = ["reservoir_level", "phi", "porosity"]
+    em = fitted(X, smooth3(X), names, box={n: (0.0, 1.0) for n in names})
+    Xt = np.random.default_rng(5).random((1000, 3))
+    yt = smooth3(Xt)
+    mu, sd = em.predict(Xt)["y"]
+    m = E.metrics(yt, mu, sd)
+    # the issue's targets for the FMU emulator: RMSE <= 2 % of the range, 90-98 % of the
+    # points inside their 95 % intervals (1000 independent uniform test points)
+    assert m["rmse_pct"] <= 2.0, m
+    assert 0.90 <= m["coverage95"] <= 0.98, m
+    # the cross-validation sees the same: its RMSE within a factor 2 of the test points'
+    assert 0.5 <= em.cv["y"]["rmse_pct"] / m["rmse_pct"] <= 2.0, (em.cv["y"]["rmse_pct"], m)
+
+
+@pytest.mark.parametrize("mode", E.MODES)
+def test_save_and_load_give_identical_predictions(tmp_path, mode):
+    rng = np.random.default_rng(2)
+    X = np.column_stack([0.40 + 0.12 * rng.random(24), 25 + 15 * rng.random(24),
+                         np.tile([0.0, 1.0], 12)])
+    y = [standin_runup(dict(zip(["reservoir_level", "phi", "saturated"], x))) for x in X]
+    em = fitted(X, np.array(y), ["reservoir_level", "phi", "saturated"], mode=mode)
+    assert em.kinds == ["continuous", "continuous", "binary"]
+    path = str(tmp_path / "em.json")
+    em.save(path)
+    doc = json.loads(pathlib.Path(path).read_text())
+    assert doc["schema"] == "mixsph-emulator" and doc["schema_version"] == 1
+    em2 = E.Emulator.from_json(doc)
+    Xq = np.column_stack([0.40 + 0.12 * rng.random(200), 25 + 15 * rng.random(200),
+                          rng.integers(0, 2, 200)])
+    a, b = em.predict(Xq)["y"], em2.predict(Xq)["y"]
+    # identical: the loaded GP is rebuilt from the saved hyperparameters (optimizer=None)
+    assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
+def test_out_of_box_queries_are_flagged():
+    rng = np.random.default_rng(3)
+    X = np.column_stack([0.40 + 0.12 * rng.random(12), 25 + 15 * rng.random(12),
+                         np.tile([0.0, 1.0], 6)])
+    em = fitted(X, X[:, 0] + 0.01 * X[:, 1], ["reservoir_level", "phi", "saturated"],
+                box={"reservoir_level": (0.40, 0.52), "phi": (25.0, 40.0)})
+    q = np.array([[0.46, 30.0, 1.0],        # inside
+                  [0.55, 30.0, 0.0],        # level above the box
+                  [0.46, 20.0, 0.5],        # phi below, saturated not 0/1
+                  [0.52, 40.0, 0.0]])       # on the box's corner: inside
+    oob = em.predict(q)["out_of_box"]
+    assert list(oob) == ["", "reservoir_level", "phi,saturated", ""]
+
+
+def test_a_killed_design_continues_without_repeating_runs(tmp_path):
+    out, log = tmp_path / "design", tmp_path / "evaluated.txt"
+    code = (f"import sys; sys.path[:0] = [{str(ROOT)!r}, {str(ROOT / 'tests' / 'python')!r}]; "
+            f"import test_emulate as T; T.run_standin_design({str(out)!r}, {str(log)!r}, 0.5, 12)")
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, env=ENV,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    state = out / "design.json"
+    t0 = time.monotonic()
+    # kill it once its first batch after the start is recorded and has begun running
+    while True:
+        if state.exists() and log.exists():
+            st = json.loads(state.read_text())
+            if len(st["batches"]) >= 2 and len(log.read_text().split()) >= 6:
+                break
+        assert proc.poll() is None, proc.communicate()
+        assert time.monotonic() - t0 < 120, "the design did not reach its second batch"
+        time.sleep(0.05)
+    time.sleep(0.7)                      # into the second batch's 0.5 s runs
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.wait()
+    before = log.read_text().split()
+    st = json.loads(state.read_text())
+    recorded = [i for b in st["batches"] for i in b["ids"]]
+    assert 6 <= len(before) < 12, "killed too late: nothing left to continue"
+    res = run_standin_design(str(out), str(log), 0.0, 12)
+    after = log.read_text().split()
+    # no scenario was evaluated twice, and the design spent exactly its budget of 12 runs
+    assert len(after) == len(set(after)), [i for i in after if after.count(i) > 1]
+    assert res["runs"] == 12 and len(after) == 12
+    # the batches recorded before the kill were completed, not replaced
+    st2 = json.loads(state.read_text())
+    assert [i for b in st2["batches"] for i in b["ids"]][:len(recorded)] == recorded
+    assert set(ResultStore(str(out)).done_ids()) == set(after)
+
+
+def test_design_batches_are_not_clustered_and_follow_the_uncertainty():
+    """With 10 start runs in one half of the level range, the picks go to the empty half, and
+    the two picks of a batch are apart (the correlation penalty)."""
+    rng = np.random.default_rng(4)
+    X = np.column_stack([0.40 + 0.06 * rng.random(10), 25 + 15 * rng.random(10)])
+    y = np.array([standin_runup({"reservoir_level": a, "phi": b, "saturated": 0}) for a, b in X])
+    em = fitted(X, y, ["reservoir_level", "phi"], box={"reservoir_level": (0.40, 0.52),
+                                                       "phi": (25.0, 40.0)})
+    dists = [S.Distribution("reservoir_level", "uniform:0.40:0.52"),
+             S.Distribution("phi", "uniform:25:40")]
+    b = D.pick_batch(em, "y", dists, {}, 2, np.random.default_rng(0), 2000)
+    assert len(b) == 2
+    assert all(s["reservoir_level"] > 0.46 for s in b), b       # the unexplored half
+    u = em.unit(em.matrix(b))
+    assert np.linalg.norm(u[0] - u[1]) > 0.2, b                # 0.2 of the unit box apart
+
+
+def test_risk_and_sobol_of_a_known_response():
+    """y = a + 0.5 b, a, b ~ U(0, 1): P(y > 1) = 0.25; Sobol S1 = ST = 0.8 and 0.2."""
+    from scipy.stats import qmc
+    X = qmc.LatinHypercube(d=2, seed=2).random(30)
+    names = ["reservoir_level", "phi"]
+    em = fitted(X, X[:, 0] + 0.5 * X[:, 1], names, box={n: (0.0, 1.0) for n in names})
+    dists = {n: S.Distribution(n, "uniform:0:1") for n in names}
+    t0 = time.perf_counter()
+    r = E.exceedance(em, "y", dists, {}, 1.0, n=100_000, n_joint=1000, n_draws=200, seed=1)
+    took = time.perf_counter() - t0
+    # exact 0.25; the Monte Carlo se of 1e5 samples is 0.0014: 4 se
+    assert abs(r["p"] - 0.25) <= 4 * 0.0014 + 0.002, r
+    # the band brackets P (up to rounding) and is narrow: the emulator of a linear function is
+    # all but exact, its draws hardly differ
+    assert r["p_lo"] - 1e-9 <= r["p"] <= r["p_hi"] + 1e-9 and r["p_hi"] - r["p_lo"] < 0.05, r
+    assert took < 10.0, took                         # the issue: 1e5 samples in under 10 s
+    s = E.sobol(em, "y", dists, {}, n_base=4096, seed=1)
+    # exact: var(a) = 1/12, var(0.5 b) = 1/48 -> S1 = 0.8, 0.2; additive -> ST = S1. SALib's
+    # bootstrap 95 % half-widths at N = 4096 are about 0.03
+    assert s["S1"] == pytest.approx([0.8, 0.2], abs=0.05)
+    assert s["ST"] == pytest.approx([0.8, 0.2], abs=0.05)
+    Xq = np.random.default_rng(0).random((1000, 2))
+    t0 = time.perf_counter()
+    em.predict(Xq)
+    assert time.perf_counter() - t0 < 1.0            # the issue: 1000 scenarios under 1 s
+
+
+# ---- with the FMU ------------------------------------------------------------------------------
+
+def _with_guid(src, dst, guid):
+    """A copy of the FMU whose modelDescription.xml has another GUID."""
+    with zipfile.ZipFile(src) as zin, zipfile.ZipFile(dst, "w", zipfile.ZIP_DEFLATED) as zout:
+        for item in zin.infolist():
+            data = zin.read(item.filename)
+            if item.filename == "modelDescription.xml":
+                text = data.decode()
+                i = text.index('guid="') + 6
+                text = text[:i] + guid + text[text.index('"', i):]
+                data = text.encode()
+            zout.writestr(item, data)
+
+
+def test_design_on_the_fmu_end_to_end_and_a_foreign_guid_is_refused(tmp_path):
+    from fmpy import simulate_fmu
+    fmu = fmu_path()
+    out = tmp_path / "design"
+    stop = 0.8
+    p = emulate("design", out, "--fmu", fmu, "--dist", "reservoir_level=uniform:0.40:0.52",
+                "--dist", "phi=uniform:25:40", "--budget", 6, "--init", 4, "--target-error", 0,
+                "--dx", 0.05, "--stop-time", stop, "--workers", 2, "--folds", 4, "--no-plots")
+    df = ResultStore(str(out)).latest()
+    # the budget: 6 runs, all ok, 4 from the start and one batch of 2 (2 workers)
+    assert len(df) == 6 and (df["status"] == "ok").all(), df.get("error")
+    st = json.loads((out / "design.json").read_text())
+    assert [len(b["ids"]) for b in st["batches"]] == [4, 2] and st["stopped"] == "budget"
+    doc = json.loads((out / "emulator.json").read_text())
+    from fmpy import read_model_description
+    assert doc["fmu"]["guid"] == read_model_description(fmu).guid
+    assert sorted(doc["X"]) == sorted(df[["reservoir_level", "phi"]].to_numpy().tolist())
+    # the emulator reproduces its own training runs within their 95 % intervals (inputs and
+    # outputs kept together through scaling, standardisation and the JSON)
+    tr = df[["reservoir_level", "phi"]].copy()
+    tr.to_csv(tmp_path / "train.csv", index=False)
+    emulate("predict", out / "emulator.json", "--fmu", fmu, "--csv", tmp_path / "train.csv",
+            "--output", "max_run_up", "-o", tmp_path / "pred_train.csv")
+    pt = pd.read_csv(tmp_path / "pred_train.csv")
+    y = df["max_run_up"].to_numpy()
+    assert ((pt["max_run_up_lo95"] <= y) & (y <= pt["max_run_up_hi95"])).all(), (pt, y)
+    # a scenario not in the design, run on the FMU directly: the emulator is nearer to it than
+    # half the spread of the 6 runs (a gross check only: at dx = 0.05 the run-up moves in
+    # lattice steps and 6 runs cannot calibrate the intervals; the CV in the file says so)
+    q = {"reservoir_level": 0.47, "phi": 31.0}
+    r = simulate_fmu(fmu, start_values={**q, "dx": 0.05, "threads": 1}, stop_time=stop,
+                     output_interval=0.05, output=["max_run_up"])
+    y_new = float(r[-1]["max_run_up"])
+    emulate("predict", out / "emulator.json", "--fmu", fmu, "--set", "reservoir_level=0.47",
+            "--set", "phi=31", "--output", "max_run_up", "-o", tmp_path / "pred.csv")
+    row = pd.read_csv(tmp_path / "pred.csv").iloc[0]
+    assert abs(row["max_run_up_mean"] - y_new) <= 0.5 * np.ptp(y), (y_new, row.to_dict())
+    assert pd.isna(row["out_of_box"]) or row["out_of_box"] == ""
+    # out of the box: flagged in the output
+    emulate("predict", out / "emulator.json", "--fmu", fmu, "--set", "reservoir_level=0.60",
+            "--set", "phi=31", "-o", tmp_path / "pred2.csv")
+    assert pd.read_csv(tmp_path / "pred2.csv").iloc[0]["out_of_box"] == "reservoir_level"
+    # another FMU (another GUID) is refused with a message naming both GUIDs
+    other = tmp_path / "Other.fmu"
+    _with_guid(fmu, other, "{00000000-1111-2222-3333-444444444444}")
+    p = emulate("predict", out / "emulator.json", "--fmu", other, "--set", "reservoir_level=0.47",
+                "--set", "phi=31", check=False)
+    assert p.returncode == 2, p.stderr
+    assert "refused" in p.stderr and "{00000000-1111-2222-3333-444444444444}" in p.stderr
+    assert doc["fmu"]["guid"] in p.stderr
+    with pytest.raises(E.GuidMismatch):
+        E.load(str(out / "emulator.json"), str(other))
+    # the same emulator loads against its own FMU
+    assert E.load(str(out / "emulator.json"), fmu).inputs == ["reservoir_level", "phi"]

@@ -1,0 +1,180 @@
+"""The emulator's PNG plots: the run-up over (reservoir level, phi) with its uncertainty, the
+cross-validation's predicted vs simulated, the exceedance curve with its band, Sobol indices."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from . import emulator as E
+
+
+def _plt():
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def surface(em: E.Emulator, output: str, path: str, x="reservoir_level", y="phi",
+            fixed: dict | None = None, n=41):
+    """Mean over (x, y) with the 95 % half-width as contour lines, one column per level of the
+    binary inputs; below, slices over x at three y values with their 95 % bands. The other
+    inputs at `fixed` or the middle of their box."""
+    plt = _plt()
+    if x not in em.inputs or y not in em.inputs:
+        raise E.EmulatorError(f"the surface needs inputs {x} and {y} (the emulator has "
+                              f"{', '.join(em.inputs)})")
+    fixed = dict(fixed or {})
+    bins = [n_ for n_, k in zip(em.inputs, em.kinds) if k == "binary" and n_ not in fixed]
+    levels = [dict(zip(bins, v)) for v in np.ndindex(*([2] * len(bins)))] if bins else [{}]
+    levels = levels[:4]
+    ix, iy = em.inputs.index(x), em.inputs.index(y)
+    gx = np.linspace(*em.box[ix], n)
+    gy = np.linspace(*em.box[iy], n)
+    GX, GY = np.meshgrid(gx, gy)
+    base = {nm: fixed.get(nm, 0.5 * (b[0] + b[1])) for nm, b in zip(em.inputs, em.box)}
+    fig, axes = plt.subplots(2, len(levels), figsize=(5.2 * len(levels), 8.4), squeeze=False)
+    res = []
+    for c, lv in enumerate(levels):
+        rows = []
+        for xv, yv in zip(GX.ravel(), GY.ravel()):
+            r = dict(base)
+            r.update(lv)
+            r[x], r[y] = xv, yv
+            rows.append(r)
+        mu, sd = em.predict(em.matrix(rows), [output])[output]
+        res.append((mu, sd))
+        ax = axes[0, c]
+        cs = ax.contourf(GX, GY, mu.reshape(GX.shape), 14, cmap="viridis")
+        fig.colorbar(cs, ax=ax, label=f"{output} (mean)")
+        cl = ax.contour(GX, GY, (E.Z95 * sd).reshape(GX.shape), 5, colors="w", linewidths=0.8,
+                        linestyles="--")
+        ax.clabel(cl, fmt="±%.3g", fontsize=7)
+        m = em.models[output]
+        rows_t, _ = em._rows(output)
+        Xt = em.X[rows_t]
+        sel = np.ones(len(Xt), bool)
+        for nm, v in lv.items():
+            sel &= Xt[:, em.inputs.index(nm)] == v
+        ax.plot(Xt[sel, ix], Xt[sel, iy], "k.", ms=4, label="training runs")
+        ttl = ", ".join(f"{k}={v}" for k, v in lv.items()) or "all"
+        ax.set_title(f"{ttl}: mean, dashed: 95 % half-width", fontsize=9)
+        ax.set_xlabel(x)
+        ax.set_ylabel(y)
+        ax.legend(loc="lower right", fontsize=7)
+        ax2 = axes[1, c]
+        for yv, col in zip(np.quantile(gy, [0.0, 0.5, 1.0]), ("C0", "C1", "C2")):
+            rows = []
+            for xv in gx:
+                r = dict(base)
+                r.update(lv)
+                r[x], r[y] = xv, yv
+                rows.append(r)
+            mu1, sd1 = em.predict(em.matrix(rows), [output])[output]
+            ax2.plot(gx, mu1, color=col, label=f"{y} = {yv:.3g}")
+            ax2.fill_between(gx, mu1 - E.Z95 * sd1, mu1 + E.Z95 * sd1, color=col, alpha=0.25)
+        ax2.set_xlabel(x)
+        ax2.set_ylabel(f"{output} (mean, 95 % band)")
+        ax2.set_title(f"{ttl}: slices; others at " + ", ".join(
+            f"{k}={v:.3g}" for k, v in base.items() if k not in (x, y) and k not in lv),
+            fontsize=8)
+        ax2.legend(fontsize=7)
+        ax2.grid(alpha=0.3)
+        del m
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def cv_plot(cv: dict, output: str, path: str, title: str = "cross-validation",
+            holdout: dict | None = None):
+    """Predicted (out-of-fold mean, 95 % interval) against simulated."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.6, 5.2))
+    sets = [(title, cv, "C0")] + ([("hold-out", holdout, "C3")] if holdout else [])
+    lo = hi = None
+    for label, d, col in sets:
+        y, mu, sd = (np.asarray(d[k], float) for k in ("y", "mean", "sd"))
+        inside = np.abs(mu - y) <= E.Z95 * sd
+        ax.errorbar(y, mu, yerr=E.Z95 * sd, fmt="o", ms=4, color=col, alpha=0.8, lw=0.8,
+                    label=f"{label}: n {len(y)}, RMSE {d['rmse_pct']:.2f} %, max "
+                          f"{d['max_error_pct']:.2f} % of range, {100 * inside.mean():.0f} % inside")
+        lo = min(y.min(), (mu - E.Z95 * sd).min()) if lo is None else min(lo, y.min())
+        hi = max(y.max(), (mu + E.Z95 * sd).max()) if hi is None else max(hi, y.max())
+    ax.plot([lo, hi], [lo, hi], "k-", lw=0.8)
+    ax.set_xlabel(f"{output}, FMU")
+    ax.set_ylabel(f"{output}, emulator (mean, 95 % interval)")
+    ax.legend(fontsize=7, loc="upper left")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def exceedance_plot(risk: dict, path: str):
+    plt = _plt()
+    c = risk["curve"]
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    ax.fill_between(c["z"], c["lo"], c["hi"], color="C0", alpha=0.3,
+                    label="95 % band (emulator uncertainty)")
+    ax.plot(c["z"], c["p"], "C0-", label="P(exceed), emulator")
+    ax.plot(c["z"], c["mean_only"], "k:", lw=0.8, label="from the mean only")
+    ax.axvline(risk["crest"], color="C3", ls="--",
+               label=f"crest {risk['crest']:g}: P = {risk['p']:.3f} "
+                     f"[{risk['p_lo']:.3f}, {risk['p_hi']:.3f}]")
+    ax.set_xlabel(risk["output"])
+    ax.set_ylabel("exceedance probability")
+    ax.set_ylim(0, 1)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def sobol_plot(s: dict, output: str, path: str):
+    plt = _plt()
+    names = s["names"]
+    x = np.arange(len(names))
+    fig, ax = plt.subplots(figsize=(1.4 * len(names) + 2.5, 3.8))
+    ax.bar(x - 0.2, s["S1"], 0.4, yerr=s["S1_conf"], label="first order S1", capsize=3)
+    ax.bar(x + 0.2, s["ST"], 0.4, yerr=s["ST_conf"], label="total ST", capsize=3)
+    ax.set_xticks(x, names, rotation=15)
+    ax.set_ylabel(f"Sobol index of {output}")
+    ax.axhline(0, color="k", lw=0.6)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def design_history(history: list[dict], path: str, target=None, other: dict | None = None):
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    h = [r for r in history if "rmse_pct" in r]
+    ax.plot([r["runs"] for r in h], [r["rmse_pct"] for r in h], "o-", ms=3, label="CV RMSE")
+    ax.plot([r["runs"] for r in h], [r["max_error_pct"] for r in h], "s--", ms=3,
+            label="CV max error")
+    if target is not None:
+        ax.axhline(target, color="C3", ls=":", label=f"target {target:g} %")
+    ax.set_xlabel("FMU runs")
+    ax.set_ylabel("% of the output's range")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def ensure_dir(path):
+    d = os.path.dirname(path)
+    if d:
+        os.makedirs(d, exist_ok=True)
