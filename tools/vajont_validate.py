@@ -133,9 +133,17 @@ PAPER = {
 }
 
 
+D_ETA_RANGE = 0.1345      # [m] (Z_exp - Z_still) / 1211.8: the lab-frame run-up of 100 % of (13)
+
+
 def d_eta(z):
     """The paper's error (13) in the lab frame [%]."""
-    return 100.0 * abs(z - EXP_RUN_UP) / 0.1345 if math.isfinite(z) else math.nan
+    return 100.0 * abs(z - EXP_RUN_UP) / D_ETA_RANGE if math.isfinite(z) else math.nan
+
+
+def d_eta_scale_mm():
+    """Millimetres of lab-frame run-up per 1 % of the error (13)."""
+    return D_ETA_RANGE * 1e3 / 100.0
 
 
 # ---- runs and their results ----------------------------------------------------------------------

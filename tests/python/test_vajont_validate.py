@@ -246,3 +246,29 @@ def test_twin_reruns_v1_with_perturbed_gravity(tmp_path):
     with open(out / "V1_dx0.03_twin" / vv.STAMP) as f:
         stamp = json.load(f)
     assert stamp["sets"] == [["gravity", case_json()["gravity"] * (1 + 1e-6)]]
+
+
+def test_convergence_report(tmp_path):
+    # tools/vajont_convergence.py on hand-written V1 folders: the finest spacing is the reference,
+    # 1 % of the error (13) is 1.345 mm of lab run-up, and the cheapest spacing within the
+    # tolerance is picked (0.0035 m off the finest = 2.6 % d_eta: outside 2 %, inside 3 %)
+    import vajont_convergence as vc
+    for dx, z in ((0.02, 0.6925), (0.01, 0.7100), (0.005, 0.7135)):
+        d = str(tmp_path / f"dx{dx:g}" / f"V1_dx{dx:g}")
+        write_run(d)
+        with open(os.path.join(d, "summary.json")) as f:
+            s = json.load(f)
+        s["outputs"]["run_up"]["max"] = z
+        with open(os.path.join(d, "summary.json"), "w") as f:
+            json.dump(s, f)
+    assert vc.MM_PER_D_ETA == pytest.approx(1.345)
+    rows, finest = vc.collect(str(tmp_path), [0.02, 0.01, 0.005])
+    assert finest["dx"] == 0.005
+    assert rows[1]["diff_mm"] == pytest.approx(-3.5) and rows[1]["diff_d_eta"] == pytest.approx(3.5 / 1.345)
+    assert vc.cheapest_within(rows, finest, 2.0) is None
+    assert vc.cheapest_within(rows, finest, 3.0)["dx"] == 0.01
+    vc.run(["--spacings", "0.02,0.01,0.005", "--out", str(tmp_path), "--only-report", "--tolerance", "3"])
+    with open(tmp_path / "convergence.md") as f:
+        text = f.read()
+    assert "cheapest spacing within 3 % d_eta" in text and "dx = 0.01 m" in text
+    assert os.path.getsize(tmp_path / "convergence.png") > 1000

@@ -3,6 +3,7 @@
     mixsph-validate vajont --runs 1,2,4 --dx 0.01     # tools/vajont_validate.py, docs/validation/vajont.md
     mixsph-validate erosive --runs 2,6 --jobs 2       # tools/erosive_dambreak.py, docs/validation/erosive_dambreak.md
     mixsph-validate column --runs 1,2,3 --jobs 2      # tools/column_collapse.py, docs/validation/granular.md
+    mixsph-validate convergence --set numerics.viscosity=1   # tools/vajont_convergence.py, docs/validation/vajont.md
 
 CASE's options, outputs and exit status are its script's (``mixsph-validate CASE --help``).
 """
@@ -14,6 +15,8 @@ CASES = {
     "vajont": ("vajont_validate", "the Vajont runs V1-V6 of Manenti et al. (2018), Tables 4-5"),
     "erosive": ("erosive_dambreak", "the erosive dam break Runs 1-7 of Manenti et al. (2018), Tables 1-2"),
     "column": ("column_collapse", "a dry granular column collapse: does the deposit come to rest?"),
+    "convergence": ("vajont_convergence", "Vajont V1 against the particle spacing, and the cheapest spacing "
+                    "within a tolerance of the finest"),
 }
 
 
