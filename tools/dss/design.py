@@ -200,15 +200,20 @@ class Design:
         evaluate(self._scenarios(todo), on_result)
 
     def fit(self, restarts=None, folds=None, mode=None):
+        """The emulator of the runs so far; the hyperparameters start from the previous fit's,
+        and the CV keeps them in every fold (cheap; the final fit of `emulate design` refits
+        them per fold)."""
         df = self.results()
         ok = df[df["status"] == "ok"] if not df.empty else df
         if len(ok) < 3:
             return None
         em = E.from_results(ok, outputs=[self.output], inputs=self.names, box=self.box,
                             fmu=self.fmu, sweep={**self.settings, "design": self.state_path})
-        em.fit_output(self.output, mode=mode or self.mode,
-                      restarts=self.restarts if restarts is None else restarts,
-                      seed=self.seed, folds=folds or self.folds, cv=True)
+        m = em.fit_output(self.output, mode=mode or self.mode,
+                          restarts=self.restarts if restarts is None else restarts,
+                          seed=self.seed, folds=folds or self.folds, cv=True, cv_refit=False,
+                          init=getattr(self, "_thetas", None))
+        self._thetas = m.thetas()
         return em
 
     def _eta(self, runs_left):
@@ -231,6 +236,7 @@ class Design:
         while True:
             self._complete_batches(evaluate)
             n = self.n_runs()
+            t_fit = time.monotonic()
             em = self.fit()
             cv = em.cv[self.output] if em is not None else None
             hist = {"runs": n, "batches": len(self.state["batches"]),
@@ -238,6 +244,7 @@ class Design:
             if cv:
                 hist.update({k: cv[k] for k in ("rmse", "max_error", "coverage95", "range",
                                                 "rmse_pct", "max_error_pct")})
+                hist["fit_s"] = time.monotonic() - t_fit
             if not self.state["history"] or self.state["history"][-1]["runs"] != n:
                 self.state["history"].append(hist)
                 self._write_state()

@@ -91,7 +91,7 @@ def build_parser():
                             f"{'product' if design else 'auto'})")
         p.add_argument("--folds", type=int, default=5 if design else 10,
                        help=f"k of the k-fold cross-validation (default {5 if design else 10})")
-        p.add_argument("--restarts", type=int, default=2 if design else 3,
+        p.add_argument("--restarts", type=int, default=1 if design else 3,
                        help="optimizer restarts of the hyperparameters (default "
                             f"{2 if design else 3})")
         p.add_argument("--seed", type=int, default=0)
@@ -135,6 +135,12 @@ def build_parser():
                    help="pick where P(output > Z) is most uncertain (max p(1-p)) instead of max sd")
     d.add_argument("--candidates", type=int, help="random candidates per batch (1000 per input)")
     d.add_argument("--no-plots", action="store_true")
+    d.add_argument("--fit-output", action="append", default=[], metavar="NAME",
+                   help="another output the final emulator fits (repeatable; default: "
+                        "max_run_up_Z when the output is max_run_up)")
+    d.add_argument("--final-categorical", choices=("auto",) + E.MODES, default="auto",
+                   help="the binary inputs' handling of the final fit (10-fold CV, refitted "
+                        "per fold; default auto)")
     fit_opts(d, design=True)
     common_run_args(d)
     common_cluster_args(d)
@@ -437,6 +443,8 @@ def cmd_design(args):
     fmu, fixed, opts, md, var, dx = resolve_run(args, saved)
     if "dx" in var and var["dx"].causality == "parameter":
         fixed.setdefault("dx", dx)
+    if not args.fit_output and args.output == "max_run_up" and "max_run_up_Z" in var:
+        args.fit_output = ["max_run_up_Z"]
     dists = [Distribution(*split_assignment(it)) for it in args.dist]
     for d_ in dists:
         if d_.name not in var or var[d_.name].causality != "parameter":
@@ -470,10 +478,11 @@ def cmd_design(args):
           + {"target": f"the CV RMSE reached the target {args.target_error:g} %",
              "budget": f"the budget of {args.budget} runs is spent",
              "no new point": "no new candidate"}.get(res["reason"], str(res["reason"])))
-    em, files, fit_s = fit_folder(args.out, None, [d_.name for d_ in dists],
+    outs = [args.output] + [o for o in args.fit_output if o != args.output]
+    em, files, fit_s = fit_folder(args.out, outs, [d_.name for d_ in dists],
                                   {d_.name: D.box_of(d_) for d_ in dists}, fmu,
-                                  args.categorical if args.categorical != "product" else "auto",
-                                  10, 3, args.seed, None, not args.no_plots)
+                                  args.final_categorical, 10, 3, args.seed, None,
+                                  not args.no_plots)
     for name in em.models:
         _print_cv(name, em.cv.get(name), em.mode_comparison.get(name))
     if not args.no_plots:
