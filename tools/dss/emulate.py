@@ -14,6 +14,7 @@
   risk EMU           P(output > crest) under parameter distributions (--dist, the sweep's
                      syntax), with its band from joint posterior draws, and Sobol indices
   plot EMU           the response surface over reservoir_level and phi with its uncertainty
+  curve DESIGN HOLD  the hold-out error of emulators of a design's first n runs, against n
 
 The emulator file is JSON (docs/dss.md, section Emulator); it is checked against the FMU
 (--fmu, default build/LandslideWave.fmu): another GUID is refused. Exit codes: 0 ok, 1 the job
@@ -174,6 +175,20 @@ def build_parser():
     r.add_argument("--plots", metavar="DIR", help="write exceedance.png and sobol.png there")
     r.add_argument("--json", help="write the result as JSON")
     _fmu_args(r)
+
+    c = sub.add_parser("curve", help="hold-out error against the number of a design's runs")
+    c.add_argument("design", help="a design folder (emulate design)")
+    c.add_argument("holdout", help="a hold-out sweep folder")
+    c.add_argument("--sizes", default="", help="comma-separated run counts (default: after "
+                                               "every 10 runs and at the end)")
+    c.add_argument("--output", default="max_run_up")
+    c.add_argument("--categorical", choices=E.MODES, help="default: the design's emulator's")
+    c.add_argument("--range", type=float, help="the range the errors are relative to")
+    c.add_argument("--compare", action="append", default=[], metavar="SWEEP",
+                   help="another folder (e.g. a Latin hypercube) fitted whole and validated alike")
+    c.add_argument("--plot", help="PNG of the curve")
+    c.add_argument("--json", help="write the table as JSON")
+    _fmu_args(c)
 
     q = sub.add_parser("plot", help="the response surface over two inputs")
     q.add_argument("emulator")
@@ -420,6 +435,63 @@ def cmd_risk(args):
     return 0
 
 
+def cmd_curve(args):
+    """Fit the design's first n runs (in the order the design ran them) for several n and
+    validate each on the hold-out: the hold-out error against the number of runs."""
+    from .store import open_store
+    from .scenarios import ID
+    em_final = _load(argparse.Namespace(emulator=os.path.join(args.design, "emulator.json"),
+                                        fmu=args.fmu, no_fmu_check=args.no_fmu_check))
+    out = args.output
+    mode = args.categorical or em_final.models[out].mode
+    with open(os.path.join(args.design, "design.json")) as f:
+        st = json.load(f)
+    order = [i for b in st["batches"] for i in b["ids"]]
+    runs = open_store(args.design).latest().set_index(ID)
+    runs = runs.loc[[i for i in order if i in runs.index]]
+    hold = open_store(args.holdout).latest()
+    hold = hold[hold["status"] == "ok"]
+    n_all = len(runs)
+    sizes = [int(x) for x in args.sizes.split(",") if x.strip()] or \
+        sorted(set(list(range(10, n_all, 10)) + [n_all]))
+    box = {n: (float(lo), float(hi)) for n, (lo, hi) in zip(em_final.inputs, em_final.box)}
+    y_h = hold[out].astype(float).to_numpy()
+    rng = args.range or float(np.ptp(np.concatenate([y_h, runs[out].astype(float).to_numpy()])))
+    rows = []
+
+    def one(label, df, n):
+        ok = df[df["status"] == "ok"]
+        em = E.from_results(ok, outputs=[out], inputs=em_final.inputs, box=box)
+        em.fit_output(out, mode=mode, restarts=3, cv=False)
+        mu, sd = em.predict(hold[em.inputs].astype(float).to_numpy(), [out])[out]
+        m = E.metrics(y_h, mu, sd, y_range=rng)
+        rows.append({"set": label, "runs": n, **{k: m[k] for k in (
+            "rmse", "max_error", "coverage95", "rmse_pct", "max_error_pct")}})
+        r = rows[-1]
+        print(f"  {label:10s} {n:4d} runs: hold-out RMSE {r['rmse_pct']:.2f} %, max "
+              f"{r['max_error_pct']:.2f} %, coverage {100 * r['coverage95']:.1f} %")
+
+    print(f"emulate curve: {len(hold)} hold-out runs, mode {mode}, errors in % of {rng:.4g}")
+    for n in sizes:
+        if n < 3 or n > n_all:
+            continue
+        one("design", runs.iloc[:n].reset_index(), n)
+    for folder in args.compare:
+        df = open_store(folder).latest()
+        one(os.path.basename(os.path.normpath(folder)), df, int((df["status"] == "ok").sum()))
+    if args.plot:
+        from . import emulate_plots as P
+        P.ensure_dir(args.plot)
+        P.curve_plot(rows, args.plot)
+        print(f"  wrote {args.plot}")
+    if args.json:
+        with open(args.json, "w") as f:
+            json.dump(E._jsonable({"range": rng, "mode": mode, "holdout_runs": len(hold),
+                                   "rows": rows}), f, indent=1)
+        print(f"  wrote {args.json}")
+    return 0
+
+
 def cmd_plot(args):
     from . import emulate_plots as P
     from .__main__ import parse_sets
@@ -500,7 +572,8 @@ def main(argv=None):
     os.environ.setdefault("OMP_WAIT_POLICY", "passive")
     try:
         return {"fit": cmd_fit, "predict": cmd_predict, "validate": cmd_validate,
-                "risk": cmd_risk, "plot": cmd_plot, "design": cmd_design}[args.cmd](args)
+                "risk": cmd_risk, "plot": cmd_plot, "design": cmd_design,
+                "curve": cmd_curve}[args.cmd](args)
     except E.GuidMismatch as e:
         print(f"emulate: refused: {e}", file=sys.stderr)
         return 2

@@ -174,6 +174,31 @@ def design_history(history: list[dict], path: str, target=None, other: dict | No
     return path
 
 
+def curve_plot(rows: list[dict], path: str):
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(6, 4))
+    d = [r for r in rows if r["set"] == "design"]
+    ax.plot([r["runs"] for r in d], [r["rmse_pct"] for r in d], "o-", color="C0",
+            label="design: hold-out RMSE")
+    ax.plot([r["runs"] for r in d], [r["max_error_pct"] for r in d], "s--", color="C0",
+            label="design: hold-out max error")
+    for i, r in enumerate([r for r in rows if r["set"] != "design"]):
+        ax.plot([r["runs"]], [r["rmse_pct"]], "o", color=f"C{i + 1}", ms=8,
+                label=f"{r['set']}: RMSE")
+        ax.plot([r["runs"]], [r["max_error_pct"]], "s", color=f"C{i + 1}", ms=8,
+                label=f"{r['set']}: max")
+    ax.axhline(2, color="k", ls=":", lw=0.8)
+    ax.axhline(5, color="k", ls="-.", lw=0.8)
+    ax.set_xlabel("FMU runs fitted")
+    ax.set_ylabel("% of the run-up's range")
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
 def ensure_dir(path):
     d = os.path.dirname(path)
     if d:
