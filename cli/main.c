@@ -1,9 +1,9 @@
 /* mixsph - run a case file.
  *
  *   mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]
- *              [--checkpoint-every SECONDS] [--no-csv]
+ *              [--checkpoint-every SECONDS] [--no-csv] [--fixed-threads]
  *   mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]
- *              [--no-csv]
+ *              [--no-csv] [--fixed-threads]
  *
  * Progress on a terminal (simulated time, steps, steps/s, ETA); at the end a readable summary
  * on stdout and summary.json in the output folder. SIGINT or SIGTERM (Ctrl-C) stops the run before
@@ -21,18 +21,24 @@
 
 #include "mixsph.h"
 
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
 #define MAX_SETS 64
 
 static void usage(FILE *f)
 {
     fprintf(f,
             "usage: mixsph run CASE.json [--set key=value]... [--out DIR] [--threads N] [--quiet]\n"
-            "                  [--checkpoint-every SECONDS] [--no-csv]\n"
+            "                  [--checkpoint-every SECONDS] [--no-csv] [--fixed-threads]\n"
             "       mixsph run --restart CHECKPOINT [--out DIR] [--threads N] [--quiet] [--checkpoint-every SECONDS]\n"
-            "                  [--no-csv]\n"
+            "                  [--no-csv] [--fixed-threads]\n"
             "  --set key=value   override a numeric case value, e.g. --set numerics.dx=0.01\n"
             "  --out DIR         output folder (default: out/<case name>)\n"
-            "  --threads N       OpenMP threads (default: all cores)\n"
+            "  --threads N       OpenMP threads (default: all cores); the run drops to 1 thread while that\n"
+            "                    measures faster (another process busy on the cores), results unchanged\n"
+            "  --fixed-threads   always N threads\n"
             "  --quiet           no progress line\n"
             "  --checkpoint-every SECONDS\n"
             "                    write DIR/checkpoint.h5 every SECONDS of wall time (0: at every progress\n"
@@ -204,13 +210,100 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
     return fclose(f) == 0 ? 0 : -1;
 }
 
+/* The thread governor: runs on fewer threads when they measure faster. The step's parallel loops
+ * meet at barriers; when another busy process shares the cores, a barrier waits for a thread the
+ * system has descheduled, and with OpenMP's default (spinning) wait policy a 2-thread run on 2
+ * cores beside one busy process was 15-60 times slower than on an idle machine, and 6-10 times
+ * slower than 1 thread beside the same process (docs/performance.md, "Under load"). Results do not
+ * depend on the thread count, so the CLI may change it between steps: it times the steps in windows
+ * of GOV_WINDOW_S of wall time, and now and then (GOV_FIRST_S after the start or after a switch,
+ * then twice as long after each probe that kept the count, up to GOV_MAX_S; at once when a window
+ * is GOV_DROP times slower than the one after the last probe) runs one window on the other count
+ * (1 or the --threads asked for) and keeps it when its steps per second are GOV_GAIN times more.
+ * A probe costs at most one window at the slower count. --fixed-threads turns it off. */
+#define GOV_WINDOW_S 0.1
+#define GOV_FIRST_S 1.0
+#define GOV_MAX_S 32.0
+#define GOV_GAIN 1.1
+#define GOV_DROP 0.5
+
+struct governor {
+    int on;                /* more than one thread asked for and no --fixed-threads */
+    int max, cur;          /* threads asked for, threads in use */
+    int probing;           /* the window in progress runs on the other count */
+    double acc_s;          /* stepping wall time of the window in progress */
+    long acc_steps;        /* its steps */
+    double rate, rate_ref; /* steps/s of the last window on cur; of the first after the last probe */
+    double next_probe, interval;
+    long switches;
+};
+
+static void governor_init(struct governor *g, int threads, int fixed)
+{
+    memset(g, 0, sizeof *g);
+    g->max = threads;
+#ifdef _OPENMP
+    if (g->max == 0) g->max = omp_get_max_threads();
+#endif
+    if (g->max < 1) g->max = 1;
+    g->cur = g->max;
+    g->on = !fixed && g->max > 1;
+    g->interval = GOV_FIRST_S;
+    g->next_probe = now() + GOV_FIRST_S;
+}
+
+static void governor_window_done(mixsph_sim *s, struct governor *g, double t)
+{
+    const double rate = (double)g->acc_steps / g->acc_s;
+    g->acc_s = 0.0;
+    g->acc_steps = 0;
+    if (g->probing) {
+        const int other = g->cur == g->max ? 1 : g->max;
+        g->probing = 0;
+        if (rate > GOV_GAIN * g->rate) { /* the other count is faster: keep it */
+            g->cur = other;
+            g->rate = g->rate_ref = rate;
+            g->interval = GOV_FIRST_S;
+            g->switches++;
+        } else {
+            mixsph_sim_set_threads(s, g->cur);
+            g->rate_ref = g->rate;
+            g->interval = fmin(2.0 * g->interval, GOV_MAX_S);
+        }
+        g->next_probe = t + g->interval;
+        return;
+    }
+    g->rate = rate;
+    if (g->rate_ref <= 0.0) g->rate_ref = rate;
+    if (t >= g->next_probe || rate < GOV_DROP * g->rate_ref) {
+        g->probing = 1;
+        mixsph_sim_set_threads(s, g->cur == g->max ? 1 : g->max);
+    }
+}
+
+/* mixsph_sim_advance_to(s, target) (the same steps), timing each step for the governor. */
+static mixsph_status advance_governed(mixsph_sim *s, double target, struct governor *g)
+{
+    if (!g->on) return mixsph_sim_advance_to(s, target);
+    mixsph_status st = MIXSPH_OK;
+    while (st == MIXSPH_OK && mixsph_sim_time(s) < target && !stop_signal) {
+        const double t0 = now();
+        st = mixsph_sim_step(s);
+        const double t1 = now();
+        g->acc_s += t1 - t0;
+        g->acc_steps++;
+        if (g->acc_s >= GOV_WINDOW_S) governor_window_done(s, g, t1);
+    }
+    return st;
+}
+
 static int cmd_run(int argc, char **argv)
 {
     const char *case_path = NULL, *out_dir = NULL, *restart = NULL;
     double ckpt_every = -1.0; /* wall seconds between checkpoints, < 0: none */
     mixsph_override sets[MAX_SETS];
     size_t n_sets = 0;
-    int threads = 0, quiet = 0, no_csv = 0;
+    int threads = 0, quiet = 0, no_csv = 0, fixed_threads = 0;
     char err[1024];
     for (int a = 0; a < argc; a++) {
         const char *arg = argv[a];
@@ -255,6 +348,8 @@ static int cmd_run(int argc, char **argv)
             quiet = 1;
         } else if (strcmp(arg, "--no-csv") == 0) {
             no_csv = 1;
+        } else if (strcmp(arg, "--fixed-threads") == 0) {
+            fixed_threads = 1;
         } else if (arg[0] == '-') {
             fprintf(stderr, "mixsph: unknown option '%s'\n", arg);
             usage(stderr);
@@ -323,8 +418,10 @@ static int cmd_run(int argc, char **argv)
     double last_print = 0.0, last_ckpt = t0;
     unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
+    struct governor gov;
+    governor_init(&gov, threads, fixed_threads);
     for (int c = 1; c <= chunks && st == MIXSPH_OK && !stop_signal; c++) {
-        st = mixsph_sim_advance_to(s, t_end * c / chunks);
+        st = advance_governed(s, t_end * c / chunks, &gov);
         if (st == MIXSPH_ERR_INTERRUPTED) st = MIXSPH_OK; /* a signal, between two steps: stopped below */
         if (st == MIXSPH_OK && ckpt_every >= 0.0 && c < chunks && mixsph_sim_steps(s) > ckpt_step &&
             now() - last_ckpt >= ckpt_every) {
@@ -344,6 +441,9 @@ static int cmd_run(int argc, char **argv)
         }
     }
     if (tty) fprintf(stderr, "\n");
+    if (!quiet && gov.on)
+        fprintf(stderr, "mixsph: %d threads asked, %d in use at the end, %ld switches of the thread count\n", gov.max,
+                gov.cur, gov.switches);
     const double wall = now() - t0;
     const int stopped = stop_signal && st == MIXSPH_OK && mixsph_sim_time(s) < t_end;
     if (stopped) {

@@ -552,26 +552,42 @@ static int scratch_reserve(struct forces *F, size_t n)
 
 typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, struct particles *restrict, size_t, size_t);
 
-/* Run `fn` over all bands of FORCES_BAND_ROWS cell rows: even bands in parallel, then odd. */
-static void for_bands(const struct pair_system *S, band_fn fn, const struct pair_ctx *X)
+/* Walk `fn` over all bands of FORCES_BAND_ROWS cell rows, even bands in parallel, then odd:
+ * orphaned worksharing loops, to be called by every thread of the enclosing parallel region (each
+ * phase ends with the loop's barrier); called outside a region, the calling thread walks them all
+ * in the same order. A pass opens one region for its bands and its per-particle loop after them,
+ * so that a step has few parallel regions: each region's fork and join, and each barrier, waits
+ * for a thread that another process may have descheduled (docs/performance.md, "Under load"). */
+static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X, int last_nowait)
 {
     const struct cells *C = S->C;
     const long nb = (C->nz + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
     struct particles *P = S->P;
-#pragma omp parallel num_threads(S->n_threads)
-    for (int phase = 0; phase < 2; phase++) {
+#define FORCES_BAND(b)                                                                                        \
+    do {                                                                                                      \
+        const long r0 = (b) * FORCES_BAND_ROWS;                                                               \
+        const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;                        \
+        fn(X, S->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);         \
+    } while (0)
 #pragma omp for schedule(dynamic, 1)
-        for (long b = phase; b < nb; b += 2) {
-            const long r0 = b * FORCES_BAND_ROWS;
-            const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;
-            fn(X, S->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);
-        }
+    for (long b = 0; b < nb; b += 2) FORCES_BAND(b);
+    if (last_nowait) {
+#pragma omp for schedule(dynamic, 1) nowait
+        for (long b = 1; b < nb; b += 2) FORCES_BAND(b);
+    } else {
+#pragma omp for schedule(dynamic, 1)
+        for (long b = 1; b < nb; b += 2) FORCES_BAND(b);
     }
+#undef FORCES_BAND
 }
 
 static size_t active_count(const struct pair_system *S) { return S->C->start[S->C->ncell]; }
 
-int forces_density_rate(struct forces *F, const struct pair_system *S)
+/* The density pass, and with `grad` the velocity gradient of the grains, in one parallel
+ * region: the gradient reads positions, velocities and volumes, which the density pass does not
+ * write, so it runs while the last bands finish; the per-particle loop after the bands waits for
+ * them. */
+static int density_rate(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad)
 {
     struct particles *P = S->P;
     struct pair_ctx X;
@@ -586,16 +602,33 @@ int forces_density_rate(struct forces *F, const struct pair_system *S)
         X.fk = F->fk;
         X.fk_off = F->fk_off;
     }
-    for_bands(S, continuity_band, &X);
     int bad = 0;
     const double *count = F->nbr_count;
-#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        P->drho[i] *= P->rho[i];
-        P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
-        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
+    const struct medium *M = S->media;
+#pragma omp parallel num_threads(S->n_threads)
+    {
+        bands_in_team(S, continuity_band, &X, grad != NULL);
+        if (grad) {
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n; i++)
+                if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
+                    gradient_particle(&X, S->G, P, grad, i);
+        }
+#pragma omp for schedule(static) reduction(| : bad) nowait
+        for (size_t i = 0; i < n; i++) {
+            P->drho[i] *= P->rho[i];
+            P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
+            bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
+        }
     }
     return bad;
+}
+
+int forces_density_rate(struct forces *F, const struct pair_system *S) { return density_rate(F, S, NULL); }
+
+int forces_density_rate_gradient(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad)
+{
+    return density_rate(F, S, grad);
 }
 
 void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out)
@@ -638,14 +671,17 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         X.fk_off = F->fk_off;
     }
     F->fk_valid = 0;
-    for_bands(S, momentum_band, &X);
     const double g = X.g;
     int bad = 0;
-#pragma omp parallel for schedule(static) reduction(| : bad) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
-        P->az[i] = P->az[i] * P->inv_m[i] - g;
-        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
+#pragma omp parallel num_threads(S->n_threads)
+    {
+        bands_in_team(S, momentum_band, &X, 0);
+#pragma omp for schedule(static) reduction(| : bad) nowait
+        for (size_t i = 0; i < n; i++) {
+            P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
+            P->az[i] = P->az[i] * P->inv_m[i] - g;
+            bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
+        }
     }
     F->visc_valid = X.visc_w != NULL;
     return bad;
@@ -668,7 +704,8 @@ int forces_viscous_apply(const struct forces *F, const struct pair_system *S, co
     X.out_x = out_x;
     X.out_z = out_z;
     X.out_diag = diag;
-    for_bands(S, viscous_band, &X);
+#pragma omp parallel num_threads(S->n_threads)
+    bands_in_team(S, viscous_band, &X, 1);
     return 0;
 }
 
@@ -714,18 +751,21 @@ int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double
     memset(F->smooth_weight, 0, n * sizeof(double));
     X.sum = F->smooth_sum;
     X.weight = F->smooth_weight;
-    for_bands(S, smooth_band, &X);
     const double *sum = F->smooth_sum, *weight = F->smooth_weight;
     const struct medium *M = S->media;
-#pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || !(weight[i] > 0.0)) continue;
-        const double c = M[P->medium[i]].c;
-        const double dp = theta_dt_over_h * c * sum[i] / weight[i];
-        P->p[i] += dp;
-        P->rho[i] += dp / (c * c);
-        P->inv_rho[i] = 1.0 / P->rho[i];
-        P->vol[i] = P->m[i] * P->inv_rho[i];
+#pragma omp parallel num_threads(S->n_threads)
+    {
+        bands_in_team(S, smooth_band, &X, 0);
+#pragma omp for schedule(static) nowait
+        for (size_t i = 0; i < n; i++) {
+            if (P->state[i] > MIXSPH_STATE_FIXED || !(weight[i] > 0.0)) continue;
+            const double c = M[P->medium[i]].c;
+            const double dp = theta_dt_over_h * c * sum[i] / weight[i];
+            P->p[i] += dp;
+            P->rho[i] += dp / (c * c);
+            P->inv_rho[i] = 1.0 / P->rho[i];
+            P->vol[i] = P->m[i] * P->inv_rho[i];
+        }
     }
     return 0;
 }

@@ -60,6 +60,10 @@ int forces_density_rate(struct forces *F, const struct pair_system *S);
  *  lost, over its gather ranges (walls enter with their no-slip velocity). */
 void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out);
 
+/** forces_density_rate and forces_velocity_gradient(S, grad) in one parallel region (the same
+ *  results: the gradient reads nothing the density pass writes). */
+int forces_density_rate_gradient(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad);
+
 /** Acceleration (ax, az) of every particle, gravity included (without the viscous term when
  *  params.implicit_viscosity; the pass then stores the viscous couplings w_ij of the pairs, and
  *  must follow this step's forces_density_rate). Returns 1 if a non-finite value appeared at a

@@ -39,42 +39,53 @@
  * a grain mobilised at the next step is then integrated stably from its first mobile step. It
  * also keeps the velocity a fixed grain picks up in one step (dt a) small, so grains whose forces
  * nearly balance stay fixed (docs/model.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
+static inline double particle_time_step(const mixsph_sim *s, size_t i, int implicit)
+{
+    const struct particles *P = &s->P;
+    const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
+    double mu = implicit ? 0.0 : P->mu[i];
+    if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
+        const struct medium *m = &s->cfg.media[P->medium[i]];
+        mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
+    }
+    return integrate_particle_dt(s->cfg.cfl, s->cfg.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
+}
+
 double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;
-    const double h = s->h, cfl = s->cfg.cfl, cflv = s->cfg.cfl_visc, cmax = s->c_max;
     const int implicit = s->cfg.viscosity_implicit; /* no viscous bound: the viscous step is implicit */
     double dt = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : dt) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
-        double mu = implicit ? 0.0 : P->mu[i];
-        if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
-            const struct medium *m = &s->cfg.media[P->medium[i]];
-            mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
-        }
-        const double d = integrate_particle_dt(cfl, cflv, h, cmax, u, P->rho[i], mu);
+        const double d = particle_time_step(s, i, implicit);
         if (d < dt) dt = d;
     }
     return dt;
 }
 
+/* The equation of state of particle i (not a wall, not lost): pressure, 1/rho, volume, alpha c h. */
+static inline void particle_pressure(mixsph_sim *s, size_t i)
+{
+    struct particles *P = &s->P;
+    const struct medium *m = &s->cfg.media[P->medium[i]];
+    const double pb = s->cfg.p_background;
+    double p = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
+    if (m->tension_cutoff && p < pb) p = pb; /* a cohesionless medium carries no tension */
+    P->p[i] = p;
+    P->inv_rho[i] = 1.0 / P->rho[i];
+    P->vol[i] = P->m[i] * P->inv_rho[i];
+    P->avc[i] = m->alpha_m * m->c * s->h;
+}
+
 void integrate_pressure_and_derived(mixsph_sim *s)
 {
     struct particles *P = &s->P;
-    const struct medium *M = s->cfg.media;
-    const double pb = s->cfg.p_background;
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
-        const struct medium *m = &M[P->medium[i]];
-        double p = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
-        if (m->tension_cutoff && p < pb) p = pb; /* a cohesionless medium carries no tension */
-        P->p[i] = p;
-        P->inv_rho[i] = 1.0 / P->rho[i];
-        P->vol[i] = P->m[i] * P->inv_rho[i];
-        P->avc[i] = m->alpha_m * m->c * s->h;
+        particle_pressure(s, i);
     }
 }
 
@@ -149,16 +160,15 @@ static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.nce
 
 int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 {
-    const int bad = forces_density_rate(s->forces, S);
-    if (bad >= 0 && s->mixture) forces_velocity_gradient(S, mixture_gradient(s->mixture));
-    return bad;
+    if (s->mixture) return forces_density_rate_gradient(s->forces, S, mixture_gradient(s->mixture));
+    return forces_density_rate(s->forces, S);
 }
 
-/* After the densities are updated: pressures (smoothed with numerics.pressure_smoothing), the
- * grains' regimes, the walls' extrapolated state. Returns -1 when out of memory. */
+/* After the densities are updated and the equation of state: pressures smoothed (with
+ * numerics.pressure_smoothing), the grains' regimes, the walls' extrapolated state. Returns -1
+ * when out of memory. */
 static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth)
 {
-    integrate_pressure_and_derived(s);
     if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
     if (s->mixture) s->n_fixed = mixture_update(s->mixture, &s->K, &s->G, &s->P, active_particles(s), S->n_threads);
     walls_extrapolate_fluid(&s->cfg, s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
@@ -217,6 +227,7 @@ mixsph_status integrate_initial_rates(mixsph_sim *s)
     const int bad = integrate_density_rates(s, &S);
     if (bad < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
+    integrate_pressure_and_derived(s);
     pressures_and_regimes(s, &S, 0);
     const int bad_a = forces_momentum(s->forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -247,30 +258,46 @@ mixsph_status integrate_step(mixsph_sim *s)
     const double gap = INTEGRATE_CLIP_GAP * s->dx;
     const double half_kick = implicit ? 0.0 : 0.5 * dt;
     long clips = 0;
-#pragma omp parallel for schedule(static) reduction(+ : clips) num_threads(SIM_THREADS(s))
+    /* with the drift, in the same loop, the largest squared displacement of an active particle
+     * (walls included: they moved above) since the last build and whether one left the grid, as
+     * neighbours_max_shift2 computes them (max and | are exact, so any order gives the same) */
+    const size_t n_active = s->C.start[s->C.ncell];
+    const double *x_build = s->NB.x0, *z_build = s->NB.z0;
+    const struct cells *C = &s->C;
+    const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
+    double shift2 = 0.0;
+    int outside = 0;
+#pragma omp parallel for schedule(static) reduction(+ : clips) reduction(max : shift2) reduction(| : outside) \
+    num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         const int st = P->state[i];
-        if (st == MIXSPH_STATE_WALL || st == MIXSPH_STATE_LOST) continue;
-        const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : half_kick;
-        double vx = P->vx[i] + kick * P->ax[i];
-        double vz = P->vz[i] + kick * P->az[i];
-        if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
-            const double x0 = P->x[i], z0 = P->z[i];
-            double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
-            if (s->near_wall[i]) walls_clip(&s->cfg, s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
-            P->x[i] = x1;
-            P->z[i] = z1;
+        if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
+            const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : half_kick;
+            double vx = P->vx[i] + kick * P->ax[i];
+            double vz = P->vz[i] + kick * P->az[i];
+            if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
+                const double x0 = P->x[i], z0 = P->z[i];
+                double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
+                if (s->near_wall[i])
+                    walls_clip(&s->cfg, s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
+                P->x[i] = x1;
+                P->z[i] = z1;
+            }
+            P->vx[i] = P->uvx[i] = vx;
+            P->vz[i] = P->uvz[i] = vz;
         }
-        P->vx[i] = P->uvx[i] = vx;
-        P->vz[i] = P->uvz[i] = vz;
+        if (i < n_active) {
+            const double ddx = P->x[i] - x_build[i], ddz = P->z[i] - z_build[i];
+            const double d2 = ddx * ddx + ddz * ddz;
+            shift2 = d2 > shift2 ? d2 : shift2;
+            outside |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
+        }
     }
     s->n_clipped += clips;
     s->t += dt;
     s->step++;
     /* the lists hold while no particle has moved skin/2 since their build; a particle that left
      * the grid is marked lost by the rebuild at once */
-    int outside = 0;
-    const double shift2 = neighbours_max_shift2(&s->NB, &s->C, P, s->C.start[s->C.ncell], &outside, SIM_THREADS(s));
     if (outside || 4.0 * shift2 >= s->NB.skin * s->NB.skin) {
         const mixsph_status st = integrate_rebuild_lists(s);
         if (st != MIXSPH_OK) return st;
@@ -278,11 +305,13 @@ mixsph_status integrate_step(mixsph_sim *s)
     const struct pair_system S = sim_pair_system(s);
     int bad_rho = integrate_density_rates(s, &S);
     if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    /* the densities and the equation of state, in one loop */
 #pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         P->rho[i] += dt * P->drho[i];
         bad_rho |= !(P->rho[i] > 0.0);
+        particle_pressure(s, i);
     }
     if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -295,7 +324,19 @@ mixsph_status integrate_step(mixsph_sim *s)
                                 "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
                                 P->rho[i], P->id[i], P->x[i], P->z[i], s->t);
     }
-    if (!implicit) kick_velocities(s, 0.5 * dt);
-    s->dt = integrate_time_step(s);
+    /* the last kick (explicit scheme) and the next time step, in one loop */
+    const double last_kick = implicit ? 0.0 : 0.5 * dt;
+    double dt_next = INFINITY;
+#pragma omp parallel for schedule(static) reduction(min : dt_next) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        if (!implicit && !(P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed)) {
+            P->vx[i] += last_kick * P->ax[i];
+            P->vz[i] += last_kick * P->az[i];
+        }
+        const double d = particle_time_step(s, i, implicit);
+        if (d < dt_next) dt_next = d;
+    }
+    s->dt = dt_next;
     return MIXSPH_OK;
 }

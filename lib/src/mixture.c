@@ -182,80 +182,85 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
     const int fixed_bed = cfg->fixed_bed_speed >= 0.0;
     if (fixed_bed) fixed_bed_tops(M, P, n);
     long fixed = 0;
-#pragma omp parallel for schedule(static) reduction(+ : fixed) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const struct medium *m = &cfg->media[P->medium[i]];
-        if (m->kind != MEDIUM_GRANULAR) continue;
-        double dudx = K->dudx[i], dudz = K->dudz[i], dwdx = K->dwdx[i], dwdz = K->dwdz[i];
-        const double det = K->lxx[i] * K->lzz[i] - K->lxz[i] * K->lxz[i];
-        if (det > MIXTURE_DET_MIN) {
-            const double a = K->lzz[i] / det, b = -K->lxz[i] / det, d = K->lxx[i] / det; /* L^-1 = [a b; b d] */
-            const double ux = dudx * a + dudz * b, uz = dudx * b + dudz * d;
-            const double wx = dwdx * a + dwdz * b, wz = dwdx * b + dwdz * d;
-            dudx = ux;
-            dudz = uz;
-            dwdx = wx;
-            dwdz = wz;
+    const double g = cfg->g, pb = cfg->p_background;
+    /* one parallel region for the three loops (each waits for the one before: the second reads the
+     * regimes of the first, the third the pressures of the second) */
+#pragma omp parallel num_threads(n_threads)
+    {
+#pragma omp for schedule(static) reduction(+ : fixed)
+        for (size_t i = 0; i < n; i++) {
+            if (P->state[i] == MIXSPH_STATE_WALL) continue;
+            const struct medium *m = &cfg->media[P->medium[i]];
+            if (m->kind != MEDIUM_GRANULAR) continue;
+            double dudx = K->dudx[i], dudz = K->dudz[i], dwdx = K->dwdx[i], dwdz = K->dwdz[i];
+            const double det = K->lxx[i] * K->lzz[i] - K->lxz[i] * K->lxz[i];
+            if (det > MIXTURE_DET_MIN) {
+                const double a = K->lzz[i] / det, b = -K->lxz[i] / det, d = K->lxx[i] / det; /* L^-1 = [a b; b d] */
+                const double ux = dudx * a + dudz * b, uz = dudx * b + dudz * d;
+                const double wx = dwdx * a + dwdz * b, wz = dwdx * b + dwdz * d;
+                dudx = ux;
+                dudz = uz;
+                dwdx = wx;
+                dwdz = wz;
+            }
+            const double sii = rheology_sqrt_ii(dudx, dudz, dwdx, dwdz);
+            const double pw = m->saturated ? pore_pressure(M, m, P->x[i], P->z[i]) : 0.0;
+            const double sigma = rheology_effective_stress(P->p[i] - cfg->p_background, pw);
+            const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
+            double mu;
+            int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
+            if (fixed_bed && frozen(M, P, i)) {
+                fix = 1;
+                mu = m->mu_thr;
+            }
+            if (fix) {
+                P->state[i] = MIXSPH_STATE_FIXED;
+                P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
+                fixed++;
+            } else {
+                P->state[i] = MIXSPH_STATE_MOBILE;
+            }
+            P->mu[i] = mu;
         }
-        const double sii = rheology_sqrt_ii(dudx, dudz, dwdx, dwdz);
-        const double pw = m->saturated ? pore_pressure(M, m, P->x[i], P->z[i]) : 0.0;
-        const double sigma = rheology_effective_stress(P->p[i] - cfg->p_background, pw);
-        const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
-        double mu;
-        int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
-        if (fixed_bed && frozen(M, P, i)) {
-            fix = 1;
-            mu = m->mu_thr;
+        if (fixed > 0) { /* the reduction is complete after the loop's barrier, in every thread */
+            /* pressure of the fixed grains from the mobile grains around them */
+#pragma omp for schedule(static)
+            for (size_t i = 0; i < n; i++) {
+                if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
+                const double xi = P->x[i], zi = P->z[i];
+                double sw = 0.0, sp = 0.0;
+                for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
+                    for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
+                    if (P->state[j] != MIXSPH_STATE_MOBILE || cfg->media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
+                    const double rx = xi - P->x[j], rz = zi - P->z[j];
+                    const double r2 = rx * rx + rz * rz;
+                    if (r2 >= KW->r2max) continue;
+                    const double w = kernel_w(KW, sqrt(r2));
+                    sw += w;
+                    sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
+                }
+                if (sw > 0.0) {
+                    const double p = sp / sw;
+                    P->p[i] = cfg->media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
+                }
+            }
+            if (fixed_bed) {
+                /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
+                 * final: the top is never frozen, and its extrapolation above is done) */
+#pragma omp for schedule(static) nowait
+                for (size_t i = 0; i < n; i++) {
+                    if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
+                    const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
+                    const struct medium *m = &cfg->media[P->medium[i]];
+                    double p = P->p[top] + cfg->media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+                    if (m->tension_cutoff && p < pb) p = pb;
+                    P->p[i] = p;
+                    P->rho[i] = eos_density(p - pb, m->rho0, m->c);
+                    P->inv_rho[i] = 1.0 / P->rho[i];
+                    P->vol[i] = P->m[i] * P->inv_rho[i];
+                }
+            }
         }
-        if (fix) {
-            P->state[i] = MIXSPH_STATE_FIXED;
-            P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
-            fixed++;
-        } else {
-            P->state[i] = MIXSPH_STATE_MOBILE;
-        }
-        P->mu[i] = mu;
-    }
-    if (fixed == 0) return 0;
-    /* pressure of the fixed grains from the mobile grains around them */
-    const double g = cfg->g;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
-        const double xi = P->x[i], zi = P->z[i];
-        double sw = 0.0, sp = 0.0;
-        for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
-            for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
-            if (P->state[j] != MIXSPH_STATE_MOBILE || cfg->media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
-            const double rx = xi - P->x[j], rz = zi - P->z[j];
-            const double r2 = rx * rx + rz * rz;
-            if (r2 >= KW->r2max) continue;
-            const double w = kernel_w(KW, sqrt(r2));
-            sw += w;
-            sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
-        }
-        if (sw > 0.0) {
-            const double pb = cfg->p_background;
-            const double p = sp / sw;
-            P->p[i] = cfg->media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
-        }
-    }
-    if (!fixed_bed) return fixed;
-    /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
-     * final: the top is never frozen, and its extrapolation above is done) */
-    const double pb = cfg->p_background;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
-        const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
-        const struct medium *m = &cfg->media[P->medium[i]];
-        double p = P->p[top] + cfg->media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
-        if (m->tension_cutoff && p < pb) p = pb;
-        P->p[i] = p;
-        P->rho[i] = eos_density(p - pb, m->rho0, m->c);
-        P->inv_rho[i] = 1.0 / P->rho[i];
-        P->vol[i] = P->m[i] * P->inv_rho[i];
     }
     return fixed;
 }
