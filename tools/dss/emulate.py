@@ -132,6 +132,9 @@ def build_parser():
     d.add_argument("--output", default="max_run_up", help="the output designed for")
     d.add_argument("--init", type=int, help="runs of the Latin-hypercube start (default "
                                             "min(budget/3, 10 per input), at least one batch)")
+    d.add_argument("--min-runs", type=int, metavar="N",
+                   help="runs before the CV target may stop the design (default 10 per input, "
+                        "at most the budget)")
     d.add_argument("--crest", type=float, metavar="Z",
                    help="pick where P(output > Z) is most uncertain (max p(1-p)) instead of max sd")
     d.add_argument("--candidates", type=int, help="random candidates per batch (1000 per input)")
@@ -540,7 +543,8 @@ def cmd_design(args):
                        budget=args.budget, target_error=args.target_error, n_init=args.init,
                        crest=args.crest, seed=args.seed, n_workers=nw, mode=args.categorical,
                        folds=args.folds, restarts=args.restarts, n_candidates=args.candidates,
-                       fmu=ident, settings=settings, progress=not quiet)
+                       fmu=ident, settings=settings, progress=not quiet,
+                       min_runs=args.min_runs)
         try:
             res = des.run(evaluate)
         except D.DesignError as e:
