@@ -2,8 +2,9 @@
  * a restored state continues bit for bit as the original (in place and in a new simulation
  * created from the state alone), a state of another case or a damaged buffer is refused with a
  * message and leaves the simulation unchanged, and a wall driven by an external velocity moves
- * by exactly v t. Case: the Vajont Padua case (granular landslide, water, moving plate) at a
- * coarse dx, so every part of the state (fixed grains, wall motion, monitors) is exercised. */
+ * by exactly v t and takes a new velocity at once. Case: the Vajont Padua case (granular
+ * landslide, water, moving plate) at a coarse dx, so every part of the state (fixed grains, wall
+ * motion, monitors) is exercised; the slope tank for the velocity jump. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -188,12 +189,66 @@ static void test_external_wall_velocity(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* Fastest fluid or granular particle [m/s]. */
+static double fastest(const mixsph_sim *s)
+{
+    mixsph_particles_view v;
+    mixsph_sim_particles_view(s, &v);
+    double u = 0.0;
+    for (size_t i = 0; i < v.n; i++)
+        if (v.state[i] <= MIXSPH_STATE_FIXED) u = fmax(u, hypot(v.vx[i], v.vz[i]));
+    return u;
+}
+
+/* A drive that jumps to a new speed takes effect at once: the ram's particles carry it before
+ * the next step, and the grains held fixed against the ram are mobilised by it instead of being
+ * kicked with mu_thr over a time step made for mu0. Case: cases/slope_tank.json (the FMU's test
+ * case), its ram driven at U = 1.5 m/s along its law's direction from t = 0, when every grain is
+ * held fixed, and again after a pause at rest. Reference: a grain shoved by a piston moving at U
+ * moves at about U (momentum); bound 2 U. With the drive's stale state (the wall pass of the old
+ * velocity) the fastest grain reached 27.6 m/s within 0.02 s, and the FMU's run failed at 0.1 s. */
+static void test_external_velocity_jump(void **state)
+{
+    (void)state;
+    const double U = 1.5, ux = 0.715 / hypot(0.715, 0.358), uz = -0.358 / hypot(0.715, 0.358);
+    for (int pause = 0; pause < 2; pause++) {
+        mixsph_sim *s = NULL;
+        char err[512];
+        const mixsph_status st = mixsph_sim_create(MIXSPH_SOURCE_DIR "/cases/slope_tank.json", NULL, 0, &s, err, sizeof err);
+        if (st != MIXSPH_OK) fprintf(stderr, "%s\n", err);
+        assert_int_equal(st, MIXSPH_OK);
+        assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+        if (pause) {
+            assert_int_equal(mixsph_sim_set_wall_velocity(s, "ram", 0.0, 0.0), MIXSPH_OK);
+            assert_int_equal(mixsph_sim_advance_to(s, 0.05), MIXSPH_OK);
+        }
+        assert_int_equal(mixsph_sim_set_wall_velocity(s, "ram", U * ux, U * uz), MIXSPH_OK);
+        mixsph_particles_view v;
+        mixsph_sim_particles_view(s, &v);
+        for (size_t i = 0; i < v.n; i++)
+            if (v.state[i] == MIXSPH_STATE_WALL && v.medium[i] == 1) { /* the ram is the second wall */
+                assert_true(v.vx[i] == U * ux);
+                assert_true(v.vz[i] == U * uz);
+            }
+        const double t0 = mixsph_sim_time(s);
+        double worst = 0.0;
+        for (int k = 1; k <= 10; k++) {
+            assert_int_equal(mixsph_sim_advance_to(s, t0 + 0.002 * k), MIXSPH_OK);
+            worst = fmax(worst, fastest(s));
+        }
+        if (worst >= 2.0 * U) fprintf(stderr, "pause %d: fastest particle %g m/s\n", pause, worst);
+        assert_true(worst < 2.0 * U);
+        mixsph_sim_destroy(s);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_restore_continues_identically),
         cmocka_unit_test(test_bad_states_are_refused),
         cmocka_unit_test(test_external_wall_velocity),
+        cmocka_unit_test(test_external_velocity_jump),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -483,6 +483,7 @@ mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, doub
     s->walls[w].ext = 1;
     s->walls[w].ext_vx = vx;
     s->walls[w].ext_vz = vz;
+    walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, 0.0, 0.0, &s->P);
     return MIXSPH_OK;
 }
 
@@ -492,6 +493,13 @@ mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall)
     if (!wall) return SIM_FAIL(s, MIXSPH_ERR_ARG, "release_wall_velocity: no wall name");
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
+    if (s->walls[w].ext) {
+        const struct motion *law = &s->cfg.motions[s->cfg.walls[w].motion];
+        double vx, vz, ax, az;
+        case_motion_velocity(law, s->t, &vx, &vz);
+        case_motion_acceleration(law, s->t, &ax, &az);
+        walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, ax, az, &s->P);
+    }
     s->walls[w].ext = 0;
     return MIXSPH_OK;
 }

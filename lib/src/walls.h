@@ -23,6 +23,12 @@ struct wall_state {
 /** Velocity and acceleration of every wall at t = 0 from its motion law. */
 void walls_start(const struct case_def *cfg, struct wall_state *ws);
 
+/** Give moving wall w the velocity (vx, vz) and acceleration (ax, az) from now on, between two
+ *  steps: its state, its particles' velocity and their velocity in the viscous terms (the mirror
+ *  of the last wall pass, which the next regime decision reads) change with it. */
+void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, size_t w, double vx, double vz, double ax,
+                           double az, struct particles *P);
+
 #define WALLS_INTERRUPTED (-2L)
 
 /** Append the wall particles of every wall of the case at spacing dx (cfg->wall_layers layers
