@@ -170,6 +170,17 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
     json_number(f, wall > 0 ? psteps / wall : NAN);
     fprintf(f, ",\n  \"wall_s_per_simulated_s\": ");
     json_number(f, simulated > 0 ? wall / simulated : NAN);
+    uint64_t visc_iterations = 0;
+    double visc_wall = 0.0;
+    mixsph_sim_viscous_cost(s, &visc_iterations, &visc_wall);
+    if (visc_iterations > 0) { /* the implicit viscous step: its iterations and its share of the time */
+        fprintf(f, ",\n  \"viscous_iterations_per_step\": ");
+        json_number(f, mixsph_sim_steps(s) > 0 ? (double)visc_iterations / (double)mixsph_sim_steps(s) : NAN);
+        fprintf(f, ",\n  \"viscous_solve_wall_time_s\": ");
+        json_number(f, visc_wall);
+        fprintf(f, ",\n  \"viscous_solve_fraction\": ");
+        json_number(f, wall > 0 ? visc_wall / wall : NAN);
+    }
     fprintf(f, ",\n  \"outputs\": {\n");
     const size_t n = mixsph_sim_output_count(s);
     for (size_t k = 0; k < n; k++) {

@@ -127,6 +127,10 @@ uint64_t mixsph_sim_steps(const mixsph_sim *s);   /**< steps taken */
  *  checkpoint was written by a build that did not record it). mixsph_sim_load_state leaves it
  *  alone (it is not physics). */
 double mixsph_sim_run_wall_time(const mixsph_sim *s);
+/** The implicit viscous step's cost (numerics.viscosity = "implicit"; 0 and 0 otherwise): the
+ *  iterations of all its solves since t = 0 (carried by saved states) and the wall-clock seconds
+ *  this process has spent in it (setting up and solving, within mixsph_sim_run_wall_time). */
+mixsph_status mixsph_sim_viscous_cost(const mixsph_sim *s, uint64_t *iterations, double *wall_s);
 size_t mixsph_sim_particles(const mixsph_sim *s); /**< fluid + granular particles */
 size_t mixsph_sim_wall_particles(const mixsph_sim *s);
 const char *mixsph_sim_name(const mixsph_sim *s);

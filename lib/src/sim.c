@@ -432,6 +432,14 @@ double sim_clock_s(void)
 
 double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->run_wall_s : NAN; }
 
+mixsph_status mixsph_sim_viscous_cost(const mixsph_sim *s, uint64_t *iterations, double *wall_s)
+{
+    if (!s || !iterations || !wall_s) return MIXSPH_ERR_ARG;
+    *iterations = s->viscous_iterations;
+    *wall_s = s->viscous_wall_s;
+    return MIXSPH_OK;
+}
+
 mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
 {
     if (!s) return MIXSPH_ERR_ARG;

@@ -54,6 +54,7 @@ struct mixsph_sim {
     struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
     struct viscous_report viscous_last; /* the last solve */
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
+    double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
     struct mixture *mixture;      /* granular phase; NULL without granular media */
