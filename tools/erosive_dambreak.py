@@ -434,7 +434,10 @@ def plot(path, results, at, dx):
 OPTIONS = campaign.CaseOptions(
     description="Erosive dam break (Manenti et al. 2018, Tables 1-2): run mixsph and compare with the paper.",
     own=(("--at", dict(type=float, default=0.5, help="time [s] of the profiles compared and plotted, one of the "
-                       "case's profile times (default 0.5)")),),
+                       "case's profile times (default 0.5)")),
+         ("--against", dict(metavar="DIR", help="also compare every run with the run of the same number and dx "
+                            "in DIR (another campaign, e.g. the other viscous scheme): interface errors, bed-load "
+                            "rise, steps, wall time; table printed and written to OUT/erosive_against.csv"))),
     runs="2,5,6,7", known=tuple(PAPER), dx=0.01, out="erosive", case="erosive_dambreak.json", t_end="0.5 s",
     dx_help="particle spacing [m] (default 0.01; the paper's is 0.005)",
     set_example="numerics.fixed_bed_speed=0.0125", sphera=SPHERA_OPTIONS, progress=300.0,
@@ -495,6 +498,47 @@ def report(s, args, results, n_ran):
     print(f"plot:  {show(png_path)}")
 
 
+def against(results, jobs, other_dir, at, dx, sediment, out):
+    """Each finished run beside the run of the same folder name in other_dir: the interface errors
+    (top grain, f = 0.5) of this run against that one, as the paper's measure against a reference,
+    and their bed-load rise, steps and wall time. Printed and written to OUT/erosive_against.csv."""
+    rows = []
+    for r, job in zip(results, jobs):
+        if r.paper.twin:
+            continue
+        twin_job = dataclasses.replace(job, outdir=os.path.join(other_dir, os.path.basename(job.outdir)),
+                                       source="reused")
+        o = load_result(twin_job, at, dx, sediment)
+        row = {"run": r.paper.run, "status": r.status, "other_status": o.status, "err_top": math.nan,
+               "err_frac": math.nan, "rise": r.rise, "other_rise": o.rise, "steps": r.steps, "other_steps": o.steps,
+               "wall_s": r.wall, "other_wall_s": o.wall, "threads": r.threads, "other_threads": o.threads}
+        if r.ok and o.ok:
+            if r.interface is not None and o.interface is not None:
+                row["err_top"] = interface_error(r.interface, o.interface)[0]
+            if r.interface_frac is not None and o.interface_frac is not None:
+                row["err_frac"] = interface_error(r.interface_frac, o.interface_frac)[0]
+        rows.append(row)
+    print()
+    print(f"against {show(other_dir)} (the same run there is the reference of each row; t = {at:g} s):")
+    print(f"{'run':>4} {'err top %':>10} {'err f=0.5 %':>12} {'rise [m]':>9} {'there':>7} {'steps':>10} "
+          f"{'there':>10} {'wall s':>8} {'there':>8}")
+    for w in rows:
+        if w["status"] != "ok" or w["other_status"] != "ok":
+            print(f"{w['run']:>4} n/a (here {w['status']}, there {w['other_status']})")
+            continue
+        print(f"{w['run']:>4} {fmt(w['err_top'], '.2f', 'n/a'):>10} {fmt(w['err_frac'], '.2f', 'n/a'):>12} "
+              f"{fmt(w['rise'], '.3f', 'n/a'):>9} {fmt(w['other_rise'], '.3f', 'n/a'):>7} "
+              f"{fmt(w['steps'], ',.0f', 'n/a'):>10} {fmt(w['other_steps'], ',.0f', 'n/a'):>10} "
+              f"{fmt(w['wall_s'], '.0f', 'n/a'):>8} {fmt(w['other_wall_s'], '.0f', 'n/a'):>8}")
+    path = os.path.join(out, "erosive_against.csv")
+    with open(path, "w") as f:
+        keys = list(rows[0]) if rows else ["run"]
+        f.write(",".join(keys) + "\n")
+        for w in rows:
+            f.write(",".join(str(w[k]) for k in keys) + "\n")
+    print(f"table: {show(path)}")
+
+
 def run(argv=None, prog=PROG):
     args = campaign.parse_args(prog, OPTIONS, argv)
     runs = campaign.parse_runs(args.runs, "--runs", PAPER, "2,5,6,7")
@@ -506,6 +550,10 @@ def run(argv=None, prog=PROG):
     failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL, what=f" at dx = {args.dx:g} m")
     results = [load_result(job, args.at, args.dx, sediment) for job in jobs]
     report(s, args, results, sum(job.source != "reused" for job in jobs))
+    if args.against:
+        if not os.path.isdir(args.against):
+            raise mt.ToolError(f"--against {show(args.against)}: no such folder")
+        against(results, jobs, args.against, args.at, args.dx, sediment, s.out)
     campaign.check_failed(failed)
 
 

@@ -1,5 +1,6 @@
-"""tools/erosive_dambreak.py without running mixsph: the two interface measures on snapshots and
-profiles written by hand in the formats of cli/main.c and lib/src/monitors.c."""
+"""tools/erosive_dambreak.py: the two interface measures on snapshots and profiles written by hand
+in the formats of cli/main.c and lib/src/monitors.c, and the campaign's options on short, coarse
+runs of mixsph."""
 
 import math
 import os
@@ -273,3 +274,38 @@ def test_mixsph_validate_dispatches_to_the_scripts(capsys):
         with pytest.raises(SystemExit) as e:
             validate.main([case, "--runs", "9"])
         assert e.value.code == 2 and f"mixsph-validate {case}: error: {message}" in capsys.readouterr().err
+
+
+def test_against_compares_each_run_with_the_same_run_of_another_folder(tmp_path):
+    # --against DIR: each run beside the run of the same number and dx in DIR. Run 6 at dx 0.04 to
+    # t = 0.5 s (the comparison time) with the implicit scheme against the explicit one: finite,
+    # non-zero interface errors and different step counts; against a copy of its own folder: every
+    # error exactly 0 (the same profiles); a run missing there is n/a, not an error.
+    import csv
+    import shutil
+    import subprocess
+    from tool_helpers import ENV, script_command
+    tool = script_command("erosive_dambreak.py", "--runs", "6", "--dx", "0.04", "--threads", "1", "--progress", "0")
+    explicit, implicit = tmp_path / "explicit", tmp_path / "implicit"
+    r = subprocess.run(tool + ["--out", str(explicit)], capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    shutil.copytree(explicit, tmp_path / "copy")
+    r = subprocess.run(tool + ["--out", str(implicit), "--set", "numerics.viscosity=1", "--against", str(explicit)],
+                       capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    with open(implicit / "erosive_against.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert row["run"] == "6" and row["status"] == "ok" and row["other_status"] == "ok"
+    assert 0.0 < float(row["err_top"]) < 100.0 and 0.0 < float(row["err_frac"]) < 100.0
+    assert float(row["steps"]) < float(row["other_steps"])   # the acoustic time step of the implicit scheme
+    r = subprocess.run(tool + ["--out", str(explicit), "--reuse", "--against", str(tmp_path / "copy")],
+                       capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    with open(explicit / "erosive_against.csv") as f:
+        (row,) = list(csv.DictReader(f))
+    assert float(row["err_top"]) == 0.0 and float(row["err_frac"]) == 0.0
+    shutil.rmtree(tmp_path / "copy" / "run6_dx0.04")
+    r = subprocess.run(tool + ["--out", str(explicit), "--reuse", "--against", str(tmp_path / "copy")],
+                       capture_output=True, text=True, env=ENV, timeout=600)
+    assert r.returncode == 0, r.stdout + r.stderr
+    assert "n/a (here ok, there" in r.stdout
