@@ -102,7 +102,7 @@ class Design:
     def __init__(self, out, dists, fixed, stop_time, output="max_run_up", budget=60,
                  target_error=2.0, n_init=None, crest=None, seed=0, n_workers=2, mode="product",
                  folds=5, restarts=2, n_candidates=None, fmu=None, settings=None, progress=True,
-                 stream=None, min_runs=None):
+                 stream=None, min_runs=None, noise=None):
         self.out = out
         self.dists = list(dists)
         self.names = [d.name for d in self.dists]
@@ -122,6 +122,8 @@ class Design:
         # the budget
         self.min_runs = int(min_runs) if min_runs is not None else min(10 * d, self.budget)
         self.box = {dd.name: box_of(dd) for dd in self.dists}
+        # the measured noise term per output (emulator.noise_from_file), or None
+        self.noise = dict(noise) if noise else None
         self.fmu = dict(fmu or {})
         self.settings = dict(settings or {})
         self.progress, self.stream = progress, stream or sys.stderr
@@ -138,7 +140,12 @@ class Design:
     def _spec(self):
         return {"dists": {d.name: _dist_spec(d) for d in self.dists}, "fixed": self.fixed,
                 "stop_time": self.stop_time, "output": self.output, "crest": self.crest,
-                "seed": self.seed, "n_init": self.n_init, "mode": self.mode}
+                "seed": self.seed, "n_init": self.n_init, "mode": self.mode,
+                # the measured noise floor changes the picks: part of the settings (absent
+                # without one, so designs of before it continue)
+                **({"noise": {k: {"variance": v["variance"], "mode": v["mode"]}
+                              for k, v in self.noise.items() if k == self.output}}
+                   if self.noise else {})}
 
     def _load_state(self):
         if os.path.isfile(self.state_path):
@@ -213,7 +220,8 @@ class Design:
         if len(ok) < 3:
             return None
         em = E.from_results(ok, outputs=[self.output], inputs=self.names, box=self.box,
-                            fmu=self.fmu, sweep={**self.settings, "design": self.state_path})
+                            fmu=self.fmu, sweep={**self.settings, "design": self.state_path},
+                            noise=self.noise)
         m = em.fit_output(self.output, mode=mode or self.mode,
                           restarts=self.restarts if restarts is None else restarts,
                           seed=self.seed, folds=folds or self.folds, cv=True, cv_refit=False,

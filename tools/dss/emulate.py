@@ -15,6 +15,10 @@
                      syntax), with its band from joint posterior draws, and Sobol indices
   plot EMU           the response surface over reservoir_level and phi with its uncertainty
   curve DESIGN HOLD  the hold-out error of emulators of a design's first n runs, against n
+  jitter OUT         measure the FMU's discretisation noise: runs at a box point with the
+                     reservoir level moved by up to half a particle spacing; writes
+                     OUT/jitter.json, which fit and design take as the noise term's lower bound
+                     (--noise-floor)
 
 The emulator file is JSON (docs/dss.md, section Emulator); it is checked against the FMU
 (--fmu, default build/LandslideWave.fmu): another GUID is refused. Exit codes: 0 ok, 1 the job
@@ -25,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -96,6 +101,14 @@ def build_parser():
                        help="optimizer restarts of the hyperparameters (default "
                             f"{2 if design else 3})")
         p.add_argument("--seed", type=int, default=0)
+        p.add_argument("--noise-floor", metavar="JITTER.json",
+                       help="the measured noise variance per output (emulate jitter) as the "
+                            "lower bound of the GP's noise term (default: the bounds "
+                            f"{E.NOISE_BOUNDS[0]:g}..{E.NOISE_BOUNDS[1]:g} of the standardised "
+                            "variance, fitted)")
+        p.add_argument("--noise", choices=E.NOISE_MODES, default="floor",
+                       help="with --noise-floor: floor (the lower bound; the fit may put more "
+                            "noise) or fixed (the noise term is the measured variance)")
 
     f = sub.add_parser("fit", help="fit the emulator of a sweep folder's results")
     f.add_argument("sweep", help="a sweep folder (results.parquet or results.csv)")
@@ -193,6 +206,24 @@ def build_parser():
     c.add_argument("--json", help="write the table as JSON")
     _fmu_args(c)
 
+    j = sub.add_parser("jitter", help="measure the FMU's discretisation noise (resumable)")
+    j.add_argument("out")
+    j.add_argument("--at", action="append", default=[], required=True, metavar="NAME=V[,V...]",
+                   help="the box point (repeatable; a comma list gives one point per value, "
+                        "e.g. saturated=0,1; the lists' product)")
+    j.add_argument("--perturb", action="append", default=[], metavar="NAME=H",
+                   help="an input moved by offsets in [-H, H] (a Latin hypercube per point; "
+                        "default reservoir_level=dx/2: the lattice is anchored at the level, so "
+                        "this moves the water's particles through one particle spacing against "
+                        "the slide and the terrain)")
+    j.add_argument("-n", "--n", type=int, default=6, help="runs per point (default 6)")
+    j.add_argument("--seed", type=int, default=0)
+    j.add_argument("--output", action="append", default=[], metavar="NAME",
+                   help="an output to measure (default: the emulator's default outputs)")
+    j.add_argument("--no-plots", action="store_true")
+    common_run_args(j)
+    common_cluster_args(j)
+
     q = sub.add_parser("plot", help="the response surface over two inputs")
     q.add_argument("emulator")
     q.add_argument("--output", default="max_run_up")
@@ -206,6 +237,18 @@ def build_parser():
 
 
 # ---- commands ---------------------------------------------------------------------------------
+
+def _print_noise(em, name):
+    m = em.models[name]
+    fit = ", ".join(f"{math.sqrt(v):.4g}" for v in m.fitted_noise())
+    if m.noise:
+        print(f"  {name}: noise term: measured sd {m.noise['sd']:.4g} (95 % CI "
+              f"{m.noise['ci95_sd'][0]:.4g}-{m.noise['ci95_sd'][1]:.4g}, {m.noise['dof']} dof) as "
+              f"its {'lower bound' if m.noise['mode'] == 'floor' else 'fixed value'}; fitted sd "
+              f"{fit}")
+    else:
+        print(f"  {name}: noise term: fitted sd {fit} (no measured floor)")
+
 
 def _print_cv(name, cv, comparison=None):
     if comparison:
@@ -224,7 +267,7 @@ def _print_cv(name, cv, comparison=None):
 
 
 def fit_folder(folder, outputs=None, inputs=None, box=None, fmu=None, mode="auto", folds=10,
-               restarts=3, seed=0, out=None, plots=True):
+               restarts=3, seed=0, out=None, plots=True, noise_file=None, noise_mode="floor"):
     from .store import open_store
     df = open_store(folder).latest()
     if df.empty:
@@ -242,6 +285,9 @@ def fit_folder(folder, outputs=None, inputs=None, box=None, fmu=None, mode="auto
     em = E.from_results(ok, outputs=outputs, inputs=inputs, box=box, fmu=ident,
                         sweep={**settings, "source": os.path.abspath(folder), "n_runs": len(ok),
                                "n_failed": int((df["status"] != "ok").sum())})
+    if noise_file:
+        em.noise = E.noise_from_file(noise_file, list(em.Y), noise_mode, ident,
+                                     dx=settings.get("dx"))
     t0 = time.perf_counter()
     for name in list(em.Y):
         if not np.isfinite(em.Y[name]).any():
@@ -267,12 +313,14 @@ def cmd_fit(args):
     inputs = [s.strip() for s in args.inputs.split(",")] if args.inputs else None
     em, files, fit_s = fit_folder(args.sweep, args.output or None, inputs, _parse_box(args.box),
                                   args.fmu, args.categorical, args.folds, args.restarts,
-                                  args.seed, args.out, not args.no_plots)
+                                  args.seed, args.out, not args.no_plots,
+                                  args.noise_floor, args.noise)
     print(f"emulate: {len(em.X)} runs, inputs " + ", ".join(
         f"{n} [{b[0]:g}, {b[1]:g}]{' (binary)' if k == 'binary' else ''}"
         for n, k, b in zip(em.inputs, em.kinds, em.box)) + f"; fitted in {fit_s:.1f} s")
     for name in em.models:
         _print_cv(name, em.cv.get(name), em.mode_comparison.get(name))
+        _print_noise(em, name)
         print(f"  kernel: {em.models[name].parts[next(iter(em.models[name].parts))].kernel_}")
     for f in files:
         print(f"  wrote {f}")
@@ -464,7 +512,8 @@ def cmd_curve(args):
 
     def one(label, df, n):
         ok = df[df["status"] == "ok"]
-        em = E.from_results(ok, outputs=[out], inputs=em_final.inputs, box=box)
+        em = E.from_results(ok, outputs=[out], inputs=em_final.inputs, box=box,
+                            noise=em_final.noise)
         em.fit_output(out, mode=mode, restarts=3, cv=False)
         mu, sd = em.predict(hold[em.inputs].astype(float).to_numpy(), [out])[out]
         m = E.metrics(y_h, mu, sd, y_range=rng)
@@ -474,7 +523,10 @@ def cmd_curve(args):
         print(f"  {label:10s} {n:4d} runs: hold-out RMSE {r['rmse_pct']:.2f} %, max "
               f"{r['max_error_pct']:.2f} %, coverage {100 * r['coverage95']:.1f} %")
 
-    print(f"emulate curve: {len(hold)} hold-out runs, mode {mode}, errors in % of {rng:.4g}")
+    nz = em_final.noise.get(out)
+    print(f"emulate curve: {len(hold)} hold-out runs, mode {mode}, errors in % of {rng:.4g}, "
+          + (f"the design's measured noise sd {nz['sd']:.4g} ({nz['mode']})" if nz else
+             "no measured noise floor"))
     for n in sizes:
         if n < 3 or n > n_all:
             continue
@@ -490,7 +542,7 @@ def cmd_curve(args):
     if args.json:
         with open(args.json, "w") as f:
             json.dump(E._jsonable({"range": rng, "mode": mode, "holdout_runs": len(hold),
-                                   "rows": rows}), f, indent=1)
+                                   "noise": nz, "rows": rows}), f, indent=1)
         print(f"  wrote {args.json}")
     return 0
 
@@ -526,6 +578,11 @@ def cmd_design(args):
             raise UsageError(f"{d_.name!r} is not a parameter of the FMU")
         fixed.pop(d_.name, None)
     ident = E.fmu_identity(fmu)
+    outs = [args.output] + [o for o in args.fit_output if o != args.output]
+    noise = E.noise_from_file(args.noise_floor, outs, args.noise, ident,
+                              dx=fixed.get("dx", dx)) if args.noise_floor else None
+    if args.noise_floor and args.output not in noise:
+        raise UsageError(f"{args.noise_floor} has no measurement of {args.output}")
     os.makedirs(args.out, exist_ok=True)
     settings = {"fmu": os.path.abspath(fmu), "stop_time": opts["stop_time"], "step": opts["step"],
                 "dx": fixed.get("dx", dx), "fixed": fixed, "threads": opts["threads"]}
@@ -544,7 +601,7 @@ def cmd_design(args):
                        crest=args.crest, seed=args.seed, n_workers=nw, mode=args.categorical,
                        folds=args.folds, restarts=args.restarts, n_candidates=args.candidates,
                        fmu=ident, settings=settings, progress=not quiet,
-                       min_runs=args.min_runs)
+                       min_runs=args.min_runs, noise=noise)
         try:
             res = des.run(evaluate)
         except D.DesignError as e:
@@ -554,18 +611,117 @@ def cmd_design(args):
           + {"target": f"the CV RMSE reached the target {args.target_error:g} %",
              "budget": f"the budget of {args.budget} runs is spent",
              "no new point": "no new candidate"}.get(res["reason"], str(res["reason"])))
-    outs = [args.output] + [o for o in args.fit_output if o != args.output]
     em, files, fit_s = fit_folder(args.out, outs, [d_.name for d_ in dists],
                                   {d_.name: D.box_of(d_) for d_ in dists}, fmu,
                                   args.final_categorical, 10, 3, args.seed, None,
-                                  not args.no_plots)
+                                  not args.no_plots, args.noise_floor, args.noise)
     for name in em.models:
         _print_cv(name, em.cv.get(name), em.mode_comparison.get(name))
+        _print_noise(em, name)
     if not args.no_plots:
         from . import emulate_plots as P
         files.append(P.design_history(res["history"], os.path.join(args.out, "design_history.png"),
                                       target=args.target_error))
     for f in files:
+        print(f"  wrote {f}")
+    return 0
+
+
+def jitter_scenarios(points: list[dict], perturb: dict, n: int, seed: int) -> list[dict]:
+    """n scenarios per point: the point with the perturbed inputs moved by a Latin hypercube of
+    offsets in [-H, H] (scipy.stats.qmc, seeded per point)."""
+    from scipy.stats import qmc
+    out = []
+    names = list(perturb)
+    for k, pt in enumerate(points):
+        u = qmc.LatinHypercube(d=len(names), seed=np.random.default_rng([seed, k])).random(n)
+        for row in u:
+            s = dict(pt)
+            for j, nm in enumerate(names):
+                s[nm] = float(pt[nm]) + (2 * row[j] - 1) * perturb[nm]
+            out.append(s)
+    return out
+
+
+def cmd_jitter(args):
+    """Run the jitter scan (through the sweep machinery: resumable) and estimate the noise."""
+    import itertools
+    from .__main__ import cmd_sweep, parse_value, resolve_run
+    from .scenarios import split_assignment
+    from .store import open_store
+    fmu, fixed, opts, md, var, dx = resolve_run(args, {})
+    dx = float(fixed.get("dx", dx))
+    axes = {}
+    for it in args.at:
+        k, v = split_assignment(it)
+        axes[k] = [parse_value(x) for x in v.split(",")]
+    points = [dict(zip(axes, c)) for c in itertools.product(*axes.values())]
+    perturb = {}
+    for it in args.perturb or [f"reservoir_level={dx / 2!r}"]:
+        k, v = split_assignment(it)
+        perturb[k] = float(v)
+    for nm in list(axes) + list(perturb):
+        if nm not in var or var[nm].causality != "parameter":
+            raise UsageError(f"{nm!r} is not a parameter of the FMU")
+    missing = [nm for nm in perturb if nm not in axes]
+    if missing:
+        raise UsageError(f"the perturbed input(s) {', '.join(missing)} need a value in --at")
+    if args.n < 3:
+        raise UsageError("a jitter scan needs at least 3 runs per point (-n)")
+    scen = jitter_scenarios(points, perturb, args.n, args.seed)
+    os.makedirs(args.out, exist_ok=True)
+    csv = os.path.join(args.out, "jitter_scenarios.csv")
+    pd.DataFrame(scen).to_csv(csv, index=False)
+    sw = argparse.Namespace(**{**vars(args), "csv": csv, "grid": [], "dist": [], "n": 0,
+                               "sample": "random", "retry_failed": True, "crest": None,
+                               "no_report": True})
+    rc = cmd_sweep(sw)
+    if rc:
+        return rc
+    df = open_store(args.out).latest()
+    df = df[df["status"] == "ok"]
+    groups, offs, keep = [], [], []
+    for i, rec in enumerate(df.to_dict(orient="records")):
+        for k, pt in enumerate(points):
+            if all(math.isclose(float(rec[nm]), float(v), rel_tol=0, abs_tol=1e-12)
+                   for nm, v in pt.items() if nm not in perturb):
+                d = [float(rec[nm]) - float(pt[nm]) for nm in perturb]
+                if all(abs(x) <= h * (1 + 1e-9) for x, h in zip(d, perturb.values())):
+                    groups.append(k)
+                    offs.append(d)
+                    keep.append(i)
+                    break
+    df = df.iloc[keep]
+    outputs = args.output or [o for o in E.DEFAULT_OUTPUTS if o in df.columns]
+    est = {}
+    for o in outputs:
+        y = df[o].astype(float).to_numpy()
+        if not np.isfinite(y).any():
+            continue
+        est[o] = E.jitter_noise(np.array(offs), y, groups)
+    doc = {"schema": "mixsph-jitter", "schema_version": 1,
+           "fmu": E.fmu_identity(fmu),
+           "settings": {"dx": dx, "stop_time": opts["stop_time"], "step": opts["step"],
+                        "fixed": fixed, "points": points, "perturb": perturb, "n_per_point": args.n,
+                        "seed": args.seed},
+           "method": "residual variance about a linear trend in the offsets per point "
+                     "(emulator.jitter_noise); 95 % CI from the chi-square distribution",
+           "runs": {"group": groups, "offsets": offs,
+                    **{o: df[o].astype(float).tolist() for o in outputs}},
+           "outputs": est}
+    path = os.path.join(args.out, "jitter.json")
+    with open(path, "w") as f:
+        json.dump(E._jsonable(doc), f, indent=1)
+    print(f"emulate jitter: {len(df)} runs at {len(points)} point(s), offsets "
+          + ", ".join(f"{nm} +-{h:g}" for nm, h in perturb.items()))
+    for o, e in est.items():
+        print(f"  {o}: noise sd {e['sd']:.4g} (95 % CI {e['ci95_sd'][0]:.4g}-{e['ci95_sd'][1]:.4g}, "
+              f"{e['dof']} dof; about the point means without the trend: sd "
+              f"{math.sqrt(e['variance_about_means']):.4g})")
+    print(f"  wrote {path}")
+    if not args.no_plots and "max_run_up" in est:
+        from . import emulate_plots as P
+        f = P.jitter_plot(doc, "max_run_up", os.path.join(args.out, "jitter.png"))
         print(f"  wrote {f}")
     return 0
 
@@ -577,7 +733,7 @@ def main(argv=None):
     try:
         return {"fit": cmd_fit, "predict": cmd_predict, "validate": cmd_validate,
                 "risk": cmd_risk, "plot": cmd_plot, "design": cmd_design,
-                "curve": cmd_curve}[args.cmd](args)
+                "curve": cmd_curve, "jitter": cmd_jitter}[args.cmd](args)
     except E.GuidMismatch as e:
         print(f"emulate: refused: {e}", file=sys.stderr)
         return 2

@@ -203,3 +203,36 @@ def ensure_dir(path):
     d = os.path.dirname(path)
     if d:
         os.makedirs(d, exist_ok=True)
+
+
+def jitter_plot(doc: dict, output: str, path: str):
+    """The jitter scan: the output against the first perturbed input's offset, per point, with
+    the fitted linear trend and the estimated noise sd."""
+    plt = _plt()
+    runs, est = doc["runs"], doc["outputs"][output]
+    names = list(doc["settings"]["perturb"])
+    off = np.array(runs["offsets"], dtype=float)[:, 0]
+    y = np.array(runs[output], dtype=float)
+    g = np.array(runs["group"])
+    fig, ax = plt.subplots(figsize=(6, 4))
+    for i, k in enumerate(np.unique(g)):
+        s = g == k
+        pt = doc["settings"]["points"][int(k)]
+        lab = ", ".join(f"{n}={v:g}" for n, v in pt.items() if n not in names)
+        ax.plot(1e3 * off[s], y[s], "o", color=f"C{i}", label=lab or "runs")
+        o = np.sort(off[s])
+        # the fitted trend of this point (residuals: y - fit)
+        fit = y[s] - np.array(est["residuals"])[s]
+        c = np.polyfit(off[s], fit, 1)
+        ax.plot(1e3 * o, np.polyval(c, o), "-", color=f"C{i}", lw=0.8)
+    ax.set_xlabel(f"offset of {names[0]} (mm)")
+    ax.set_ylabel(output)
+    ax.set_title(f"jitter scan at dx = {doc['settings']['dx']:g}: noise sd {est['sd']:.3g} "
+                 f"(95 % CI {est['ci95_sd'][0]:.2g}-{est['ci95_sd'][1]:.2g}, {est['dof']} dof)",
+                 fontsize=9)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path

@@ -18,6 +18,13 @@ Predictions give mean and sd (the sd includes the fitted noise, so the 95 % inte
 mean +- 1.96 sd is one for a new FMU run); a query outside the training box (or a binary input
 not 0/1) is flagged, not refused.
 
+The noise term can be measured instead of fitted alone (``noise``, per output): the variance of
+the FMU's discretisation jitter from a jitter scan (``jitter_noise``: runs at one box point with
+the reservoir level, which the particle lattice is anchored at, moved by up to half a particle
+spacing; the residual variance about a linear trend in the offset), used as the lower bound of
+the WhiteKernel (mode 'floor': the likelihood may still put more noise) or as its fixed value
+('fixed').
+
 Saved as JSON (no pickle): schema name and version, the inputs with their kind and box, the
 training inputs and outputs, per output the standardisation, the kernel's structure (mode and
 the input kinds rebuild it) with its fitted hyperparameters (theta, log scale, as scikit-learn
@@ -38,7 +45,10 @@ import warnings
 import numpy as np
 
 SCHEMA = "mixsph-emulator"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+# version 1: no measured noise term (read as noise None); 2 adds outputs.NAME.noise
+READABLE_VERSIONS = (1, 2)
+NOISE_MODES = ("floor", "fixed")
 MODES = ("product", "binary", "separate")
 
 # the FMU's physical parameters and the numerical ones an emulator may take as inputs when a
@@ -69,8 +79,25 @@ class GuidMismatch(EmulatorError):
 
 # ---- kernels -------------------------------------------------------------------------------------
 
-def build_kernel(mode: str, kinds: list[str]):
-    """The (unfitted) kernel of a mode over inputs of the given kinds ('continuous'/'binary')."""
+def noise_bounds(noise_std: float | None, noise_mode: str = "floor"):
+    """(initial noise level, bounds) of the WhiteKernel in standardised units: the default
+    bounds, or the measured variance noise_std (variance / y_std^2) as the lower bound
+    ('floor') or the fixed value ('fixed')."""
+    if noise_std is None:
+        return 1e-4, NOISE_BOUNDS
+    v = max(float(noise_std), NOISE_BOUNDS[0])
+    if noise_mode == "fixed":
+        return v, "fixed"
+    if noise_mode != "floor":
+        raise EmulatorError(f"unknown noise mode {noise_mode!r} ({', '.join(NOISE_MODES)})")
+    hi = max(NOISE_BOUNDS[1], 2.0 * v)
+    return min(max(1e-4, v), hi), (v, hi)
+
+
+def build_kernel(mode: str, kinds: list[str], noise_std: float | None = None,
+                 noise_mode: str = "floor"):
+    """The (unfitted) kernel of a mode over inputs of the given kinds ('continuous'/'binary');
+    noise_std: a measured noise variance in standardised units (see noise_bounds)."""
     from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Matern, WhiteKernel
     d = len(kinds)
     cont = [k == "continuous" for k in kinds]
@@ -89,8 +116,9 @@ def build_kernel(mode: str, kinds: list[str]):
                     * RBF(length_scale=ls_r, length_scale_bounds=b_r))
     else:
         raise EmulatorError(f"unknown mode {mode!r} ({', '.join(MODES)})")
+    n0, nb = noise_bounds(noise_std, noise_mode)
     return (ConstantKernel(1.0, CONST_BOUNDS) * core
-            + WhiteKernel(noise_level=1e-4, noise_level_bounds=NOISE_BOUNDS))
+            + WhiteKernel(noise_level=n0, noise_level_bounds=nb))
 
 
 def _gp(kernel, restarts: int, seed: int, optimizer=True):
@@ -125,9 +153,12 @@ class OutputModel:
     """The GP(s) of one output: 'parts' maps a level key (a tuple of binary values, () for all)
     to a fitted GaussianProcessRegressor over the part's input columns."""
 
-    def __init__(self, name, mode, kinds, y_mean, y_std):
+    def __init__(self, name, mode, kinds, y_mean, y_std, noise: dict | None = None):
         self.name, self.mode, self.kinds = name, mode, list(kinds)
         self.y_mean, self.y_std = float(y_mean), float(y_std)
+        # the measured noise term: {'variance': in the output's units squared, 'mode':
+        # 'floor'|'fixed', ...} or None (the default bounds)
+        self.noise = dict(noise) if noise else None
         self.parts: dict[tuple, object] = {}
         self.bin_idx = [i for i, k in enumerate(self.kinds) if k == "binary"]
         self.cont_idx = [i for i, k in enumerate(self.kinds) if k == "continuous"]
@@ -135,6 +166,13 @@ class OutputModel:
     @property
     def split(self) -> bool:
         return self.mode == "separate" and bool(self.bin_idx)
+
+    def kernel(self, mode, kinds):
+        """The unfitted kernel of this output (the noise term from self.noise)."""
+        if not self.noise:
+            return build_kernel(mode, kinds)
+        return build_kernel(mode, kinds, self.noise["variance"] / self.y_std ** 2,
+                            self.noise.get("mode", "floor"))
 
     def part_kinds(self):
         return ["continuous"] * len(self.cont_idx) if self.split else self.kinds
@@ -157,7 +195,7 @@ class OutputModel:
         ys = (np.asarray(y, float) - self.y_mean) / self.y_std
 
         def kernel(mode, kinds, key):
-            k = build_kernel(mode, kinds)
+            k = self.kernel(mode, kinds)
             if init and key in init and len(init[key]) == len(k.theta):
                 k = k.clone_with_theta(np.clip(np.asarray(init[key]), k.bounds[:, 0],
                                                k.bounds[:, 1]))
@@ -189,11 +227,11 @@ class OutputModel:
                 rows = np.flatnonzero((lv == np.array(key)).all(axis=1))
                 if rows.size == 0:
                     continue
-                k = build_kernel("separate", self.part_kinds()).clone_with_theta(np.asarray(theta))
+                k = self.kernel("separate", self.part_kinds()).clone_with_theta(np.asarray(theta))
                 self.parts[key] = _gp(k, 0, 0, optimizer=False).fit(U[np.ix_(rows, self.cont_idx)],
                                                                     ys[rows])
         else:
-            k = build_kernel(self.mode, self.kinds).clone_with_theta(np.asarray(thetas[()]))
+            k = self.kernel(self.mode, self.kinds).clone_with_theta(np.asarray(thetas[()]))
             self.parts[()] = _gp(k, 0, 0, optimizer=False).fit(U, ys)
         return self
 
@@ -246,13 +284,18 @@ class OutputModel:
                           "key": list(key), "theta": k.theta.tolist(), "kernel": str(k),
                           "hyperparameters": _hyper(k),
                           "log_marginal_likelihood": float(gp.log_marginal_likelihood_value_)})
-        return {"mode": self.mode, "y_mean": self.y_mean, "y_std": self.y_std, "parts": parts}
+        return {"mode": self.mode, "y_mean": self.y_mean, "y_std": self.y_std, "parts": parts,
+                "noise": self.noise}
+
+    def fitted_noise(self) -> list[float]:
+        """The fitted WhiteKernel variance of each part, in the output's units squared."""
+        return [float(gp.kernel_.k2.noise_level) * self.y_std ** 2 for gp in self.parts.values()]
 
 
 # ---- the emulator ---------------------------------------------------------------------------------
 
 class Emulator:
-    def __init__(self, inputs, kinds, box, X, Y: dict, fmu=None, sweep=None):
+    def __init__(self, inputs, kinds, box, X, Y: dict, fmu=None, sweep=None, noise=None):
         self.inputs = list(inputs)
         self.kinds = list(kinds)
         self.box = np.asarray(box, dtype=float)       # d x 2: lo, hi
@@ -263,6 +306,9 @@ class Emulator:
         self.models: dict[str, OutputModel] = {}
         self.cv: dict[str, dict] = {}
         self.mode_comparison: dict[str, dict] = {}
+        # the measured noise term per output (see OutputModel.noise); outputs not in it get
+        # the default bounds
+        self.noise: dict[str, dict] = dict(noise or {})
         span = self.box[:, 1] - self.box[:, 0]
         if np.any(span <= 0):
             bad = [n for n, s in zip(self.inputs, span) if s <= 0]
@@ -291,7 +337,8 @@ class Emulator:
         return np.flatnonzero(ok), y[ok]
 
     def _new_model(self, name, mode, y):
-        m = OutputModel(name, mode, self.kinds, np.mean(y), np.std(y) if np.std(y) > 0 else 1.0)
+        m = OutputModel(name, mode, self.kinds, np.mean(y), np.std(y) if np.std(y) > 0 else 1.0,
+                        noise=self.noise.get(name))
         m.bin_names = [self.inputs[i] for i in m.bin_idx]
         return m
 
@@ -377,7 +424,9 @@ class Emulator:
             "inputs": [{"name": n, "kind": k, "lo": float(b[0]), "hi": float(b[1])}
                        for n, k, b in zip(self.inputs, self.kinds, self.box)],
             "kernel_family": "ConstantKernel*Matern(nu=2.5, anisotropic)+WhiteKernel; modes: "
-                             "product (x RBF of the binary inputs), binary, separate",
+                             "product (x RBF of the binary inputs), binary, separate; noise: "
+                             "the WhiteKernel's default bounds, or a measured variance as its "
+                             "lower bound (floor) or value (fixed)",
             "X": self.X.tolist(),
             "outputs": {name: {**m.to_json(), "y": [None if not np.isfinite(v) else float(v)
                                                      for v in self.Y[name]],
@@ -396,9 +445,10 @@ class Emulator:
     def from_json(cls, doc: dict) -> "Emulator":
         if doc.get("schema") != SCHEMA:
             raise EmulatorError(f"not a {SCHEMA} file (schema {doc.get('schema')!r})")
-        if doc.get("schema_version") != SCHEMA_VERSION:
-            raise EmulatorError(f"emulator schema version {doc.get('schema_version')} is not "
-                                f"{SCHEMA_VERSION}, the one this code reads: refit it")
+        if doc.get("schema_version") not in READABLE_VERSIONS:
+            raise EmulatorError(f"emulator schema version {doc.get('schema_version')} is not one "
+                                f"this code reads ({', '.join(map(str, READABLE_VERSIONS))}): "
+                                f"refit it")
         inp = doc["inputs"]
         Y = {name: np.array([np.nan if v is None else v for v in o["y"]], dtype=float)
              for name, o in doc["outputs"].items()}
@@ -406,7 +456,10 @@ class Emulator:
                  [(i["lo"], i["hi"]) for i in inp], doc["X"], Y, doc.get("fmu"), doc.get("sweep"))
         for name, o in doc["outputs"].items():
             rows, y = em._rows(name)
-            m = OutputModel(name, o["mode"], em.kinds, o["y_mean"], o["y_std"])
+            m = OutputModel(name, o["mode"], em.kinds, o["y_mean"], o["y_std"],
+                            noise=o.get("noise"))     # version 1: no noise key
+            if m.noise:
+                em.noise[name] = m.noise
             m.bin_names = [em.inputs[i] for i in m.bin_idx]
             thetas = {tuple(p["key"]): p["theta"] for p in o["parts"]}
             m.rebuild(em.unit(em.X[rows]), y, thetas)
@@ -492,7 +545,8 @@ def choose_inputs(df, candidates=None) -> tuple[list[str], list[str]]:
     return inputs, kinds
 
 
-def from_results(df, outputs=None, inputs=None, box=None, fmu=None, sweep=None) -> Emulator:
+def from_results(df, outputs=None, inputs=None, box=None, fmu=None, sweep=None,
+                 noise=None) -> Emulator:
     """An (unfitted) emulator of the ok rows of a results table."""
     df = df[df["status"] == "ok"] if "status" in df.columns else df
     if df.empty:
@@ -516,7 +570,7 @@ def from_results(df, outputs=None, inputs=None, box=None, fmu=None, sweep=None) 
         if o not in df.columns:
             raise EmulatorError(f"{o!r} is not a column of the results")
         Y[o] = df[o].astype(float).to_numpy()
-    return Emulator(names, kinds, b, X, Y, fmu=fmu, sweep=sweep)
+    return Emulator(names, kinds, b, X, Y, fmu=fmu, sweep=sweep, noise=noise)
 
 
 # ---- cross-validation ----------------------------------------------------------------------------
@@ -654,3 +708,75 @@ def sobol(em: Emulator, output: str, dists: dict, fixed: dict, n_base=4096, seed
     return {"names": names, "S1": r["S1"].tolist(), "S1_conf": r["S1_conf"].tolist(),
             "ST": r["ST"].tolist(), "ST_conf": r["ST_conf"].tolist(), "n_model": int(len(u)),
             "seconds": time.perf_counter() - t0}
+
+
+# ---- the measured noise term ---------------------------------------------------------------------
+
+def jitter_noise(offsets, y, groups=None) -> dict:
+    """The variance of an output's discretisation jitter from a jitter scan: runs at one or
+    more box points (groups) with inputs moved by small offsets (n x p) that change the
+    physics only smoothly. The variance is the residual one about a linear trend in the
+    offsets, fitted per group (least squares, numpy.linalg.lstsq): s^2 = RSS / (n - rank), with
+    its 95 % confidence interval from the chi-square distribution of (n - rank) s^2 / sigma^2
+    (scipy.stats.chi2; exact for independent normal jitter). Also the plain pooled variance
+    about the group means (without the trend), for comparison."""
+    from scipy.stats import chi2
+    y = np.asarray(y, dtype=float)
+    D = np.atleast_2d(np.asarray(offsets, dtype=float))
+    if D.shape[0] != len(y):
+        D = D.T
+    g = np.zeros(len(y), dtype=int) if groups is None else np.unique(
+        np.asarray(groups, dtype=object).astype(str), return_inverse=True)[1]
+    ok = np.isfinite(y)
+    y, D, g = y[ok], D[ok], g[ok]
+    cols = []
+    for k in np.unique(g):
+        ind = (g == k).astype(float)
+        cols.append(ind)
+        cols += [ind * D[:, j] for j in range(D.shape[1])]
+    A = np.column_stack(cols)
+    coef, _, rank, _ = np.linalg.lstsq(A, y, rcond=None)
+    res = y - A @ coef
+    dof = len(y) - int(rank)
+    if dof < 1:
+        raise EmulatorError(f"a jitter scan of {len(y)} runs in {len(np.unique(g))} group(s) "
+                            f"with {D.shape[1]} offset(s) leaves no degree of freedom: more runs")
+    s2 = float(res @ res / dof)
+    lo, hi = dof * s2 / chi2.ppf(0.975, dof), dof * s2 / chi2.ppf(0.025, dof)
+    dev = y - np.array([y[g == k].mean() for k in g])
+    dof0 = len(y) - len(np.unique(g))
+    return {"variance": s2, "sd": math.sqrt(s2), "dof": dof, "n": int(len(y)),
+            "groups": int(len(np.unique(g))), "ci95_variance": [float(lo), float(hi)],
+            "ci95_sd": [math.sqrt(lo), math.sqrt(hi)],
+            "variance_about_means": float(dev @ dev / dof0) if dof0 > 0 else None,
+            "trend": coef.tolist(), "residuals": res.tolist()}
+
+
+def noise_from_file(path: str, outputs, mode: str = "floor", fmu: dict | None = None,
+                    dx=None) -> dict:
+    """The noise spec per output ({'variance', 'mode', 'source', ...}) of a jitter file
+    (emulate jitter's jitter.json), checked against the emulator's FMU (GUID) and dx: a floor
+    measured on another FMU or resolution is refused."""
+    if mode not in NOISE_MODES:
+        raise EmulatorError(f"unknown noise mode {mode!r} ({', '.join(NOISE_MODES)})")
+    with open(path) as f:
+        doc = json.load(f)
+    if doc.get("schema") != "mixsph-jitter":
+        raise EmulatorError(f"{path} is not a jitter file of emulate jitter")
+    guid = (doc.get("fmu") or {}).get("guid")
+    if fmu and fmu.get("guid") and guid != fmu["guid"]:
+        raise EmulatorError(f"the jitter scan {path} is of the FMU with GUID {guid}, the runs of "
+                            f"the FMU with GUID {fmu['guid']}: measure the noise on this FMU")
+    jdx = (doc.get("settings") or {}).get("dx")
+    if dx is not None and jdx is not None and not math.isclose(float(dx), float(jdx)):
+        raise EmulatorError(f"the jitter scan {path} is at dx = {jdx:g}, the runs at dx = "
+                            f"{float(dx):g}: the jitter depends on the particle spacing")
+    out = {}
+    for name in outputs:
+        est = (doc.get("outputs") or {}).get(name)
+        if est is None:
+            continue
+        out[name] = {"variance": est["variance"], "sd": est["sd"], "mode": mode,
+                     "dof": est["dof"], "ci95_sd": est["ci95_sd"],
+                     "source": os.path.abspath(path), "dx": jdx, "fmu_guid": guid}
+    return out
