@@ -190,6 +190,9 @@ static void test_out_of_range(void **state)
     EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 2", ORIGIN ": numerics.wall_layers: ",
                       "do not cover the kernel support", "expected >= 3");
     EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3.5", ORIGIN ": numerics.wall_layers: expected an integer");
+    /* the arithmetic pair mean only with the implicit step (the explicit time step is sized for the harmonic one) */
+    EXPECT_EDIT_ERROR("\"wall_layers\": 3", "\"wall_layers\": 3, \"viscosity_mean\": \"arithmetic\"",
+                      ORIGIN ": numerics.viscosity_mean: \"arithmetic\" needs numerics.viscosity \"implicit\"");
     EXPECT_EDIT_ERROR("[0.2, 0.0], [0.2, 0.1]", "[0.2, 0.0], [0.2, 0.0]", ORIGIN ": bodies.pool.polygon[2]: repeats");
 }
 

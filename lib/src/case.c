@@ -228,6 +228,11 @@ static mixsph_status read_numerics(const struct case_reader *r, const cJSON *roo
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
         return FAIL(r, "%s: numerics.wall_layers: %d layers do not cover the kernel support 2h = %.2f dx (expected >= %d)",
                     r->origin, c->wall_layers, 2.0 * c->h_over_dx, (int)ceil(2.0 * c->h_over_dx));
+    if (c->viscosity_arithmetic && !c->viscosity_implicit)
+        return FAIL(r, "%s: numerics.viscosity_mean: \"arithmetic\" needs numerics.viscosity \"implicit\" (the "
+                       "explicit time step (4) is sized for the harmonic mean: a mobile grain beside a fixed one "
+                       "would be coupled at about mu_thr / 2)",
+                    r->origin);
     return MIXSPH_OK;
 }
 

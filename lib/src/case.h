@@ -130,6 +130,8 @@ struct case_def {
     int av_separating;        /* ... also on separating pairs (default 0: approaching pairs only) */
     int viscosity_implicit;   /* numerics.viscosity: 0 "explicit" (in the momentum pass, dt bound (4)),
                                  1 "implicit" (viscous.h: SDIRK2, no viscous dt bound) */
+    int viscosity_arithmetic; /* numerics.viscosity_mean: 0 "harmonic" (model.md [V]), 1 "arithmetic"
+                                 (implicit only) */
     double viscous_tolerance; /* implicit: relative residual at which the solve stops [-] */
     int viscous_max_iterations; /* implicit: iteration budget of one solve */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */

@@ -32,6 +32,7 @@
 
 static const struct case_choice kernels[] = {{"cubic_spline", 0}, {"wendland_c2", 1}, {NULL, 0}};
 static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
+static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
 static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
@@ -106,6 +107,11 @@ static const struct case_key numerics_keys[] = {
      .field = CASE_FIELD(case_def, viscosity_implicit),
      .meaning = "the laminar viscous term: explicit (in the momentum pass, time step bounded by cfl_visc) or "
                 "implicit (SDIRK2 with the walls in the solve, by BiCGSTAB; no viscous time-step bound)"},
+    {.key = "viscosity_mean", .type = CASE_CHOICE, DEF(0), .choices = viscosity_means, .numeric_choice = 1,
+     .field = CASE_FIELD(case_def, viscosity_arithmetic),
+     .meaning = "the pair viscosity of the laminar term between particles of different viscosities: harmonic, "
+                "2 mu_i mu_j / (mu_i + mu_j), or arithmetic, (mu_i + mu_j) / 2 (Morris et al. 1997; implicit "
+                "viscosity only)"},
     {.key = "viscous_tolerance", .type = CASE_NUMBER, RANGE(0, 1, 1e-2, 0), DEF(1e-6), .unit = "-",
      .field = CASE_FIELD(case_def, viscous_tolerance),
      .meaning = "implicit viscosity: relative residual ‖b − A u‖ / ‖b‖ at which a solve stops"},

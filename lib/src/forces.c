@@ -92,6 +92,7 @@ struct pair_ctx {
     double av_mixed; /* 1: ... between particles of different media too, 0: same medium only */
     double av_cap;   /* u_ij.x_ij is capped at this: 0 (approaching pairs only) or +inf (all pairs) */
     int wendland;
+    int arithmetic_mean;  /* implicit viscosity with the pair viscosity (mu_i + mu_j) / 2 */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -112,6 +113,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->av_mixed = fp->av_mixed ? 1.0 : 0.0;
     X->av_cap = fp->av_separating ? INFINITY : 0.0;
     X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
+    X->arithmetic_mean = fp->arithmetic_mean;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -260,7 +262,10 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
 /* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth) is added to
  * i and subtracted from j (ax, az hold forces during the pass; forces_momentum divides by the
  * masses after it). With `implicit` the viscous force is left out and its coupling
- * w_ij = -F fv (>= 0) is stored per lane in wl instead. */
+ * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
+ * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). */
+enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
+
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double *axi, double *azi,
                                   const double *restrict fk, double *restrict wl, const int wendland,
@@ -308,8 +313,11 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             /* m_i m_j (1/rho_i + 1/rho_j) / 2 = m_i (m_j / rho_i + V_j) / 2 */
             fr += same * (1.0 - walli * wallj) * avc_ij * mi * (m[j] * irhoi + vol[j]) * vdotr * inv_r2e * 0.5;
             /* laminar viscosity, pairwise harmonic mean: mu_i + mu_j of Morris is replaced by
-             * 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j); times r^2 / (r^2 + eta^2) */
-            const double fv = vv * 4.0 * mu_i * muj * r2 * inv_d;
+             * 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j); times r^2 / (r^2 + eta^2). The arithmetic
+             * mean keeps Morris's mu_i + mu_j, between particles of one medium only. */
+            const double fv = implicit == MOMENTUM_IMPLICIT_ARITHMETIC && tag[j] == ti
+                                  ? vv * mus * mus * r2 * inv_d
+                                  : vv * 4.0 * mu_i * muj * r2 * inv_d;
             double fx, fz;
             if (implicit) {
                 wl[k] = -F * fv;
@@ -467,11 +475,17 @@ static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB,
                           size_t b0, size_t b1)
 {
     if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
-        if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, 1);
-        else momentum_walk(X, NB, P, b0, b1, 0, 1, 1);
+        if (X->arithmetic_mean) {
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
+        } else {
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC);
+        }
         return;
     }
-#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) momentum_walk(X, NB, P, b0, b1, wendland, cached, 0)
+#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
+    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY)
     FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
 #undef MOMENTUM_EXPLICIT
 }
@@ -722,7 +736,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, 0);
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];

@@ -23,6 +23,7 @@ struct forces_params {
     int av_separating;  /* ... for separating pairs too */
     int implicit_viscosity; /* the momentum pass leaves the viscous term out and stores its
                                couplings for forces_viscous_apply (docs/numerics.md) */
+    int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */
 };
 
 /* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */

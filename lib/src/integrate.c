@@ -152,6 +152,7 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.params.av_mixed = s->cfg.av_mixed;
     S.params.av_separating = s->cfg.av_separating;
     S.params.implicit_viscosity = s->cfg.viscosity_implicit;
+    S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
