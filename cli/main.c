@@ -231,7 +231,10 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
  * then twice as long after each probe that kept the count, up to GOV_MAX_S; at once when a window
  * is GOV_DROP times slower than the one after the last probe) runs one window on the other count
  * (1 or the --threads asked for) and keeps it when its steps per second are GOV_GAIN times more.
- * A probe costs at most one window at the slower count. --fixed-threads turns it off. */
+ * A probe costs at most one window at the slower count. It starts on 1 thread when other tasks
+ * are running on the cores the threads would need (the kernel's count of runnable tasks): its
+ * first window cannot be cut short, and a spinning 2-thread step beside two busy processes took
+ * 10-20 s. --fixed-threads turns it off. */
 #define GOV_WINDOW_S 0.1
 #define GOV_FIRST_S 1.0
 #define GOV_MAX_S 32.0
@@ -249,7 +252,25 @@ struct governor {
     long switches;
 };
 
-static void governor_init(struct governor *g, int threads, int fixed)
+/* How many cores no other task is running on now (-1 when unknown): online cores minus the
+ * runnable tasks of /proc/stat (procs_running) besides the calling thread. */
+static int cores_idle_now(void)
+{
+    FILE *f = fopen("/proc/stat", "r");
+    if (!f) return -1;
+    char line[256];
+    long running = -1;
+    while (fgets(line, sizeof line, f))
+        if (sscanf(line, "procs_running %ld", &running) == 1) break;
+    fclose(f);
+    const long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    if (running < 1 || cores < 1) return -1;
+    return (int)(cores - (running - 1));
+}
+
+/* idle: cores_idle_now() read before the simulation's first parallel region (afterwards the
+ * process's own spinning threads would count as other tasks). */
+static void governor_init(struct governor *g, mixsph_sim *s, int threads, int fixed, int idle)
 {
     memset(g, 0, sizeof *g);
     g->max = threads;
@@ -261,6 +282,10 @@ static void governor_init(struct governor *g, int threads, int fixed)
     g->on = !fixed && g->max > 1;
     g->interval = GOV_FIRST_S;
     g->next_probe = now() + GOV_FIRST_S;
+    if (g->on && idle >= 0 && idle < g->max) { /* the cores are shared: start on 1 */
+        g->cur = 1;
+        mixsph_sim_set_threads(s, 1);
+    }
 }
 
 static void governor_window_done(mixsph_sim *s, struct governor *g, double t)
@@ -310,6 +335,7 @@ static mixsph_status advance_governed(mixsph_sim *s, double target, struct gover
 
 static int cmd_run(int argc, char **argv)
 {
+    const int cores_idle = cores_idle_now();
     const char *case_path = NULL, *out_dir = NULL, *restart = NULL;
     double ckpt_every = -1.0; /* wall seconds between checkpoints, < 0: none */
     mixsph_override sets[MAX_SETS];
@@ -430,7 +456,7 @@ static int cmd_run(int argc, char **argv)
     unsigned long long ckpt_step = mixsph_sim_steps(s);
     const int chunks = 1000;
     struct governor gov;
-    governor_init(&gov, threads, fixed_threads);
+    governor_init(&gov, s, threads, fixed_threads, cores_idle);
     for (int c = 1; c <= chunks && st == MIXSPH_OK && !stop_signal; c++) {
         st = advance_governed(s, t_end * c / chunks, &gov);
         if (st == MIXSPH_ERR_INTERRUPTED) st = MIXSPH_OK; /* a signal, between two steps: stopped below */
