@@ -152,8 +152,8 @@ class Design:
             with open(self.state_path) as f:
                 st = json.load(f)
             if st["spec"] != json.loads(json.dumps(self._spec())):
-                diff = [k for k in self._spec() if st["spec"].get(k) != json.loads(
-                    json.dumps(self._spec()))[k]]
+                now = json.loads(json.dumps(self._spec()))
+                diff = [k for k in sorted(set(now) | set(st["spec"])) if st["spec"].get(k) != now.get(k)]
                 raise DesignError(f"{self.out} holds a design with other settings ({', '.join(diff)}"
                                   f"): use another folder, or the same settings to continue it")
             return st
