@@ -24,6 +24,9 @@ struct particles {
     double *avc;          /* alpha_M c h of the particle's medium [m2/s]; 0 if no artificial viscosity */
     double *visc_dvx, *visc_dvz; /* velocity change of the last implicit viscous step [m/s] (its warm start) */
     double *visc_d1x, *visc_d1z; /* ... of that step's first stage (viscous.h) [m/s] */
+    double *visc_dvpx, *visc_dvpz; /* visc_dv of the step before the last (the warm starts'
+                                    * linear extrapolation) [m/s] */
+    double *visc_d1px, *visc_d1pz; /* visc_d1 of the step before the last [m/s] */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index
                            * (read it through particles_wall_index) */
     uint8_t *state;       /* MIXSPH_STATE_* */
@@ -33,7 +36,8 @@ struct particles {
 
 /* The double-valued fields, for code that treats them all alike (permute, copy, state). */
 #define PARTICLES_DOUBLE_FIELDS(X) \
-    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc) X(visc_dvx) X(visc_dvz) X(visc_d1x) X(visc_d1z)
+    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc) X(visc_dvx) X(visc_dvz) X(visc_d1x) X(visc_d1z) \
+        X(visc_dvpx) X(visc_dvpz) X(visc_d1px) X(visc_d1pz)
 
 /** The wall a wall particle belongs to (its `medium` field holds the wall's index). */
 static inline size_t particles_wall_index(const struct particles *P, size_t i) { return P->medium[i]; }

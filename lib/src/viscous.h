@@ -6,8 +6,8 @@
  * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
  * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
  * of a hold_fixed medium are prescribed. The system is solved matrix-free by BiCGSTAB with a
- * Jacobi preconditioner, each stage warm-started from its increment of the last step (kept per
- * particle). Dot products are summed in fixed blocks, so results do not depend on the thread
+ * Jacobi preconditioner, each stage warm-started from its increments of the last two steps
+ * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the thread
  * count. */
 #ifndef MIXSPH_VISCOUS_H
 #define MIXSPH_VISCOUS_H
@@ -20,7 +20,7 @@ struct viscous_solver;
 
 /* The outcome of one solve. */
 struct viscous_report {
-    int iterations;    /* conjugate-gradient iterations */
+    int iterations;    /* BiCGSTAB iterations */
     double residual;   /* final ||b - A u|| / ||b|| (0 when b = 0) */
     int converged;     /* residual <= tolerance */
 };
@@ -28,21 +28,22 @@ struct viscous_report {
 struct viscous_solver *viscous_create(void);
 void viscous_free(struct viscous_solver *V);
 
-/** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
- *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
- *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
- *  built and timed by the caller (NULL: the walls keep uvx, uvz). Stops at ||r|| <= tolerance ||b|| or after max_iterations. Returns -1 when out of
- *  memory, 0 otherwise (convergence is in the report). */
-/** The implicit viscous step over dt from t (walls not yet moved): TR-BDF2, a trapezoidal stage
- *  to t + gamma dt and a BDF2 stage to t + dt, each a solve of the form of viscous_solve with the
- *  walls' mirror (M, rebuilt here at the current positions) at the stage's time. Updates
- *  P->vx, P->vz, P->visc_dvx, visc_dvz (the increment over the step, the next step's warm start)
- *  and the wall particles' uvx, uvz. The report sums the two stages' iterations and keeps the
- *  larger residual. Returns -1 when out of memory, 0 otherwise. */
+/** The implicit viscous step over dt from t (walls not yet moved): the two-stage SDIRK of
+ *  docs/numerics.md, each stage a solve (m + gamma dt L) U = m w - gamma dt L u_B with the
+ *  walls' mirror (M, rebuilt here at the current positions) at the stage's time, warm-started
+ *  from its increments of the last two steps. Updates P->vx, P->vz, the increments
+ *  (visc_dv*, visc_d1* and those of the step before) and the wall particles' uvx, uvz. The
+ *  report sums the two stages' iterations and keeps the larger residual. Stops a stage at
+ *  ||r|| <= tolerance ||b|| or after max_iterations. Returns -1 when out of memory, 0 otherwise
+ *  (convergence is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
                  double tolerance, int max_iterations, struct viscous_report *report);
 
+/** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
+ *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
+ *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
+ *  built and timed by the caller (NULL: the walls keep uvx, uvz); tests of the solver. */
 int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                   const struct wall_mirror *M, double dt, double tolerance, int max_iterations,
                   struct viscous_report *report);
