@@ -26,6 +26,9 @@
  * the same sums for any thread count. */
 #define VISCOUS_BLOCK 2048
 #define N_SUMS 6 /* partial sums per block */
+/* Rows past the active ones that the operator's pair loops may read (forces.c reads up to
+ * FORCES_CHUNK - 1 = 7 elements past a range); kept zero. */
+#define VISCOUS_PAD 16
 
 /* The solver's vectors, per active particle (pairs: x and z components):
  *   U   the iterate u (unknown rows; junk on the others until the end)
@@ -66,11 +69,14 @@ static int reserve(struct viscous_solver *V, size_t n)
         V->partial = q;
         V->cap_blocks = nb;
     }
-    if (V->cap >= n) return 0;
+    if (V->cap >= n + VISCOUS_PAD) return 0;
     const size_t cap = n + n / 4 + 64;
     for (int k = 0; k < N_VEC; k++) {
         double *q = realloc(V->v[k], cap * sizeof(double));
         if (!q) return -1;
+        /* the operator's chunked pair loops read (with zero weights) a few rows past the active
+         * ones: those must hold finite numbers, or 0 * NaN poisons a row's sum */
+        memset(q, 0, cap * sizeof(double));
         V->v[k] = q;
     }
     unsigned char *m = realloc(V->mobile, cap);
@@ -348,7 +354,8 @@ static int stage(const struct solve_ctx *c, double tolerance, int max_iterations
     }
     const double residual = b2 > 0.0 ? sqrt(r2 / b2) : sqrt(r2);
     report->iterations += it;
-    report->residual = fmax(report->residual, residual);
+    /* fmax would drop a NaN, and the failure message would then read "residual 0" */
+    report->residual = isnan(residual) ? residual : fmax(report->residual, residual);
     report->converged = report->converged && r2 <= tolerance * tolerance * b2;
     return 0;
 }
