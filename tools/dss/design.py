@@ -3,11 +3,21 @@
 Start: a Latin hypercube of n_init runs over the box of the distributions (the sweep's LHS,
 scenarios.sample). Then, until the emulator's cross-validated RMSE (in % of the output's range
 over the runs) is at most the target or the budget is spent: fit the emulator, draw a large
-random candidate set in the box, and pick a batch of as many runs as there are workers at the
-candidates of largest predictive sd (or, with a crest, of largest p(1-p), p = P(output > crest)
-at the candidate: where the exceedance is most uncertain). Within a batch each pick multiplies
-the others' scores by 1 - r(x, x_picked)^2, r the fitted kernel's correlation (without the
-noise): a simple distance penalty in the GP's own length scales, so a batch is not clustered.
+random candidate set in the box, and pick a batch of as many runs as there are workers among
+them by a criterion:
+
+  imse   (default) the largest reduction of the posterior variance integrated over a random
+         reference sample of the box (imse_pick); within a batch each pick conditions the
+         covariances on a run there (a rank-1 update). The largest sd alone sits on the box's
+         faces when the length scales are long (the Vajont campaign: all 48 picks within 5 % of
+         a face), which leaves the interior to the start.
+  sd     the largest predictive sd
+  crest  (with a crest) the largest p(1-p), p = P(output > crest) at the candidate: where the
+         exceedance is most uncertain
+
+With sd and crest each pick multiplies the others' scores by 1 - r(x, x_picked)^2, r the fitted
+kernel's correlation (without the noise): a simple distance penalty in the GP's own length
+scales, so a batch is not clustered.
 
 State: OUT/design.json (settings, the batches' scenario ids in order, the history of the CV
 error), OUT/scenarios.csv (every scenario's parameters, as a sweep's) and the results store
@@ -63,20 +73,42 @@ def _fmt_t(s):
     return f"{s // 3600}h{s // 60 % 60:02d}m" if s >= 3600 else f"{s // 60}m{s % 60:02d}s"
 
 
-def pick_batch(em: E.Emulator, output: str, dists: list[S.Distribution], fixed: dict, k: int,
-               rng, n_cand: int, crest: float | None = None, exclude=None):
-    """k scenarios (dicts) from n_cand random candidates in the box: largest sd, or largest
-    p(1-p) with a crest; each pick damps the others by 1 - r^2 (r: the fitted correlation)."""
-    from scipy.stats import norm
-    u = rng.random((n_cand, len(dists)))
-    cand = [dict(fixed) for _ in range(n_cand)]
+CRITERIA = ("imse", "sd")
+N_REF = 500              # the reference sample of the integrated variance
+IMSE_CANDIDATES = 2000   # imse's default candidates at most (1000 per input below it)
+
+
+def _draw(dists, fixed, n, rng):
+    """n random scenarios (dicts) from the distributions (uniform u through each ppf)."""
+    u = rng.random((n, len(dists)))
+    out = [dict(fixed) for _ in range(n)]
     for j, d in enumerate(dists):
         col = d.ppf(u[:, j])
-        for i in range(n_cand):
-            cand[i][d.name] = col[i]
+        for i in range(n):
+            out[i][d.name] = col[i]
+    return out
+
+
+def pick_batch(em: E.Emulator, output: str, dists: list[S.Distribution], fixed: dict, k: int,
+               rng, n_cand: int, crest: float | None = None, exclude=None,
+               criterion: str = "imse", n_ref: int = N_REF):
+    """k scenarios (dicts) from n_cand random candidates in the box.
+
+    With a crest: largest p(1-p), p = P(output > crest); criterion 'sd': largest predictive
+    sd; with either, each pick damps the others' scores by 1 - r^2 (r: the fitted correlation).
+    criterion 'imse' (without a crest): largest integrated-variance reduction over a reference
+    sample R of n_ref scenarios drawn (after the candidates, from the same rng) from the same
+    distributions (imse_pick)."""
+    from scipy.stats import norm
+    if crest is None and criterion not in CRITERIA:
+        raise DesignError(f"unknown criterion {criterion!r} ({', '.join(CRITERIA)})")
+    cand = _draw(dists, fixed, n_cand, rng)
     X = em.matrix(cand)
     U = em.unit(X)
     m = em.models[output]
+    if crest is None and criterion == "imse":
+        Ur = em.unit(em.matrix(_draw(dists, fixed, n_ref, rng)))
+        return [cand[i] for i in imse_pick(m, U, Ur, k)]
     mu, sd = m.predict(U)
     if crest is None:
         score = sd.copy()
@@ -95,6 +127,43 @@ def pick_batch(em: E.Emulator, output: str, dists: list[S.Distribution], fixed: 
     return [cand[i] for i in picked]
 
 
+def imse_pick(m: E.OutputModel, Uc, Ur, k: int) -> list[int]:
+    """Indices of k candidates (rows of Uc, unit box) picked one by one at the largest
+    reduction of the posterior variance integrated over the reference points Ur (IMSE, Sacks
+    et al. 1989; the ALC criterion of Gramacy's laGP):
+
+        score(c) = sum_{x in R} cov(x, c)^2 / (var(c) + noise(c))
+
+    cov the posterior covariance of the latent response (OutputModel.posterior_cov), var(c) =
+    cov(c, c), noise the fitted WhiteKernel variance at c. After each pick p, the covariances
+    over R and the candidates are those of the GP with a run at p (fitted noise) added, a rank-1
+    update: cov(a, b) -= cov(a, p) cov(p, b) / (var(p) + noise(p)), with cov(C, p) from one
+    fresh column of posterior_cov and the previous picks' updates. Cost: one |R| x |C| matrix
+    (the kernel against the training runs and a product of n_train), then O(|R| |C|) per pick."""
+    cRC = m.posterior_cov(Ur, Uc)                       # R x C, updated in place
+    vC = m.posterior_var(Uc)
+    nz = m.noise_at(Uc)
+    W = []                                              # the updates' vectors over C
+    picked = []
+    for _ in range(k):
+        score = (cRC ** 2).sum(axis=0) / (np.maximum(vC, 0.0) + nz)
+        score[~np.isfinite(score)] = -np.inf
+        score[picked] = -np.inf
+        i = int(np.argmax(score))
+        if not np.isfinite(score[i]) or score[i] <= 0:
+            break
+        picked.append(i)
+        cCp = m.posterior_cov(Uc, Uc[i:i + 1])[:, 0]
+        for w in W:
+            cCp -= w * w[i]
+        s = math.sqrt(max(vC[i], 0.0) + nz[i])
+        wC, wR = cCp / s, cRC[:, i] / s
+        cRC -= np.outer(wR, wC)
+        vC = vC - wC ** 2
+        W.append(wC)
+    return picked
+
+
 class Design:
     """A sequential design in OUT (see the module doc). evaluate(scenarios, on_result) runs a
     list of scenarios ({'scenario_id', params...}) and calls on_result(row) per finished run."""
@@ -102,7 +171,7 @@ class Design:
     def __init__(self, out, dists, fixed, stop_time, output="max_run_up", budget=60,
                  target_error=2.0, n_init=None, crest=None, seed=0, n_workers=2, mode="product",
                  folds=5, restarts=2, n_candidates=None, fmu=None, settings=None, progress=True,
-                 stream=None, min_runs=None, noise=None):
+                 stream=None, min_runs=None, noise=None, criterion=None):
         self.out = out
         self.dists = list(dists)
         self.names = [d.name for d in self.dists]
@@ -115,7 +184,16 @@ class Design:
         # the start: 10 runs per input is the usual rule for GP emulators, at most a third of
         # the budget, at least one batch
         self.n_init = int(n_init) if n_init else max(self.n_workers, min(self.budget // 3, 10 * d))
-        self.n_cand = int(n_candidates) if n_candidates else 1000 * d
+        # the acquisition: 'crest' with a crest (p(1-p)), else 'imse' (default) or 'sd'
+        if crest is not None and criterion not in (None, "crest"):
+            raise DesignError(f"--criterion {criterion} applies without --crest only (with a "
+                              f"crest the picks are at the largest p(1-p))")
+        self.criterion = "crest" if crest is not None else (criterion or "imse")
+        if self.criterion not in CRITERIA + ("crest",):
+            raise DesignError(f"unknown criterion {self.criterion!r} ({', '.join(CRITERIA)})")
+        # imse costs a reference-by-candidates matrix per batch: at most IMSE_CANDIDATES
+        self.n_cand = int(n_candidates) if n_candidates else (
+            min(1000 * d, IMSE_CANDIDATES) if self.criterion == "imse" else 1000 * d)
         # the CV target may stop the design only from this many runs on: a CV of a few runs is
         # no estimate (the first campaign stopped at 10 runs on a CV RMSE of 1.7 % and missed
         # on the hold-out); default 10 runs per input (Loeppky, Sacks & Welch 2009), at most
@@ -141,6 +219,7 @@ class Design:
         return {"dists": {d.name: _dist_spec(d) for d in self.dists}, "fixed": self.fixed,
                 "stop_time": self.stop_time, "output": self.output, "crest": self.crest,
                 "seed": self.seed, "n_init": self.n_init, "mode": self.mode,
+                "criterion": self.criterion,
                 # the measured noise floor changes the picks: part of the settings (absent
                 # without one, so designs of before it continue)
                 **({"noise": {k: {"variance": v["variance"], "mode": v["mode"]}
@@ -151,6 +230,9 @@ class Design:
         if os.path.isfile(self.state_path):
             with open(self.state_path) as f:
                 st = json.load(f)
+            # a design of before the criterion setting picked at the largest sd (or p(1-p))
+            st["spec"].setdefault("criterion", "sd" if st["spec"].get("crest") is None
+                                  else "crest")
             if st["spec"] != json.loads(json.dumps(self._spec())):
                 now = json.loads(json.dumps(self._spec()))
                 diff = [k for k in sorted(set(now) | set(st["spec"])) if st["spec"].get(k) != now.get(k)]
@@ -281,14 +363,13 @@ class Design:
             rng = np.random.default_rng([self.seed, bi])
             have = set(self.results()[ID])
             batch = pick_batch(em, self.output, self.dists, self.fixed, k, rng, self.n_cand,
-                               crest=self.crest)
+                               crest=self.crest, criterion=self.criterion)
             ids = self._add_scenarios(batch)
             ids = [i for i in ids if i not in have]
             if not ids:
                 reason = "no new point"
                 break
-            self.state["batches"].append({"kind": "crest" if self.crest is not None else "sd",
-                                          "ids": ids})
+            self.state["batches"].append({"kind": self.criterion, "ids": ids})
             self._write_state()
         self.state["stopped"] = reason
         self._write_state()

@@ -6,7 +6,9 @@
   predict EMU        mean, sd and 95 % interval per scenario (--set NAME=VALUE ... or --csv);
                      queries outside the training box are flagged in the column out_of_box
   design OUT         sequential design on the Dask cluster: a Latin hypercube, then batches at
-                     the largest predictive sd (or, with --crest, the most uncertain exceedance)
+                     the largest integrated-variance reduction (--criterion imse, default), the
+                     largest predictive sd (--criterion sd) or, with --crest, the most uncertain
+                     exceedance
                      until the CV error is below --target-error or --budget runs are spent;
                      resumable; writes OUT/emulator.json
   validate EMU SWEEP the emulator against runs it was not fitted on (a hold-out sweep): RMSE,
@@ -149,8 +151,15 @@ def build_parser():
                    help="runs before the CV target may stop the design (default 10 per input, "
                         "at most the budget)")
     d.add_argument("--crest", type=float, metavar="Z",
-                   help="pick where P(output > Z) is most uncertain (max p(1-p)) instead of max sd")
-    d.add_argument("--candidates", type=int, help="random candidates per batch (1000 per input)")
+                   help="pick where P(output > Z) is most uncertain (max p(1-p)) instead of by "
+                        "--criterion")
+    d.add_argument("--criterion", choices=("imse", "sd"),
+                   help="without --crest: imse, the largest reduction of the posterior variance "
+                        "integrated over 500 random points of the box (default), or sd, the "
+                        "largest predictive sd (the design of before; its picks sit on the box's "
+                        "faces); a setting of the design (a resumed design keeps it)")
+    d.add_argument("--candidates", type=int,
+                   help="random candidates per batch (1000 per input; with imse at most 2000)")
     d.add_argument("--no-plots", action="store_true")
     d.add_argument("--fit-output", action="append", default=[], metavar="NAME",
                    help="another output the final emulator fits (repeatable; default: "
@@ -572,6 +581,9 @@ def cmd_design(args):
         fixed.setdefault("dx", dx)
     if not args.fit_output and args.output == "max_run_up" and "max_run_up_Z" in var:
         args.fit_output = ["max_run_up_Z"]
+    if args.criterion and args.crest is not None:
+        raise UsageError(f"--criterion {args.criterion} applies without --crest only (with a "
+                         f"crest the picks are at the largest p(1 - p))")
     dists = [Distribution(*split_assignment(it)) for it in args.dist]
     for d_ in dists:
         if d_.name not in var or var[d_.name].causality != "parameter":
@@ -596,13 +608,14 @@ def cmd_design(args):
         def evaluate(scen, on_result):
             runner.run_scenarios(client, fmu, scen, opts, on_result=on_result, progress=None)
 
-        des = D.Design(args.out, dists, fixed, opts["stop_time"], output=args.output,
-                       budget=args.budget, target_error=args.target_error, n_init=args.init,
-                       crest=args.crest, seed=args.seed, n_workers=nw, mode=args.categorical,
-                       folds=args.folds, restarts=args.restarts, n_candidates=args.candidates,
-                       fmu=ident, settings=settings, progress=not quiet,
-                       min_runs=args.min_runs, noise=noise)
         try:
+            # a folder holding a design of other settings (the criterion among them) is refused
+            des = D.Design(args.out, dists, fixed, opts["stop_time"], output=args.output,
+                           budget=args.budget, target_error=args.target_error, n_init=args.init,
+                           crest=args.crest, seed=args.seed, n_workers=nw, mode=args.categorical,
+                           folds=args.folds, restarts=args.restarts, n_candidates=args.candidates,
+                           fmu=ident, settings=settings, progress=not quiet,
+                           min_runs=args.min_runs, noise=noise, criterion=args.criterion)
             res = des.run(evaluate)
         except D.DesignError as e:
             print(f"emulate design: {e}", file=sys.stderr)

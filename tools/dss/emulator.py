@@ -276,6 +276,46 @@ class OutputModel:
             C[np.ix_(rows_a, rows_b)] = K
         return C
 
+    def posterior_cov(self, Ua, Ub):
+        """The posterior covariance of the latent response (without the noise term) between
+        rows of Ua and Ub, in the output's units squared: k(a, b) - k(a, X) K^-1 k(X, b), k the
+        fitted kernel without its WhiteKernel, X the part's training inputs, K = kernel_(X) +
+        alpha (the fitted GP's own Cholesky factor L_). The rows of different levels of
+        'separate' are independent: covariance 0 (as in sample and correlation)."""
+        from scipy.linalg import solve_triangular
+        C = np.zeros((len(Ua), len(Ub)))
+        rb = {key: (rows, X) for key, rows, X in self._route(Ub)}
+        for key, rows_a, Xa in self._route(Ua):
+            if key not in rb:
+                continue
+            rows_b, Xb = rb[key]
+            gp = self.parts[key]
+            k = gp.kernel_.k1
+            Va = solve_triangular(gp.L_, k(gp.X_train_, Xa), lower=True, check_finite=False)
+            Vb = solve_triangular(gp.L_, k(gp.X_train_, Xb), lower=True, check_finite=False)
+            C[np.ix_(rows_a, rows_b)] = (k(Xa, Xb) - Va.T @ Vb) * self.y_std ** 2
+        return C
+
+    def posterior_var(self, U):
+        """The diagonal of posterior_cov(U, U) without the U x U matrix (output units squared;
+        NaN for a level without a GP)."""
+        from scipy.linalg import solve_triangular
+        out = np.full(len(U), np.nan)
+        for key, rows, X in self._route(U):
+            gp = self.parts[key]
+            k = gp.kernel_.k1
+            V = solve_triangular(gp.L_, k(gp.X_train_, X), lower=True, check_finite=False)
+            out[rows] = (k.diag(X) - np.einsum("ij,ij->j", V, V)) * self.y_std ** 2
+        return out
+
+    def noise_at(self, U):
+        """The fitted WhiteKernel variance at each row of U (its level's in 'separate'), in the
+        output's units squared (NaN for a level without a GP)."""
+        out = np.full(len(U), np.nan)
+        for key, rows, _ in self._route(U):
+            out[rows] = float(self.parts[key].kernel_.k2.noise_level) * self.y_std ** 2
+        return out
+
     def to_json(self):
         parts = []
         for key, gp in self.parts.items():
