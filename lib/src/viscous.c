@@ -447,7 +447,8 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     if (walls_mirror_build(M, cfg, &S->params.K, S->G, P, n, threads) != 0) return -1;
     load_velocities(&c);
     /* stage 1: w = u*, first guess u* + the first-stage increment extrapolated linearly from
-     * the last two steps (about 2.5 times fewer iterations than the last increment alone) */
+     * the last two steps (closer than the last increment alone where the flow changes smoothly;
+     * measured in docs/numerics.md) */
 #pragma omp parallel for schedule(static) num_threads(threads)
     for (size_t i = 0; i < n; i++) {
         v[WX][i] = v[USX][i];

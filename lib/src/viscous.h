@@ -7,8 +7,8 @@
  * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
  * of a hold_fixed medium are prescribed. The system is solved matrix-free by BiCGSTAB with a
  * Jacobi preconditioner, each stage warm-started from its increments of the last two steps
- * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the thread
- * count. */
+ * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
+ * thread count. */
 #ifndef MIXSPH_VISCOUS_H
 #define MIXSPH_VISCOUS_H
 #include <stddef.h>
