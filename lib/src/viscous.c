@@ -138,26 +138,38 @@ static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2
     const unsigned char *mob = c->V->mobile;
     const double kappa = c->dt;
     const long nb = BLOCKS(c->n);
-    double *ox = v[out], *oz = v[out + 1];
-    const double *ix = v[in], *iz = v[in + 1], *mass = v[MASS];
+    const double *ox = v[out], *oz = v[out + 1];
     const double *ax = v[dot < 0 ? out : dot], *az = v[dot < 0 ? out + 1 : dot + 1];
     const double *bx = v[dot2 < 0 ? out : dot2], *bz = v[dot2 < 0 ? out + 1 : dot2 + 1];
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
     for (long bk = 0; bk < nb; bk++) {
         BLOCK_RANGE(bk, c->n, i0, i1);
-        double t[N_SUMS] = {0.0};
-        for (size_t i = i0; i < i1; i++) {
-            const double keep = mob[i] ? 1.0 : 0.0;
-            ox[i] = keep * (mass[i] * ix[i] + kappa * ox[i]);
-            oz[i] = keep * (mass[i] * iz[i] + kappa * oz[i]);
-            t[0] += ax[i] * ox[i];
-            t[1] += az[i] * oz[i];
-            t[2] += bx[i] * ox[i];
-            t[3] += bz[i] * oz[i];
-            t[4] += ox[i] * ox[i];
-            t[5] += oz[i] * oz[i];
+        { /* restrict only here: the dot operands below may be `out` itself */
+            double *restrict wx = v[out], *restrict wz = v[out + 1];
+            const double *restrict ix = v[in], *restrict iz = v[in + 1], *restrict mass = v[MASS];
+            for (size_t i = i0; i < i1; i++) {
+                const double keep = mob[i] ? 1.0 : 0.0;
+                wx[i] = keep * (mass[i] * ix[i] + kappa * wx[i]);
+                wz[i] = keep * (mass[i] * iz[i] + kappa * wz[i]);
+            }
         }
-        for (int k = 0; k < N_SUMS; k++) c->V->partial[N_SUMS * bk + k] = t[k];
+        double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0, t4 = 0.0, t5 = 0.0;
+#pragma omp simd reduction(+ : t0, t1, t2, t3, t4, t5)
+        for (size_t i = i0; i < i1; i++) {
+            t0 += ax[i] * ox[i];
+            t1 += az[i] * oz[i];
+            t2 += bx[i] * ox[i];
+            t3 += bz[i] * oz[i];
+            t4 += ox[i] * ox[i];
+            t5 += oz[i] * oz[i];
+        }
+        double *part = c->V->partial + N_SUMS * bk;
+        part[0] = t0;
+        part[1] = t1;
+        part[2] = t2;
+        part[3] = t3;
+        part[4] = t4;
+        part[5] = t5;
     }
     block_sums(c->V, nb, d);
     return 0;
@@ -176,11 +188,15 @@ static void dots(const struct solve_ctx *c, int count, const int *a, const int *
         double t[N_SUMS] = {0.0};
         for (int k = 0; k < count; k++) {
             const double *ax = v[a[k]], *az = v[a[k] + 1], *bx = v[b[k]], *bz = v[b[k] + 1];
+            double sx = 0.0, sz = 0.0;
+#pragma omp simd reduction(+ : sx, sz)
             for (size_t i = i0; i < i1; i++) {
-                if (!mob[i]) continue;
-                t[2 * k] += ax[i] * bx[i];
-                t[2 * k + 1] += az[i] * bz[i];
+                const double keep = mob[i] ? 1.0 : 0.0;
+                sx += keep * ax[i] * bx[i];
+                sz += keep * az[i] * bz[i];
             }
+            t[2 * k] = sx;
+            t[2 * k + 1] = sz;
         }
         for (int k = 0; k < N_SUMS; k++) c->V->partial[N_SUMS * bk + k] = t[k];
     }
@@ -269,34 +285,48 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
             rho[k] = rho_new[k];
         }
         /* p = r + beta (p - omega v), y = M^-1 p */
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (size_t i = 0; i < n; i++) {
-            v[PX][i] = v[RX][i] + beta[0] * (v[PX][i] - omega[0] * v[VX][i]);
-            v[PZ][i] = v[RZ][i] + beta[1] * (v[PZ][i] - omega[1] * v[VZ][i]);
-            v[YX][i] = v[MINV][i] * v[PX][i];
-            v[YZ][i] = v[MINV][i] * v[PZ][i];
+        {
+            double *restrict px = v[PX], *restrict pz = v[PZ], *restrict yx = v[YX], *restrict yz = v[YZ];
+            const double *restrict rx = v[RX], *restrict rz = v[RZ], *restrict vx = v[VX], *restrict vz = v[VZ];
+            const double *restrict minv = v[MINV];
+            const double b0 = beta[0], b1 = beta[1], w0 = omega[0], w1 = omega[1];
+#pragma omp parallel for simd schedule(static) num_threads(c->S->n_threads)
+            for (size_t i = 0; i < n; i++) {
+                px[i] = rx[i] + b0 * (px[i] - w0 * vx[i]);
+                pz[i] = rz[i] + b1 * (pz[i] - w1 * vz[i]);
+                yx[i] = minv[i] * px[i];
+                yz[i] = minv[i] * pz[i];
+            }
         }
         if (apply_a(c, YX, VX, RHX, -1, d) != 0) return -1; /* v = A y, (r^, v) */
         for (int k = 0; k < 2; k++) alpha[k] = ratio(rho[k], d[k]);
         /* u += alpha y, s = r - alpha v, z = M^-1 s, (s, s) */
+        {
+            double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict sx = v[SX], *restrict sz = v[SZ];
+            double *restrict zx = v[ZX], *restrict zz = v[ZZ];
+            const double *restrict yx = v[YX], *restrict yz = v[YZ], *restrict rx = v[RX], *restrict rz = v[RZ];
+            const double *restrict vx = v[VX], *restrict vz = v[VZ], *restrict minv = v[MINV];
+            const double a0 = alpha[0], a1 = alpha[1];
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (long bk = 0; bk < nb; bk++) {
-            BLOCK_RANGE(bk, n, i0, i1);
-            double t[2] = {0.0, 0.0};
-            for (size_t i = i0; i < i1; i++) {
-                v[UX][i] += alpha[0] * v[YX][i];
-                v[UZ][i] += alpha[1] * v[YZ][i];
-                v[SX][i] = v[RX][i] - alpha[0] * v[VX][i];
-                v[SZ][i] = v[RZ][i] - alpha[1] * v[VZ][i];
-                v[ZX][i] = v[MINV][i] * v[SX][i];
-                v[ZZ][i] = v[MINV][i] * v[SZ][i];
-                t[0] += v[SX][i] * v[SX][i];
-                t[1] += v[SZ][i] * v[SZ][i];
+            for (long bk = 0; bk < nb; bk++) {
+                BLOCK_RANGE(bk, n, i0, i1);
+                double t0 = 0.0, t1 = 0.0;
+#pragma omp simd reduction(+ : t0, t1)
+                for (size_t i = i0; i < i1; i++) {
+                    ux[i] += a0 * yx[i];
+                    uz[i] += a1 * yz[i];
+                    sx[i] = rx[i] - a0 * vx[i];
+                    sz[i] = rz[i] - a1 * vz[i];
+                    zx[i] = minv[i] * sx[i];
+                    zz[i] = minv[i] * sz[i];
+                    t0 += sx[i] * sx[i];
+                    t1 += sz[i] * sz[i];
+                }
+                double *part = c->V->partial + N_SUMS * bk;
+                part[0] = t0;
+                part[1] = t1;
+                for (int k = 2; k < N_SUMS; k++) part[k] = 0.0;
             }
-            double *part = c->V->partial + N_SUMS * bk;
-            part[0] = t[0];
-            part[1] = t[1];
-            for (int k = 2; k < N_SUMS; k++) part[k] = 0.0;
         }
         block_sums(c->V, nb, d);
         it++;
@@ -308,23 +338,33 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
         omega[0] = ratio(d[0], d[4]);
         omega[1] = ratio(d[1], d[5]);
         /* u += omega z, r = s - omega t, (r, r), (r^, r) */
+        {
+            double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict rx = v[RX], *restrict rz = v[RZ];
+            const double *restrict zx = v[ZX], *restrict zz = v[ZZ], *restrict sx = v[SX], *restrict sz = v[SZ];
+            const double *restrict tx = v[TX], *restrict tz = v[TZ], *restrict hx = v[RHX], *restrict hz = v[RHZ];
+            const double w0 = omega[0], w1 = omega[1];
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-        for (long bk = 0; bk < nb; bk++) {
-            BLOCK_RANGE(bk, n, i0, i1);
-            double t[4] = {0.0, 0.0, 0.0, 0.0};
-            for (size_t i = i0; i < i1; i++) {
-                v[UX][i] += omega[0] * v[ZX][i];
-                v[UZ][i] += omega[1] * v[ZZ][i];
-                v[RX][i] = v[SX][i] - omega[0] * v[TX][i];
-                v[RZ][i] = v[SZ][i] - omega[1] * v[TZ][i];
-                t[0] += v[RX][i] * v[RX][i];
-                t[1] += v[RZ][i] * v[RZ][i];
-                t[2] += v[RHX][i] * v[RX][i];
-                t[3] += v[RHZ][i] * v[RZ][i];
+            for (long bk = 0; bk < nb; bk++) {
+                BLOCK_RANGE(bk, n, i0, i1);
+                double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
+#pragma omp simd reduction(+ : t0, t1, t2, t3)
+                for (size_t i = i0; i < i1; i++) {
+                    ux[i] += w0 * zx[i];
+                    uz[i] += w1 * zz[i];
+                    rx[i] = sx[i] - w0 * tx[i];
+                    rz[i] = sz[i] - w1 * tz[i];
+                    t0 += rx[i] * rx[i];
+                    t1 += rz[i] * rz[i];
+                    t2 += hx[i] * rx[i];
+                    t3 += hz[i] * rz[i];
+                }
+                double *part = c->V->partial + N_SUMS * bk;
+                part[0] = t0;
+                part[1] = t1;
+                part[2] = t2;
+                part[3] = t3;
+                part[4] = part[5] = 0.0;
             }
-            double *part = c->V->partial + N_SUMS * bk;
-            for (int k = 0; k < 4; k++) part[k] = t[k];
-            part[4] = part[5] = 0.0;
         }
         block_sums(c->V, nb, d);
         *r2 = d[0] + d[1];
@@ -333,6 +373,7 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
     }
     return it;
 }
+
 
 /* One stage: (m + kappa L) u = m w - kappa L u_B from the guess v[GX], v[GZ], w in v[WX], v[WZ];
  * the solution in v[UX], v[UZ] (unknown rows). Returns -1 when out of memory. */
