@@ -94,6 +94,19 @@ static void block_sums(const struct viscous_solver *V, long nb, double s[N_SUMS]
         for (int k = 0; k < N_SUMS; k++) s[k] += V->partial[N_SUMS * bk + k];
 }
 
+/* A block's partial sums (N_SUMS of them) into V->partial. */
+static void put_partial(struct viscous_solver *V, long bk, double t0, double t1, double t2, double t3, double t4,
+                        double t5)
+{
+    double *part = V->partial + N_SUMS * bk;
+    part[0] = t0;
+    part[1] = t1;
+    part[2] = t2;
+    part[3] = t3;
+    part[4] = t4;
+    part[5] = t5;
+}
+
 #define BLOCKS(n) ((long)(((n) + VISCOUS_BLOCK - 1) / VISCOUS_BLOCK))
 #define BLOCK_RANGE(bk, n, i0, i1)                                   \
     const size_t i0 = (size_t)(bk) * VISCOUS_BLOCK;                  \
@@ -163,13 +176,7 @@ static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2
             t4 += ox[i] * ox[i];
             t5 += oz[i] * oz[i];
         }
-        double *part = c->V->partial + N_SUMS * bk;
-        part[0] = t0;
-        part[1] = t1;
-        part[2] = t2;
-        part[3] = t3;
-        part[4] = t4;
-        part[5] = t5;
+        put_partial(c->V, bk, t0, t1, t2, t3, t4, t5);
     }
     block_sums(c->V, nb, d);
     return 0;
@@ -322,10 +329,7 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
                     t0 += sx[i] * sx[i];
                     t1 += sz[i] * sz[i];
                 }
-                double *part = c->V->partial + N_SUMS * bk;
-                part[0] = t0;
-                part[1] = t1;
-                for (int k = 2; k < N_SUMS; k++) part[k] = 0.0;
+                put_partial(c->V, bk, t0, t1, 0.0, 0.0, 0.0, 0.0);
             }
         }
         block_sums(c->V, nb, d);
@@ -358,12 +362,7 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
                     t2 += hx[i] * rx[i];
                     t3 += hz[i] * rz[i];
                 }
-                double *part = c->V->partial + N_SUMS * bk;
-                part[0] = t0;
-                part[1] = t1;
-                part[2] = t2;
-                part[3] = t3;
-                part[4] = part[5] = 0.0;
+                put_partial(c->V, bk, t0, t1, t2, t3, 0.0, 0.0);
             }
         }
         block_sums(c->V, nb, d);
@@ -373,7 +372,6 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
     }
     return it;
 }
-
 
 /* One stage: (m + kappa L) u = m w - kappa L u_B from the guess v[GX], v[GZ], w in v[WX], v[WZ];
  * the solution in v[UX], v[UZ] (unknown rows). Returns -1 when out of memory. */
