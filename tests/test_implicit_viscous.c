@@ -135,9 +135,10 @@ static const char *const BOX =
     "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.1], [0.0, 0.0], [0.1, 0.0], [0.1, 0.1]], \"fluid_side\": \"left\" } },\n"
     "  \"domain\": { \"x_min\": -0.05, \"x_max\": 0.15, \"z_min\": -0.05, \"z_max\": 0.15 } }\n";
 
-static void test_momentum_only_changed_by_walls(void **state)
+/* The box with its shear field and the operator at its positions (the momentum pass stores the
+ * couplings). */
+static mixsph_sim *box_with_shear(void)
 {
-    (void)state;
     mixsph_sim *s = create(BOX, 50.0);
     struct particles *P = &s->P;
     const size_t n = s->C.start[s->C.ncell];
@@ -146,10 +147,37 @@ static void test_momentum_only_changed_by_walls(void **state)
             P->vx[i] = P->uvx[i] = 0.1 * sin(40.0 * P->z[i]);
             P->vz[i] = P->uvz[i] = 0.05 * cos(30.0 * P->x[i]);
         }
-    /* the operator at these positions (the momentum pass stores the couplings) */
     assert_true(sim_density_pass(s) >= 0);
     integrate_pressure_and_derived(s);
     assert_int_equal(sim_momentum_pass(s), 0);
+    return s;
+}
+
+/* One backward-Euler solve of the box over `factor` times the explicit viscous limit, with the
+ * walls' mirror; returns the report. */
+static struct viscous_report box_solve(mixsph_sim *s, double factor, int preconditioner)
+{
+    const size_t n = s->C.start[s->C.ncell];
+    const struct pair_system S = sim_pair_system(s);
+    struct viscous_solver *V = viscous_create();
+    assert_non_null(V);
+    struct viscous_report rep;
+    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0;
+    struct wall_mirror *M = walls_mirror_create();
+    assert_non_null(M);
+    assert_int_equal(walls_mirror_build(M, &s->cfg, &s->K, &s->G, &s->P, n, 1), 0);
+    walls_mirror_at(M, &s->cfg, s->walls, &s->P, s->t, dt, 1);
+    assert_int_equal(viscous_solve(V, s->forces, &S, M, dt, preconditioner, 1e-10, 1000, &rep), 0);
+    viscous_free(V);
+    walls_mirror_free(M);
+    return rep;
+}
+
+static void momentum_only_changed_by_walls(int preconditioner)
+{
+    mixsph_sim *s = box_with_shear();
+    struct particles *P = &s->P;
+    const size_t n = s->C.start[s->C.ncell];
     double *ux0 = calloc(n, sizeof(double)), *uz0 = calloc(n, sizeof(double));
     assert_non_null(ux0);
     assert_non_null(uz0);
@@ -157,15 +185,10 @@ static void test_momentum_only_changed_by_walls(void **state)
         ux0[i] = P->vx[i];
         uz0[i] = P->vz[i];
     }
+    const double factor = 10.0; /* times the explicit viscous limit */
+    const struct viscous_report rep = box_solve(s, factor, preconditioner);
+    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0;
     const struct pair_system S = sim_pair_system(s);
-    struct viscous_solver *V = viscous_create();
-    struct viscous_report rep;
-    const double dt = 10.0 * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0; /* 10 x the explicit limit */
-    struct wall_mirror *M = walls_mirror_create();
-    assert_non_null(M);
-    assert_int_equal(walls_mirror_build(M, &s->cfg, &s->K, &s->G, P, n, 1), 0);
-    walls_mirror_at(M, &s->cfg, s->walls, P, s->t, dt, 1);
-    assert_int_equal(viscous_solve(V, s->forces, &S, M, dt, 1e-10, 1000, &rep), 0);
     assert_true(rep.converged);
     /* momentum change of the mobile particles, and the force of the walls from the new field */
     double *ux = calloc(n, sizeof(double)), *uz = calloc(n, sizeof(double));
@@ -202,9 +225,48 @@ static void test_momentum_only_changed_by_walls(void **state)
     free(uz);
     free(lx);
     free(lz);
-    viscous_free(V);
-    walls_mirror_free(M);
     mixsph_sim_destroy(s);
+}
+
+static void test_momentum_only_changed_by_walls(void **state)
+{
+    (void)state;
+    momentum_only_changed_by_walls(VISCOUS_JACOBI);
+}
+
+static void test_momentum_only_changed_by_walls_two_level(void **state)
+{
+    (void)state;
+    momentum_only_changed_by_walls(VISCOUS_TWO_LEVEL);
+}
+
+/* The two preconditioners solve the same system: the box at 1000 times the explicit limit (the
+ * regime of a slow landslide at the acoustic step, where the error Jacobi leaves is smooth). */
+static void test_two_level_same_solution_fewer_iterations(void **state)
+{
+    (void)state;
+    const double factor = 1000.0;
+    mixsph_sim *a = box_with_shear(), *b = box_with_shear();
+    const struct viscous_report ra = box_solve(a, factor, VISCOUS_JACOBI);
+    const struct viscous_report rb = box_solve(b, factor, VISCOUS_TWO_LEVEL);
+    assert_true(ra.converged && rb.converged);
+    const size_t n = a->C.start[a->C.ncell];
+    double diff = 0.0, scale = 0.0;
+    for (size_t i = 0; i < n; i++)
+        if (a->P.state[i] == MIXSPH_STATE_MOBILE) {
+            diff = fmax(diff, hypot(a->P.vx[i] - b->P.vx[i], a->P.vz[i] - b->P.vz[i]));
+            scale = fmax(scale, hypot(a->P.vx[i], a->P.vz[i]));
+        }
+    print_message("jacobi %d iterations, two_level %d; largest difference %.2e of the largest speed %.2e\n",
+                  ra.iterations, rb.iterations, diff, scale);
+    /* reference: both solutions of the same linear system to a relative residual of 1e-10; the
+     * error is at most cond(A) times that, and cond(A) <= 1 + kappa max_i sum_j 2 w_ij / m_i is
+     * about 1e4 here, so 1e-5 of the largest speed bounds their difference */
+    assert_true(diff <= 1e-5 * scale);
+    /* the coarse level exists to remove the smooth error: it must save iterations */
+    assert_true(rb.iterations < ra.iterations);
+    mixsph_sim_destroy(a);
+    mixsph_sim_destroy(b);
 }
 
 /* The max run-up and the final landslide front of Vajont V1 at dx = 0.03 with one scheme. */
@@ -282,6 +344,8 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_momentum_only_changed_by_walls),
+        cmocka_unit_test(test_momentum_only_changed_by_walls_two_level),
+        cmocka_unit_test(test_two_level_same_solution_fewer_iterations),
         cmocka_unit_test(test_restore_continues_identically),
         cmocka_unit_test(test_schemes_agree_on_vajont),
         cmocka_unit_test(test_channel_20x),

@@ -62,7 +62,8 @@ mixsph_status mixsph_override_parse(char *text, mixsph_override *out, char *err,
     errno = 0;
     double v = strtod(eq + 1, &end);
     if (eq[1] == '\0' || *end != '\0' || errno == ERANGE || !isfinite(v)) {
-        status_set(err, err_len, MIXSPH_ERR_ARG, "override '%s': value '%s' is not a finite number", text, eq + 1);
+        status_set(err, err_len, MIXSPH_ERR_ARG, "override '%s': value '%s' is not a finite number (a choice such as "
+                   "numerics.viscosity takes its number: docs/cases.md)", text, eq + 1);
         *eq = '=';
         return MIXSPH_ERR_ARG;
     }

@@ -134,6 +134,8 @@ struct case_def {
                                  (implicit only) */
     double viscous_tolerance; /* implicit: relative residual at which the solve stops [-] */
     int viscous_max_iterations; /* implicit: iteration budget of one solve */
+    int viscous_preconditioner; /* implicit: numerics.viscous_preconditioner, 0 "jacobi", 1 "two_level"
+                                   (enum viscous_preconditioner of viscous.h) */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
     double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */

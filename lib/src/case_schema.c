@@ -32,6 +32,7 @@
 
 static const struct case_choice kernels[] = {{"cubic_spline", 0}, {"wendland_c2", 1}, {NULL, 0}};
 static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
+static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
 static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
@@ -119,6 +120,10 @@ static const struct case_key numerics_keys[] = {
      .field = CASE_FIELD(case_def, viscous_max_iterations),
      .meaning = "implicit viscosity: iteration budget of one solve; a solve that does not reach its tolerance "
                 "within it stops the run"},
+    {.key = "viscous_preconditioner", .type = CASE_CHOICE, DEF(1), .choices = viscous_preconditioners,
+     .numeric_choice = 1, .field = CASE_FIELD(case_def, viscous_preconditioner),
+     .meaning = "implicit viscosity: preconditioner of BiCGSTAB, jacobi (the diagonal) or two_level (the "
+                "diagonal plus a coarse correction on groups of cells; fewer iterations in granular flows)"},
     {.key = "max_particles", .type = CASE_NUMBER, RANGE(1, 0, 1e12, 0), DEF(1e7), .unit = "-",
      .field = CASE_FIELD(case_def, max_particles),
      .meaning = "limit of the resource budget (below): fluid, granular and wall particles, estimated from the "

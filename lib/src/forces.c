@@ -66,6 +66,7 @@
  * (10-20 candidates), so scalar remainders would cost more than the vector part. Reads may go up
  * to FORCES_CHUNK - 1 elements past a range (particles.c keeps that padding initialised). */
 #define FORCES_CHUNK 8
+_Static_assert(FORCES_CHUNK - 1 <= FORCES_PAD, "forces.h promises callers reads of at most FORCES_PAD past a range");
 
 struct forces {
     double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
@@ -101,6 +102,9 @@ struct pair_ctx {
     const double *in_x, *in_z; /* the velocity field a viscous operator is applied to */
     double *out_x, *out_z;     /* and its result */
     double *out_diag;          /* and its diagonal, or NULL */
+    const int32_t *group;      /* forces_viscous_group_couplings: each particle's group, or -1 */
+    long group_stride;         /* groups per row of the group grid */
+    double *group_w;           /* and its sums, 5 per group */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -120,6 +124,9 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->visc_w = NULL;
     X->in_x = X->in_z = NULL;
     X->out_x = X->out_z = X->out_diag = NULL;
+    X->group = NULL;
+    X->group_stride = 0;
+    X->group_w = NULL;
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -440,6 +447,35 @@ static void viscous_band(const struct pair_ctx *X, const struct neighbours *NB, 
     }
 }
 
+/* The couplings of the pairs of i's two ranges summed by the group of their other end (see
+ * forces_viscous_group_couplings). */
+static void group_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P, size_t b0,
+                       size_t b1)
+{
+    (void)P;
+    const int32_t *group = X->group;
+    const long s = X->group_stride;
+    for (size_t i = b0; i < b1; i++) {
+        const int32_t gi = group[i];
+        if (gi < 0) continue;
+        double *gw = X->group_w + 5 * (size_t)gi;
+        const uint32_t *rng = NB->rng + 4 * i;
+        const double *wl = X->visc_w + X->fk_off[i];
+        for (int r = 0; r < 2; r++)
+            for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
+                const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+                for (size_t k = 0; k < m; k++) {
+                    const int32_t gj = group[jb + k];
+                    if (gj < 0) continue;
+                    const long d = (long)gj - (long)gi;
+                    const int slot = d == 0 ? 0 : d == 1 ? 1 : d == s - 1 ? 2 : d == s ? 3 : 4;
+                    gw[slot] += wl[k];
+                }
+                wl += FORCES_CHUNK;
+            }
+    }
+}
+
 FORCES_CLONES
 static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P, size_t b0,
                         size_t b1)
@@ -701,18 +737,25 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     return bad;
 }
 
+/* A pass context over the couplings the last implicit momentum pass stored; -1 without them. */
+static int stored_couplings(const struct forces *F, const struct pair_system *S, struct pair_ctx *X)
+{
+    if (!F->visc_valid) return -1;
+    pair_ctx_init(S, X);
+    X->visc_w = F->visc_w;
+    X->fk_off = F->fk_off;
+    return 0;
+}
+
 int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
                          double *out_x, double *out_z, double *diag)
 {
-    if (!F->visc_valid) return -1;
     struct pair_ctx X;
-    pair_ctx_init(S, &X);
+    if (stored_couplings(F, S, &X) != 0) return -1;
     const size_t n = active_count(S);
     memset(out_x, 0, n * sizeof(double));
     memset(out_z, 0, n * sizeof(double));
     if (diag) memset(diag, 0, n * sizeof(double));
-    X.visc_w = F->visc_w;
-    X.fk_off = F->fk_off;
     X.in_x = in_x;
     X.in_z = in_z;
     X.out_x = out_x;
@@ -720,6 +763,19 @@ int forces_viscous_apply(const struct forces *F, const struct pair_system *S, co
     X.out_diag = diag;
 #pragma omp parallel num_threads(S->n_threads)
     bands_in_team(S, viscous_band, &X, 1);
+    return 0;
+}
+
+int forces_viscous_group_couplings(const struct forces *F, const struct pair_system *S, const int32_t *group,
+                                   long groups_per_row, double *sums)
+{
+    struct pair_ctx X;
+    if (stored_couplings(F, S, &X) != 0) return -1;
+    X.group = group;
+    X.group_stride = groups_per_row;
+    X.group_w = sums;
+#pragma omp parallel num_threads(S->n_threads)
+    bands_in_team(S, group_band, &X, 1);
     return 0;
 }
 

@@ -6,12 +6,17 @@
 #ifndef MIXSPH_FORCES_H
 #define MIXSPH_FORCES_H
 #include <stddef.h>
+#include <stdint.h>
 
 #include "case.h"
 #include "cells.h"
 #include "kernel.h"
 #include "neighbours.h"
 #include "particles.h"
+
+/* Entries past the active rows that a per-particle array handed to a pass must hold, finite and
+ * neutral (the chunked pair loops read them with zero weight). */
+#define FORCES_PAD 16
 
 /* Constants of the pair terms. */
 struct forces_params {
@@ -77,6 +82,17 @@ int forces_momentum(struct forces *F, const struct pair_system *S);
  *  Returns -1 without a stored operator. */
 int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
                          double *out_x, double *out_z, double *diag);
+
+/** The couplings of the last implicit momentum pass summed between groups of particles (the
+ *  coarse grid of viscous_coarse.h). group[i] >= 0 numbers particle i's group on a grid
+ *  of groups_per_row groups per row, a group being whole cells of one cell row and at least kx
+ *  columns wide (cells.h), so that a pair of i's half stencil (its own row forward, the row
+ *  above) ends in i's group (slot 0), the next group of the row (slot 1) or one of the three
+ *  above (slots 2, 3, 4: offsets groups_per_row - 1, groups_per_row, groups_per_row + 1);
+ *  group[i] < 0 leaves i out. Adds w_ij of each such pair (once) to sums[5 group[i] + slot].
+ *  Returns -1 without a stored operator. */
+int forces_viscous_group_couplings(const struct forces *F, const struct pair_system *S, const int32_t *group,
+                                   long groups_per_row, double *sums);
 
 /** SPHERA's partial pressure smoothing with factor theta_P dt / h (docs/model.md section 3):
  *  pressures and densities of the non-wall particles relax toward their neighbours'. Returns -1

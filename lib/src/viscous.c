@@ -11,8 +11,10 @@
  * where (L v)_i = sum_j w_ij (v_i - v_j) is forces_viscous_apply and (s a v) fills the wall rows.
  * The mirror makes A non-symmetric (row i of a wall particle's neighbour sees the fluid around
  * that wall particle, not the reverse), so the solver is BiCGSTAB (van der Vorst 1992) with the
- * Jacobi diagonal m + dt sum_j w_ij as right preconditioner. The two velocity components share
- * A and are iterated together, each with its own scalars; the solve stops when
+ * Jacobi diagonal m + dt sum_j w_ij as right preconditioner, with the coarse correction of
+ * viscous_coarse.h added to it when numerics.viscous_preconditioner is "two_level". The two
+ * velocity components share A and are iterated together, each with its own scalars; the solve
+ * stops when
  * ||r_x||^2 + ||r_z||^2 <= tol^2 (||b_x||^2 + ||b_z||^2). */
 #include "viscous.h"
 
@@ -21,14 +23,12 @@
 #include <string.h>
 
 #include "mixsph.h"
+#include "viscous_coarse.h"
 
 /* Dot products are summed per block of this many particles, then over the blocks in order:
  * the same sums for any thread count. */
 #define VISCOUS_BLOCK 2048
 #define N_SUMS 6 /* partial sums per block */
-/* Rows past the active ones that the operator's pair loops may read (forces.c reads up to
- * FORCES_CHUNK - 1 = 7 elements past a range); kept zero. */
-#define VISCOUS_PAD 16
 
 /* The solver's vectors, per active particle (pairs: x and z components):
  *   U   the iterate u (unknown rows; junk on the others until the end)
@@ -47,9 +47,20 @@ struct viscous_solver {
     unsigned char *mobile;
     double *partial;          /* per block: N_SUMS partial sums */
     size_t cap, cap_blocks;
+    struct viscous_coarse *coarse; /* two_level: the coarse level, built once per step */
+    int preconditioner;            /* enum viscous_preconditioner of the current solve */
+    int coarse_built;              /* this step's coarse groups and couplings are in */
 };
 
-struct viscous_solver *viscous_create(void) { return calloc(1, sizeof(struct viscous_solver)); }
+struct viscous_solver *viscous_create(void)
+{
+    struct viscous_solver *V = calloc(1, sizeof(struct viscous_solver));
+    if (V && !(V->coarse = viscous_coarse_create())) {
+        free(V);
+        return NULL;
+    }
+    return V;
+}
 
 void viscous_free(struct viscous_solver *V)
 {
@@ -57,6 +68,7 @@ void viscous_free(struct viscous_solver *V)
     for (int k = 0; k < N_VEC; k++) free(V->v[k]);
     free(V->mobile);
     free(V->partial);
+    viscous_coarse_free(V->coarse);
     free(V);
 }
 
@@ -69,7 +81,7 @@ static int reserve(struct viscous_solver *V, size_t n)
         V->partial = q;
         V->cap_blocks = nb;
     }
-    if (V->cap >= n + VISCOUS_PAD) return 0;
+    if (V->cap >= n + FORCES_PAD) return 0;
     const size_t cap = n + n / 4 + 64;
     for (int k = 0; k < N_VEC; k++) {
         double *q = realloc(V->v[k], cap * sizeof(double));
@@ -268,6 +280,14 @@ static int setup(const struct solve_ctx *c)
     return 0;
 }
 
+/* v[out] += the coarse correction of v[in] (two_level; both components). */
+static void coarse_correct(const struct solve_ctx *c, int in, int out)
+{
+    struct viscous_solver *V = c->V;
+    if (V->preconditioner != VISCOUS_TWO_LEVEL) return;
+    viscous_coarse_correct(V->coarse, V->mobile, V->v[in], V->v[in + 1], V->v[out], V->v[out + 1], c->S->n_threads);
+}
+
 static double ratio(double a, double b) { return b != 0.0 ? a / b : 0.0; }
 
 /* BiCGSTAB from the set-up's u0, r0 (= r^_0), right-preconditioned by M^-1; per iteration two
@@ -305,6 +325,7 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
                 yz[i] = minv[i] * pz[i];
             }
         }
+        coarse_correct(c, PX, YX);
         if (apply_a(c, YX, VX, RHX, -1, d) != 0) return -1; /* v = A y, (r^, v) */
         for (int k = 0; k < 2; k++) alpha[k] = ratio(rho[k], d[k]);
         /* u += alpha y, s = r - alpha v, z = M^-1 s, (s, s) */
@@ -338,6 +359,7 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
             *r2 = d[0] + d[1];
             break;
         }
+        coarse_correct(c, SX, ZX);
         if (apply_a(c, ZX, TX, SX, -1, d) != 0) return -1; /* t = A z, (s, t), (t, t) */
         omega[0] = ratio(d[0], d[4]);
         omega[1] = ratio(d[1], d[5]);
@@ -378,6 +400,13 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
 static int stage(const struct solve_ctx *c, double tolerance, int max_iterations, struct viscous_report *report)
 {
     if (setup(c) != 0) return -1;
+    struct viscous_solver *V = c->V;
+    if (V->preconditioner == VISCOUS_TWO_LEVEL) {
+        /* the groups and couplings hold for the step; the coarse operator depends on kappa */
+        if (!V->coarse_built && viscous_coarse_build(V->coarse, c->F, c->S, V->mobile, c->n) != 0) return -1;
+        V->coarse_built = 1;
+        viscous_coarse_operator(V->coarse, V->v[MINV], V->mobile, c->dt, c->S->n_threads);
+    }
     double **v = c->V->v;
     double d[6];
     const int bb[1] = {BX};
@@ -438,12 +467,14 @@ static void load_velocities(const struct solve_ctx *c)
 }
 
 int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                  const struct wall_mirror *M, double dt, double tolerance, int max_iterations,
+                  const struct wall_mirror *M, double dt, int preconditioner, double tolerance, int max_iterations,
                   struct viscous_report *report)
 {
     const size_t n = S->C->start[S->C->ncell];
     *report = (struct viscous_report){.converged = 1};
     if (reserve(V, n) != 0) return -1;
+    V->preconditioner = preconditioner;
+    V->coarse_built = 0;
     const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = dt, .n = n};
     const struct particles *P = S->P;
     double **v = V->v;
@@ -478,6 +509,8 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     const size_t n = S->C->start[S->C->ncell];
     *report = (struct viscous_report){.converged = 1};
     if (reserve(V, n) != 0) return -1;
+    V->preconditioner = cfg->viscous_preconditioner;
+    V->coarse_built = 0;
     const double g = SDIRK_GAMMA;
     const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = g * dt, .n = n};
     const struct particles *P = S->P;

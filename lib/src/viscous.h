@@ -6,7 +6,8 @@
  * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
  * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
  * of a hold_fixed medium are prescribed. The system is solved matrix-free by BiCGSTAB with a
- * Jacobi preconditioner, each stage warm-started from its increments of the last two steps
+ * Jacobi or a two-level (Jacobi plus the coarse correction of viscous_coarse.h) preconditioner,
+ * each stage warm-started from its increments of the last two steps
  * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
  * thread count. */
 #ifndef MIXSPH_VISCOUS_H
@@ -17,6 +18,9 @@
 #include "walls.h"
 
 struct viscous_solver;
+
+/* numerics.viscous_preconditioner (the values of its case-file choices). */
+enum viscous_preconditioner { VISCOUS_JACOBI = 0, VISCOUS_TWO_LEVEL = 1 };
 
 /* The outcome of one solve. */
 struct viscous_report {
@@ -43,9 +47,10 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
 /** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
  *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
  *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
- *  built and timed by the caller (NULL: the walls keep uvx, uvz); tests of the solver. */
+ *  built and timed by the caller (NULL: the walls keep uvx, uvz) and the preconditioner of enum
+ *  viscous_preconditioner; tests of the solver. */
 int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                  const struct wall_mirror *M, double dt, double tolerance, int max_iterations,
+                  const struct wall_mirror *M, double dt, int preconditioner, double tolerance, int max_iterations,
                   struct viscous_report *report);
 
 #endif
