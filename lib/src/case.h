@@ -123,7 +123,6 @@ struct case_def {
     double lattice_z0;        /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
     int kernel;               /* enum kernel_type */
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
-    double tensile_correction; /* epsilon of Monaghan's (2000) artificial pressure under tension (0: off) */
     double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
                                  bed; < 0: off (the default) */
     int av_wall;              /* artificial viscosity between fluid and wall particles (default 1) */

@@ -95,10 +95,6 @@ static const struct case_key numerics_keys[] = {
     {.key = "pressure_smoothing", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0), .unit = "-",
      .field = CASE_FIELD(case_def, pressure_smoothing),
      .meaning = "θ_P of the partial pressure smoothing (below); 0: off"},
-    {.key = "tensile_correction", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0), .unit = "-",
-     .field = CASE_FIELD(case_def, tensile_correction),
-     .meaning = "ε of Monaghan's artificial pressure against the tensile instability (below): fluid particles "
-                "under tension, p < 0, repel by ε (|p_i⁻| + |p_j⁻|) (W_ij / W(dx))⁴ when close; 0: off"},
     {.key = "fixed_bed_speed", .type = CASE_NUMBER, RANGE(-1, 0, 100, 0), DEF(-1), .def_text = "-1 (off)",
      .unit = "m/s", .field = CASE_FIELD(case_def, fixed_bed_speed),
      .meaning = "the fixed bed (below): speed at or below which a grain counts as bed; negative: off"},

@@ -83,9 +83,6 @@ struct forces {
     double *visc_w;
     size_t visc_w_cap;
     int visc_valid;           /* visc_w holds the couplings at the current positions */
-    /* the artificial pressure under tension: each particle's tension p^- (fluids only, else 0) */
-    double *tension;
-    size_t tension_cap;
 };
 
 /* Constants of one pass of the pair loops. */
@@ -97,9 +94,6 @@ struct pair_ctx {
     double av_cap;   /* u_ij.x_ij is capped at this: 0 (approaching pairs only) or +inf (all pairs) */
     int wendland;
     int arithmetic_mean;  /* implicit viscosity with the pair viscosity (mu_i + mu_j) / 2 */
-    double tensile_eps;   /* the artificial pressure under tension: epsilon (0: off) */
-    double inv_w_dx;      /* and 1 / W(dx), the normalisation of its weight */
-    const double *tension; /* and each particle's tension (tension_fill) */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -124,9 +118,6 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->av_cap = fp->av_separating ? INFINITY : 0.0;
     X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
     X->arithmetic_mean = fp->arithmetic_mean;
-    X->tensile_eps = fp->tensile_eps;
-    X->inv_w_dx = fp->tensile_eps > 0.0 ? 1.0 / kernel_w(&fp->K, fp->tensile_dx) : 0.0;
-    X->tension = NULL;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -279,26 +270,18 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
  * i and subtracted from j (ax, az hold forces during the pass; forces_momentum divides by the
  * masses after it). With `implicit` the viscous force is left out and its coupling
  * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
- * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). With `tensile` the
- * pressure term carries Monaghan's (2000) artificial pressure (numerics.tensile_correction): a
- * fluid particle under tension, p < 0, adds eps |p| to the pair's pressure sum, weighted by
- * (W_ij / W(dx))^4, which is 1 at the lattice spacing and grows as a pair closes in. So a pair of
- * particles in tension, which the pressure term pulls together and which would clump (the
- * tensile instability of SPH, Swegle et al. 1995), repels once it is closer than about 0.7 dx
- * (with eps = 0.2 and the cubic spline at h = 1.3 dx), while pairs near the lattice spacing and
- * pairs at p >= 0 are not changed. The term is symmetric in i and j, so momentum stays conserved. */
+ * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). */
 enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double *axi, double *azi,
                                   const double *restrict fk, double *restrict wl, const int wendland,
-                                  const int cached, const int implicit, const int tensile)
+                                  const int cached, const int implicit)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
     const double ti = P->tag[i], avci = P->avc[i];
     const double walli = ti < 0.0 ? 1.0 : 0.0;
-    const double tension_i = tensile ? X->tension[i] : 0.0;
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
     const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
     const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
@@ -327,10 +310,6 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
             /* pressure */
             double fr = -vv * (pi + p[j]);
-            if (tensile) {
-                const double w = kernel_w_q(&Xl.K, sqrt(r2) * Xl.K.inv_h, wendland) * Xl.inv_w_dx;
-                fr -= vv * (1.0 - walli - wallj) * Xl.tensile_eps * (tension_i + Xl.tension[j]) * (w * w) * (w * w);
-            }
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
@@ -404,13 +383,12 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
-                                 const int tensile)
+                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit)
 {
     for (size_t i = b0; i < b1; i++) {
         double sx = 0.0, sz = 0.0;
         momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL,
-                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit, tensile);
+                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit);
         P->ax[i] += sx;
         P->az[i] += sz;
     }
@@ -532,24 +510,20 @@ FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    /* the artificial pressure as a constant too: off, the walk is the one without it */
-#define MOMENTUM_WALK(wendland, cached, mode)                                     \
-    (X->tensile_eps > 0.0 ? momentum_walk(X, NB, P, b0, b1, wendland, cached, mode, 1) \
-                          : momentum_walk(X, NB, P, b0, b1, wendland, cached, mode, 0))
     if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
         if (X->arithmetic_mean) {
-            if (X->wendland) MOMENTUM_WALK(1, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
-            else MOMENTUM_WALK(0, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
         } else {
-            if (X->wendland) MOMENTUM_WALK(1, 1, MOMENTUM_IMPLICIT_HARMONIC);
-            else MOMENTUM_WALK(0, 1, MOMENTUM_IMPLICIT_HARMONIC);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC);
         }
         return;
     }
-#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) MOMENTUM_WALK(wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY)
+#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
+    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY)
     FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
 #undef MOMENTUM_EXPLICIT
-#undef MOMENTUM_WALK
 }
 
 struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
@@ -563,7 +537,6 @@ void forces_free(struct forces *F)
     free(F->smooth_sum);
     free(F->smooth_weight);
     free(F->visc_w);
-    free(F->tension);
     free(F);
 }
 
@@ -721,21 +694,6 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
             gradient_particle(&X, S->G, P, out, i);
 }
 
-/* The tension p^- = max(-p, 0) of the fluid particles among the first n (grains and walls 0),
- * then FORCES_CHUNK zeros for the chunked loops' reads past a range. Grains are left out: they
- * carry their own treatment of tension (media.<m>.tension_cutoff), and with them in, the Vajont
- * run at dx = 0.005 failed where the plate pushes grains together (docs/validation/vajont.md). */
-static void tension_fill(const struct pair_system *S, double *tension, size_t n)
-{
-    const struct particles *P = S->P;
-    const struct medium *M = S->media;
-    for (size_t i = 0; i < n; i++)
-        tension[i] = P->state[i] != MIXSPH_STATE_WALL && M[P->medium[i]].kind == MEDIUM_FLUID && P->p[i] < 0.0
-                         ? -P->p[i]
-                         : 0.0;
-    memset(tension + n, 0, FORCES_CHUNK * sizeof(double));
-}
-
 int forces_momentum(struct forces *F, const struct pair_system *S)
 {
     struct particles *P = S->P;
@@ -763,17 +721,6 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         X.fk_off = F->fk_off;
     }
     F->fk_valid = 0;
-    if (X.tensile_eps > 0.0) {
-        if (F->tension_cap < n + FORCES_CHUNK) {
-            const size_t cap = n + n / 4 + FORCES_CHUNK;
-            double *t = realloc(F->tension, cap * sizeof *t);
-            if (!t) return -1;
-            F->tension = t;
-            F->tension_cap = cap;
-        }
-        tension_fill(S, F->tension, n);
-        X.tension = F->tension;
-    }
     const double g = X.g;
     int bad = 0;
 #pragma omp parallel num_threads(S->n_threads)
@@ -845,20 +792,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    double *tension = NULL;
-    if (X.tensile_eps > 0.0) {
-        const size_t n = (i > j ? i : j) + 1;
-        tension = malloc((n + FORCES_CHUNK) * sizeof *tension);
-        if (!tension) {
-            free(count);
-            *ax = *az = *drho = NAN;
-            return;
-        }
-        tension_fill(S, tension, n);
-        X.tension = tension;
-    }
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY,
-                   X.tensile_eps > 0.0);
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
@@ -867,7 +801,6 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     *drho = P->rho[i] * di;
     P->drho[j] = save[2];
     free(count);
-    free(tension);
 }
 
 /* The partial pressure smoothing of SPHERA (numerics.pressure_smoothing = theta_P > 0; Di Monaco

@@ -26,8 +26,6 @@ struct forces_params {
     int av_wall;        /* artificial viscosity between particles and walls */
     int av_mixed;       /* ... between particles of different media too */
     int av_separating;  /* ... for separating pairs too */
-    double tensile_eps;  /* epsilon of the artificial pressure under tension (0: off; forces.c) */
-    double tensile_dx;   /* the spacing dx at which its weight (W_ij / W(dx))^4 is 1 [m] */
     int implicit_viscosity; /* the momentum pass leaves the viscous term out and stores its
                                couplings for forces_viscous_apply (docs/numerics.md) */
     int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */

@@ -151,8 +151,6 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.params.av_wall = s->cfg.av_wall;
     S.params.av_mixed = s->cfg.av_mixed;
     S.params.av_separating = s->cfg.av_separating;
-    S.params.tensile_eps = s->cfg.tensile_correction;
-    S.params.tensile_dx = s->dx;
     S.params.implicit_viscosity = s->cfg.viscosity_implicit;
     S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
     S.n_threads = SIM_THREADS(s);
