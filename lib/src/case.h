@@ -120,6 +120,7 @@ struct case_def {
     double cfl, cfl_visc;     /* time-step coefficients of (4) */
     double t_end;             /* [s] */
     int wall_layers;          /* layers of wall particles behind each wall */
+    int wall_placement;       /* numerics.wall_placement: enum wall_placement of walls.h */
     double lattice_z0;        /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
     int kernel;               /* enum kernel_type */
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */

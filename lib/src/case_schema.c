@@ -31,6 +31,7 @@
 /* ---- choices -------------------------------------------------------------------------------- */
 
 static const struct case_choice kernels[] = {{"cubic_spline", 0}, {"wendland_c2", 1}, {NULL, 0}};
+static const struct case_choice wall_placements[] = {{"lattice", 0}, {"aligned", 1}, {NULL, 0}};
 static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
 static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
@@ -86,6 +87,10 @@ static const struct case_key numerics_keys[] = {
     {.key = "wall_layers", .type = CASE_INTEGER, RANGE(1, 0, 8, 0), DEF(3), .unit = "-",
      .field = CASE_FIELD(case_def, wall_layers),
      .meaning = "layers of wall particles behind each wall; at least ⌈2 h_over_dx⌉, to cover the kernel support 2h"},
+    {.key = "wall_placement", .type = CASE_CHOICE, DEF(0), .choices = wall_placements, .numeric_choice = 1,
+     .field = CASE_FIELD(case_def, wall_placement),
+     .meaning = "where wall particles sit: lattice (the sites of the bodies' lattice behind each wall) or aligned "
+                "(rows parallel to each segment at (l + 1/2) dx behind it, fans at the walls' inner corners; below)"},
     {.key = "kernel", .type = CASE_CHOICE, DEF(0), .choices = kernels, .field = CASE_FIELD(case_def, kernel),
      .meaning = "SPH kernel, support 2h (cubic_spline: the cubic B-spline)"},
     {.key = "background_pressure", .type = CASE_NUMBER, RANGE(0, 0, 1e9, 0), DEF(0), .unit = "Pa",

@@ -1,7 +1,7 @@
 /* walls.c - walls from polylines (docs/model.md section 8).
  *
- * Treatment: layers of dummy wall particles behind each polyline, on the global lattice
- * (i + 1/2) dx, as deep as the kernel support; their pressure is extrapolated from the fluid
+ * Treatment: layers of dummy wall particles behind each polyline, as deep as the kernel support,
+ * on the global lattice (i + 1/2) dx or in rows aligned with each segment (numerics.wall_placement); their pressure is extrapolated from the fluid
  * (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
  *     p_w = [ sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf ] / sum_f W_wf
  * clamped at 0 (no suction at walls), and their velocity in viscous terms is the no-slip mirror
@@ -59,9 +59,152 @@ void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, si
     }
 }
 
+/* Whether (x, z) lies behind a fixed wall before w, within the layers' depth: among fixed walls a
+ * site is filled once (a site behind two walls). */
+static int behind_earlier_fixed_wall(const struct case_def *cfg, size_t w, double x, double z, double depth)
+{
+    if (cfg->walls[w].motion >= 0) return 0;
+    for (size_t v = 0; v < w; v++) {
+        if (cfg->walls[v].motion >= 0) continue;
+        int at_end = 0;
+        const double d = geom_signed_distance(&cfg->walls[v].line, cfg->walls[v].side, x, z, &at_end);
+        if (!at_end && d < 0.0 && d >= -depth) return 1;
+    }
+    return 0;
+}
+
+/* Append one wall particle of wall w at (x, z) with volume vol: its index, or -1 out of memory. */
+static long push_wall_particle(const struct wall_state *ws, size_t w, double x, double z, double vol,
+                               struct particles *P)
+{
+    const size_t j = particles_push(P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
+    if (j == (size_t)-1) return -1;
+    P->vol[j] = vol;
+    P->m[j] = 0.0;
+    P->vx[j] = P->uvx[j] = ws[w].vx;
+    P->vz[j] = P->uvz[j] = ws[w].vz;
+    return (long)j;
+}
+
+/* Segment k of a polyline: its start (ax, az), unit tangent (tx, tz), fluid-side unit normal
+ * (nx, nz) and length. */
+struct segment {
+    double ax, az, tx, tz, nx, nz, len;
+    int side; /* the wall's fluid side, +1 left of the direction of travel, -1 right */
+};
+
+static struct segment segment_of(const struct wall *wl, size_t k)
+{
+    struct segment g;
+    g.ax = wl->line.x[k];
+    g.az = wl->line.z[k];
+    const double ex = wl->line.x[k + 1] - g.ax, ez = wl->line.z[k + 1] - g.az;
+    g.len = hypot(ex, ez);
+    g.tx = ex / g.len;
+    g.tz = ez / g.len;
+    g.nx = -g.tz * wl->side;
+    g.nz = g.tx * wl->side;
+    g.side = wl->side;
+    return g;
+}
+
+/* Does the wall turn toward its fluid side from segment a to the next, b? Then the solid's angle
+ * at their vertex exceeds 180 degrees (the bottom of a valley) and the rows behind the two
+ * segments leave a fan-shaped gap there; otherwise (an edge) they overlap. */
+static int turns_toward_fluid(const struct segment *a, const struct segment *b)
+{
+    return (a->tx * b->tz - a->tz * b->tx) * a->side > 0.0;
+}
+
+/* At an edge shared with segment o, a row particle (x, z) at `depth` behind its own segment is
+ * left to o's rows when it also lies behind o, within o's span, at a smaller depth: the overlap
+ * of the two strips is split along the bisector. */
+static int owned_by_other(const struct segment *o, double x, double z, double depth)
+{
+    const double rx = x - o->ax, rz = z - o->az;
+    const double behind = -(rx * o->nx + rz * o->nz), along = rx * o->tx + rz * o->tz;
+    return behind > 0.0 && behind < depth && along >= 0.0 && along <= o->len;
+}
+
+/* Whether a wall particle of wall w from index `first` on lies within dist of (x, z): at an edge the
+ * bisector split can leave two particles of the two strips nearly on top of each other. */
+static int near_placed(const struct particles *P, size_t first, double x, double z, double dist)
+{
+    for (size_t j = first; j < P->n; j++)
+        if ((P->x[j] - x) * (P->x[j] - x) + (P->z[j] - z) * (P->z[j] - z) < dist * dist) return 1;
+    return 0;
+}
+
+/* Aligned placement: on every segment, wall_layers rows at (l + 1/2) dx behind it, with
+ * N = max(1, round(L / dx)) particles each at (m + 1/2) L / N along it (volume L / N x dx); at
+ * an edge the strips' overlap is split along the bisector (and of two particles closer than
+ * dx / 2 there, the second is dropped); at the bottom of a valley the gap is
+ * filled by a fan: rings at radius (l + 1/2) dx with round(theta r / dx) particles each. So the
+ * first row is dx/2 behind the wall line everywhere, as on a wall along the lattice, and a wall
+ * at an angle to the lattice is not a staircase. */
+static long walls_generate_aligned(const struct case_def *cfg, const struct wall_state *ws, double dx,
+                                   const mixsph_interrupt *interrupt, struct particles *P)
+{
+    const double depth = cfg->wall_layers * dx;
+    long added = 0;
+    for (size_t w = 0; w < cfg->n_walls; w++) {
+        const struct wall *wl = &cfg->walls[w];
+        const size_t nseg = wl->line.n - 1, first = P->n;
+        for (size_t k = 0; k < nseg; k++) {
+            if (interrupt && interrupt->requested && interrupt->requested(interrupt->user)) return WALLS_INTERRUPTED;
+            const struct segment g = segment_of(wl, k);
+            const struct segment prev = k > 0 ? segment_of(wl, k - 1) : g;
+            const int has_next = k + 1 < nseg;
+            const struct segment next = has_next ? segment_of(wl, k + 1) : g;
+            const int edge_before = k > 0 && !turns_toward_fluid(&prev, &g);
+            const int edge_after = has_next && !turns_toward_fluid(&g, &next);
+            const long n_along = lround(g.len / dx) > 1 ? lround(g.len / dx) : 1;
+            const double ds = g.len / (double)n_along;
+            for (int l = 0; l < cfg->wall_layers; l++) {
+                const double d = (l + 0.5) * dx;
+                for (long m = 0; m < n_along; m++) {
+                    const double s = (m + 0.5) * ds;
+                    const double x = g.ax + s * g.tx - d * g.nx, z = g.az + s * g.tz - d * g.nz;
+                    if (edge_before && owned_by_other(&prev, x, z, d)) continue;
+                    if (edge_after && owned_by_other(&next, x, z, d)) continue;
+                    const int at_edge = (edge_before && s < depth + dx) || (edge_after && s > g.len - depth - dx);
+                    if (at_edge && near_placed(P, first, x, z, 0.5 * dx)) continue;
+                    if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                    if (push_wall_particle(ws, w, x, z, ds * dx, P) < 0) return -1;
+                    added++;
+                }
+            }
+            if (!has_next || edge_after) continue;
+            /* the fan at the valley's vertex, from -n of this segment to -n of the next */
+            const double vx = next.ax, vz = next.az;
+            const double c = g.nx * next.nx + g.nz * next.nz;
+            const double theta = acos(c < -1.0 ? -1.0 : c > 1.0 ? 1.0 : c);
+            double ux = -next.nx - c * -g.nx, uz = -next.nz - c * -g.nz; /* -n_next minus its part along -n */
+            const double un = hypot(ux, uz);
+            if (!(un > 0.0)) continue;
+            ux /= un;
+            uz /= un;
+            for (int l = 0; l < cfg->wall_layers; l++) {
+                const double r = (l + 0.5) * dx;
+                const long n_arc = lround(theta * r / dx);
+                for (long j = 0; j < n_arc; j++) {
+                    const double phi = (j + 0.5) * theta / (double)n_arc;
+                    const double x = vx + r * (cos(phi) * -g.nx + sin(phi) * ux);
+                    const double z = vz + r * (cos(phi) * -g.nz + sin(phi) * uz);
+                    if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                    if (push_wall_particle(ws, w, x, z, theta * r / (double)n_arc * dx, P) < 0) return -1;
+                    added++;
+                }
+            }
+        }
+    }
+    return added;
+}
+
 long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P)
 {
+    if (cfg->wall_placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(cfg, ws, dx, interrupt, P);
     const double depth = cfg->wall_layers * dx, z_off = geom_lattice_z_offset(cfg->lattice_z0, dx);
     long added = 0;
     for (size_t w = 0; w < cfg->n_walls; w++) {
@@ -82,21 +225,8 @@ long walls_generate(const struct case_def *cfg, const struct wall_state *ws, dou
                 int at_end = 0;
                 const double d = geom_signed_distance(&wl->line, wl->side, x, z, &at_end);
                 if (at_end || d >= 0.0 || d < -depth) continue;
-                /* one particle per lattice site among fixed walls (a site behind two walls) */
-                int dup = 0;
-                for (size_t v = 0; v < w && !dup && wl->motion < 0; v++) {
-                    if (cfg->walls[v].motion >= 0) continue;
-                    int e2 = 0;
-                    const double d2 = geom_signed_distance(&cfg->walls[v].line, cfg->walls[v].side, x, z, &e2);
-                    dup = !e2 && d2 < 0.0 && d2 >= -depth;
-                }
-                if (dup) continue;
-                const size_t j = particles_push(P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
-                if (j == (size_t)-1) return -1;
-                P->vol[j] = dx * dx;
-                P->m[j] = 0.0;
-                P->vx[j] = P->uvx[j] = ws[w].vx;
-                P->vz[j] = P->uvz[j] = ws[w].vz;
+                if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                if (push_wall_particle(ws, w, x, z, dx * dx, P) < 0) return -1;
                 added++;
             }
         }

@@ -31,9 +31,15 @@ void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, si
 
 #define WALLS_INTERRUPTED (-2L)
 
+/* numerics.wall_placement: where the wall particles sit (docs/model.md section 8). */
+enum wall_placement {
+    WALL_PLACEMENT_LATTICE = 0, /* the sites of the global lattice behind each wall */
+    WALL_PLACEMENT_ALIGNED = 1  /* rows parallel to each segment, fans at inner corners */
+};
+
 /** Append the wall particles of every wall of the case at spacing dx (cfg->wall_layers layers
- *  deep, on the global lattice); their `medium` field holds their wall's index and they start
- *  with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row. Returns the
+ *  deep, placed as cfg->wall_placement says); their `medium` field holds their wall's index and
+ *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row. Returns the
  *  number added, -1 when out of memory, WALLS_INTERRUPTED when the host asked to stop. */
 long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
