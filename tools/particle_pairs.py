@@ -21,15 +21,13 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from mixsph_tools.readers import ToolError, list_snapshots, read_snapshot  # noqa: E402
-
-WALL = 2
+from mixsph_tools.readers import STATE_WALL, ToolError, list_snapshots, read_snapshot  # noqa: E402
 
 
 def close_pairs(cols, distance):
     """(pairs closer than distance, of them medium 0 with medium 0, smallest distance) among the
     non-wall particles of one snapshot."""
-    keep = cols["state"] != WALL
+    keep = cols["state"] != STATE_WALL
     xz = np.column_stack([cols["x"][keep], cols["z"][keep]])
     medium = cols["medium"][keep]
     tree = cKDTree(xz)
