@@ -137,12 +137,12 @@ static void test_block_at_slope_aligned(void **state)
 
 /* A wall with an edge (0.3, 0.4) and a valley (0.45, 0.1), at an angle to the lattice between
  * them; water above. */
-static const char *const STEP_FMT =
+static const char *const STEP_CASE =
     "{\n"
     "  \"name\": \"step\",\n"
     "  \"gravity\": 9.81,\n"
     "  \"numerics\": { \"dx\": 0.01, \"h_over_dx\": 1.3, \"t_end\": 0.1, \"wall_layers\": 3, "
-    "\"wall_placement\": \"%s\" },\n"
+    "\"wall_placement\": \"aligned\" },\n"
     "  \"media\": { \"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 50.0, \"mu\": 1.0e-3 } },\n"
     "  \"bodies\": { \"pool\": { \"medium\": \"water\", \"polygon\": [[0.5, 0.1], [0.9, 0.1], [0.9, 0.3], [0.5, 0.3]] } },\n"
     "  \"walls\": { \"step\": { \"polyline\": [[0.0, 0.4], [0.3, 0.4], [0.45, 0.1], [0.9, 0.1]], "
@@ -155,9 +155,7 @@ static const char *const STEP_FMT =
 static void test_aligned_placement(void **state)
 {
     (void)state;
-    char text[4096];
-    snprintf(text, sizeof text, STEP_FMT, "aligned");
-    mixsph_sim *s = create_text(text, "step.json");
+    mixsph_sim *s = create_text(STEP_CASE, "step.json");
     const struct particles *P = &s->P;
     const struct wall *wl = &s->cfg.walls[0];
     const double dx = s->dx, depth = s->cfg.wall_layers * dx;

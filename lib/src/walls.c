@@ -1,8 +1,8 @@
 /* walls.c - walls from polylines (docs/model.md section 8).
  *
  * Treatment: layers of dummy wall particles behind each polyline, as deep as the kernel support,
- * on the global lattice (i + 1/2) dx or in rows aligned with each segment (numerics.wall_placement); their pressure is extrapolated from the fluid
- * (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
+ * on the global lattice (i + 1/2) dx or in rows aligned with each segment (numerics.wall_placement);
+ * their pressure is extrapolated from the fluid (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
  *     p_w = [ sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf ] / sum_f W_wf
  * clamped at 0 (no suction at walls), and their velocity in viscous terms is the no-slip mirror
  * 2 v_wall - v~ (v~ the kernel average of the fluid velocity) or v~ for free slip; their density

@@ -39,8 +39,9 @@ enum wall_placement {
 
 /** Append the wall particles of every wall of the case at spacing dx (cfg->wall_layers layers
  *  deep, placed as cfg->wall_placement says); their `medium` field holds their wall's index and
- *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row. Returns the
- *  number added, -1 when out of memory, WALLS_INTERRUPTED when the host asked to stop. */
+ *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row,
+ *  or every segment when aligned. Returns the number added, -1 when out of memory,
+ *  WALLS_INTERRUPTED when the host asked to stop. */
 long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
 
