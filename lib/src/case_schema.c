@@ -221,8 +221,8 @@ static const struct case_key wall_keys[] = {
      .field = CASE_FIELD(wall, line), .meaning = "the wall, an open polyline; consecutive points differ"},
     {.key = "fluid_side", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = sides,
      .field = CASE_FIELD(wall, side), .meaning = "the side of the fluid, seen along the polyline's direction of travel"},
-    {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .field = CASE_FIELD(wall, slip),
-     .meaning = "the condition on the tangential velocity"},
+    {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .numeric_choice = 1,
+     .field = CASE_FIELD(wall, slip), .meaning = "the condition on the tangential velocity"},
     {.key = "motion", .type = CASE_NAME, .def_text = "fixed", .meaning = "name of one of the motions"},
 };
 
