@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Count particles that have clumped into pairs, per snapshot of a mixsph run: the pairs of
 non-wall particles closer than a fraction of the spacing dx (default dx / 4). On a healthy run
-the particles keep about dx apart; pairs far closer than that are the tensile instability of SPH
-(particles under negative pressure pulling together), the diagnosis of docs/validation/vajont.md.
+the particles keep about dx apart; pairs far closer than that show where particles are pressed
+together, on Vajont where walls clip them (the diagnosis of docs/validation/vajont.md).
 
     .venv/bin/python tools/particle_pairs.py RUN [--dx D] [--fraction F] [--every T]
 
