@@ -2,6 +2,7 @@
 
     mixsph-validate vajont --runs 1,2,4 --dx 0.01     # tools/vajont_validate.py, docs/validation/vajont.md
     mixsph-validate erosive --runs 2,6 --jobs 2       # tools/erosive_dambreak.py, docs/validation/erosive_dambreak.md
+    mixsph-validate erosive-ensemble --group explicit DIR... --group implicit DIR...   # tools/erosive_ensemble.py
     mixsph-validate column --runs 1,2,3 --jobs 2      # tools/column_collapse.py, docs/validation/granular.md
     mixsph-validate convergence --set numerics.viscosity=1   # tools/vajont_convergence.py, docs/validation/vajont.md
 
@@ -14,6 +15,8 @@ import sys
 CASES = {
     "vajont": ("vajont_validate", "the Vajont runs V1-V6 of Manenti et al. (2018), Tables 4-5"),
     "erosive": ("erosive_dambreak", "the erosive dam break Runs 1-7 of Manenti et al. (2018), Tables 1-2"),
+    "erosive-ensemble": ("erosive_ensemble", "ensembles of erosive dam break runs: a scheme's difference "
+                         "against its runs' drift under a round-off-size perturbation"),
     "column": ("column_collapse", "a dry granular column collapse: does the deposit come to rest?"),
     "convergence": ("vajont_convergence", "Vajont V1 against the particle spacing, and the cheapest spacing "
                     "within a tolerance of the finest"),
@@ -22,7 +25,7 @@ CASES = {
 
 def usage():
     return "usage: mixsph-validate CASE [OPTIONS]   (mixsph-validate CASE --help)\n\ncases:\n" + "".join(
-        f"  {name:8s}  {what}\n" for name, (_, what) in CASES.items())
+        f"  {name:16s}  {what}\n" for name, (_, what) in CASES.items())
 
 
 def main(argv=None):
