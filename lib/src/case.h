@@ -133,6 +133,8 @@ struct case_def {
                                  1 "implicit" (viscous.h: SDIRK2, no viscous dt bound) */
     int viscosity_arithmetic; /* numerics.viscosity_mean: 0 "harmonic" (model.md [V]), 1 "arithmetic"
                                  (implicit only) */
+    int held_grains_rigid;    /* numerics.held_grains: 0 "solved" (unknowns of the implicit viscous solve),
+                                 1 "rigid" (prescribed at rest in it, judged on one explicit step's kick) */
     double viscous_tolerance; /* implicit: relative residual at which the solve stops [-] */
     int viscous_max_iterations; /* implicit: iteration budget of one solve */
     int viscous_preconditioner; /* implicit: numerics.viscous_preconditioner, 0 "jacobi", 1 "two_level"

@@ -35,6 +35,7 @@ static const struct case_choice wall_placements[] = {{"lattice", 0}, {"aligned",
 static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
 static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
+static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
 static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
@@ -118,6 +119,11 @@ static const struct case_key numerics_keys[] = {
      .meaning = "the pair viscosity of the laminar term between particles of different viscosities: harmonic, "
                 "2 mu_i mu_j / (mu_i + mu_j), or arithmetic, (mu_i + mu_j) / 2 (Morris et al. 1997; implicit "
                 "viscosity only)"},
+    {.key = "held_grains", .type = CASE_CHOICE, DEF(0), .choices = held_grain_modes, .numeric_choice = 1,
+     .field = CASE_FIELD(case_def, held_grains_rigid),
+     .meaning = "implicit viscosity: grains held fixed are unknowns of the viscous solve (solved) or prescribed "
+                "at rest in it and judged on the velocity one explicit time step of their forces gives them "
+                "(rigid, as the explicit scheme judges them)"},
     {.key = "viscous_tolerance", .type = CASE_NUMBER, RANGE(0, 1, 1e-2, 0), DEF(1e-6), .unit = "-",
      .field = CASE_FIELD(case_def, viscous_tolerance),
      .meaning = "implicit viscosity: relative residual ‖b − A u‖ / ‖b‖ at which a solve stops"},

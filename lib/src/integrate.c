@@ -176,18 +176,37 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
     return 0;
 }
 
-/* v += dt a of the particles that take kicks (not walls, lost particles or grains held fixed
- * with hold_fixed). */
+/* v += dt a of the particles that take kicks (not walls, lost particles, grains held fixed with
+ * hold_fixed or, in the implicit scheme, rigid ones: those stay at rest through the viscous step). */
 static void kick_velocities(mixsph_sim *s, double dt)
 {
     struct particles *P = &s->P;
+    const int rigid = s->cfg.viscosity_implicit && s->cfg.held_grains_rigid;
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed) continue;
+        if (P->state[i] == MIXSPH_STATE_FIXED && (rigid || s->cfg.media[P->medium[i]].hold_fixed)) continue;
         P->vx[i] += dt * P->ax[i];
         P->vz[i] += dt * P->az[i];
     }
+}
+
+/* The time step the explicit scheme would take from the current state, at most dt: the kick over
+ * which the implicit scheme judges rigid held grains. The regime decision (docs/model.md section
+ * 6) judges a held grain on the velocity one step of its forces gives it, which grows with the
+ * step; over the implicit step, up to hundreds of times the explicit one, grains whose forces
+ * nearly balance would be released that the model holds. */
+static double held_grain_judge_dt(const mixsph_sim *s, double dt)
+{
+    const struct particles *P = &s->P;
+    double dt_explicit = dt;
+#pragma omp parallel for schedule(static) reduction(min : dt_explicit) num_threads(SIM_THREADS(s))
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        const double d = particle_time_step(s, i, 0);
+        if (d < dt_explicit) dt_explicit = d;
+    }
+    return dt_explicit;
 }
 
 /* The implicit viscous step over dt with the operator of the last momentum pass (at the current
@@ -197,8 +216,8 @@ static void kick_velocities(mixsph_sim *s, double dt)
  * one at which the viscous and the other forces balance (a half kick before the drift, as in the
  * explicit leapfrog, would move them with an unbalanced half kick of the other forces: 2.4 % of
  * the lid speed in the lid-driven channel at 20 times the explicit viscous time step). A solve
- * that misses its tolerance stops the run. */
-static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt)
+ * that misses its tolerance stops the run. judge_dt: the kick of rigid held grains (viscous.h). */
+static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judge_dt)
 {
     if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const struct pair_system S = sim_pair_system(s);
@@ -210,7 +229,7 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     struct viscous_report *rep = &s->viscous_last;
     const double t0 = sim_clock_s();
-    const int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->cfg, s->walls, s->t, dt,
+    const int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->cfg, s->walls, s->t, dt, judge_dt,
                                     s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, rep);
     s->viscous_wall_s += sim_clock_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
@@ -253,8 +272,10 @@ mixsph_status integrate_step(mixsph_sim *s)
     }
     const int implicit = s->cfg.viscosity_implicit;
     if (implicit) { /* kick with the other forces over the whole step, then the viscous step */
+        /* from the state before the kick, as the explicit scheme's step would be; 0: none held */
+        const double judge_dt = s->cfg.held_grains_rigid && s->n_fixed > 0 ? held_grain_judge_dt(s, dt) : 0.0;
         kick_velocities(s, dt);
-        const mixsph_status st = implicit_viscous_step(s, dt);
+        const mixsph_status st = implicit_viscous_step(s, dt, judge_dt);
         if (st != MIXSPH_OK) return st;
     }
     walls_move(&s->cfg, s->walls, P, s->t, dt);

@@ -5,7 +5,7 @@
  *     m_i u_i + kappa sum_j w_ij (u_i - u_j) = m_i w_i        for the unknown particles i,
  * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
  * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
- * of a hold_fixed medium are prescribed. The system is solved matrix-free by BiCGSTAB with a
+ * are prescribed at rest when numerics.held_grains is "rigid" or their medium hold_fixed. The system is solved matrix-free by BiCGSTAB with a
  * Jacobi or a two-level (Jacobi plus the coarse correction of viscous_coarse.h) preconditioner,
  * each stage warm-started from its increments of the last two steps
  * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
@@ -38,11 +38,14 @@ void viscous_free(struct viscous_solver *V);
  *  from its increments of the last two steps. Updates P->vx, P->vz, the increments
  *  (visc_dv*, visc_d1* and those of the step before) and the wall particles' uvx, uvz. The
  *  report sums the two stages' iterations and keeps the larger residual. Stops a stage at
- *  ||r|| <= tolerance ||b|| or after max_iterations. Returns -1 when out of memory, 0 otherwise
- *  (convergence is in the report). */
+ *  ||r|| <= tolerance ||b|| or after max_iterations. With rigid held grains (cfg->held_grains_rigid)
+ *  these are prescribed at rest and then, if judge_dt > 0, get the velocity one explicit step of
+ *  judge_dt of their forces gives them (the other forces' P->ax, P->az and the viscous force of the
+ *  solved field), on which the regime decision judges them. Returns -1 when out of memory, 0 otherwise (convergence
+ *  is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
-                 double tolerance, int max_iterations, struct viscous_report *report);
+                 double judge_dt, double tolerance, int max_iterations, struct viscous_report *report);
 
 /** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
  *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
