@@ -326,7 +326,10 @@ static void test_heap_implicit_vajont(void **state)
 /* The same heap with rigid held grains (numerics.held_grains = "rigid"): prescribed at rest in the
  * viscous solve and judged on the velocity one explicit time step of their forces gives them, as
  * the explicit scheme judges them. Measured: all 186 grains held to 1 s, none moved; the explicit
- * scheme at its own time step (9.1e-8 s) holds all 186 too, fastest speed 2.8e-7 m/s over 0.6 s. */
+ * scheme at its own time step (9.1e-8 s) holds all 186 too, fastest speed 2.8e-7 m/s over 0.6 s.
+ * Held grains are not drifted, so what this test checks is the release rule: that it releases no
+ * grain of a heap below phi. The two column tests below check that it does release grains where
+ * the explicit rule does (mu0 = 5 kPa s), and not where it does not (mu0 off). */
 static void test_heap_implicit_vajont_rigid(void **state)
 {
     (void)state;
@@ -357,8 +360,9 @@ static void test_heap_implicit_vajont_arithmetic(void **state)
  * dependence on mu0 (docs/model.md section 6: a grain at the free face of a body at rest is
  * released when sin(phi) / (4 CFL_vis) min(mu0, mu_thr) / mu_thr < 1, in order of magnitude: 0.045
  * with the Vajont mu0 = 5 kPa s, 2.9 with mu0 off). On cases/column_collapse.json at dx = 0.0125
- * (256 grains) to t = 0.3 s (2.1 collapse times sqrt(H0 / g)), implicit, held grains rigid; *front
- * receives the front's advance [m], the return value the fewest grains held at a 0.01 s sample. */
+ * (256 grains) to t = 0.3 s (2.1 collapse times sqrt(H0 / g)), implicit, held grains rigid;
+ * *advance_m receives the front's advance [m], the return value the fewest grains held at a 0.01 s
+ * sample. */
 static size_t rigid_column(double mu0, double *advance_m)
 {
     const mixsph_override ov[] = {{"numerics.dx", 0.0125},      {"numerics.viscosity", 1.0},

@@ -15,7 +15,9 @@
  * gets forces and the kicks, is not drifted, and enters dt with the viscosity it will have once
  * mobile (integrate_time_step; docs/model.md section 6); with the
  * medium option hold_fixed it gets no kicks either (SPHERA's momentum routine), so its velocity
- * stays 0. With numerics.pressure_smoothing > 0 the pressures are smoothed (forces.c) right
+ * stays 0; with the implicit scheme's rigid held grains (numerics.held_grains) it gets no kick and
+ * stays at rest through the viscous step, then the velocity of one explicit step of its forces
+ * (viscous.h). With numerics.pressure_smoothing > 0 the pressures are smoothed (forces.c) right
  * after the equation of state, before the regime decision reads them.
  * Evaluating both rates in one pass from the same old state would be explicit Euler for the
  * acoustic modes, which grow without bound (found the hard way: the hydrostatic tank blew up).
@@ -23,6 +25,7 @@
  * them has moved skin/2 since the last build or left the grid (neighbours.h). */
 #include <math.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "integrate.h"
 
@@ -221,9 +224,23 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
 {
     if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const struct pair_system S = sim_pair_system(s);
-    if (!forces_viscous_ready(s->forces)) { /* a restored state: the couplings at its positions */
-        if (integrate_density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0)
-            return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
+    if (!forces_viscous_ready(s->forces)) {
+        /* a restored state: the couplings at its positions; the momentum pass also rewrites the
+         * accelerations from the kicked velocities, and rigid held grains are judged on the
+         * restored ones, so those are kept */
+        const size_t bytes = s->P.n * sizeof(double);
+        double *ax = malloc(bytes ? bytes : 1), *az = malloc(bytes ? bytes : 1);
+        int bad = !ax || !az;
+        if (!bad) {
+            memcpy(ax, s->P.ax, bytes);
+            memcpy(az, s->P.az, bytes);
+            bad = integrate_density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0;
+            memcpy(s->P.ax, ax, bytes);
+            memcpy(s->P.az, az, bytes);
+        }
+        free(ax);
+        free(az);
+        if (bad) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     }
     if (!s->wall_mirror && !(s->wall_mirror = walls_mirror_create()))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
