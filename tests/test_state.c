@@ -59,6 +59,21 @@ static int same(const mixsph_sim *a, const mixsph_sim *b)
     return 1;
 }
 
+/* A simulation created from the state alone, on the given threads, and run to t2 equals ref bit for
+ * bit, and names the case file it came from. */
+static void created_from_state_continues(const void *buf, size_t len, const mixsph_sim *ref, double t2, int threads,
+                                         const char *origin)
+{
+    mixsph_sim *c = NULL;
+    char err[512];
+    assert_int_equal(mixsph_sim_create_from_state(buf, len, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(c, threads), MIXSPH_OK);
+    assert_string_equal(mixsph_sim_case_origin(c), origin);
+    assert_int_equal(mixsph_sim_advance_to(c, t2), MIXSPH_OK);
+    assert_true(same(c, ref));
+    mixsph_sim_destroy(c);
+}
+
 /* save at t1 = 0.05 s, run to t2 = 0.1 s (A); restore, run to t2 again (B): A == B bit for bit; a second
  * simulation created from the state alone and run to t2 equals A too. */
 static void test_restore_continues_identically(void **state)
@@ -80,15 +95,8 @@ static void test_restore_continues_identically(void **state)
     assert_int_equal(mixsph_sim_advance_to(s, 0.1), MIXSPH_OK);
     assert_true(same(s, ref));
 
-    mixsph_sim *c = NULL;
-    char err[512];
-    assert_int_equal(mixsph_sim_create_from_state(buf, len, &c, err, sizeof err), MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(c, 2), MIXSPH_OK); /* pair loops do not depend on it */
-    assert_string_equal(mixsph_sim_case_origin(c), VAJONT);
-    assert_int_equal(mixsph_sim_advance_to(c, 0.1), MIXSPH_OK);
-    assert_true(same(c, ref));
+    created_from_state_continues(buf, len, ref, 0.1, 2, VAJONT); /* pair loops do not depend on the threads */
     mixsph_state_free(buf);
-    mixsph_sim_destroy(c);
     mixsph_sim_destroy(s);
     mixsph_sim_destroy(ref);
 }
@@ -120,13 +128,8 @@ static void test_restore_rigid_held_grains(void **state)
     assert_int_equal(mixsph_sim_load_state(s, buf, len), MIXSPH_OK);
     assert_int_equal(mixsph_sim_advance_to(s, 0.2), MIXSPH_OK);
     assert_true(same(s, ref));
-    mixsph_sim *c = NULL;
-    assert_int_equal(mixsph_sim_create_from_state(buf, len, &c, err, sizeof err), MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(c, 1), MIXSPH_OK);
-    assert_int_equal(mixsph_sim_advance_to(c, 0.2), MIXSPH_OK);
-    assert_true(same(c, ref));
+    created_from_state_continues(buf, len, ref, 0.2, 1, EROSIVE);
     mixsph_state_free(buf);
-    mixsph_sim_destroy(c);
     mixsph_sim_destroy(s);
     mixsph_sim_destroy(ref);
 }

@@ -5,10 +5,10 @@
  *     m_i u_i + kappa sum_j w_ij (u_i - u_j) = m_i w_i        for the unknown particles i,
  * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
  * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
- * are prescribed at rest when numerics.held_grains is "rigid" or their medium hold_fixed. The system is solved matrix-free by BiCGSTAB with a
- * Jacobi or a two-level (Jacobi plus the coarse correction of viscous_coarse.h) preconditioner,
- * each stage warm-started from its increments of the last two steps
- * (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
+ * are prescribed at rest when numerics.held_grains is "rigid" or their medium hold_fixed. The
+ * system is solved matrix-free by BiCGSTAB with a Jacobi or a two-level (Jacobi plus the coarse
+ * correction of viscous_coarse.h) preconditioner, each stage warm-started from its increments of
+ * the last two steps (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
  * thread count. */
 #ifndef MIXSPH_VISCOUS_H
 #define MIXSPH_VISCOUS_H
@@ -41,8 +41,8 @@ void viscous_free(struct viscous_solver *V);
  *  ||r|| <= tolerance ||b|| or after max_iterations. With rigid held grains (cfg->held_grains_rigid)
  *  these are prescribed at rest and then, if judge_dt > 0, get the velocity one explicit step of
  *  judge_dt of their forces gives them (the other forces' P->ax, P->az and the viscous force of the
- *  solved field), on which the regime decision judges them. Returns -1 when out of memory, 0 otherwise (convergence
- *  is in the report). */
+ *  solved field), on which the regime decision judges them. Returns -1 when out of memory, 0
+ *  otherwise (convergence is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
                  double judge_dt, double tolerance, int max_iterations, struct viscous_report *report);
