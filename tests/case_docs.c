@@ -1,5 +1,5 @@
 /* case_docs.c - the key tables of docs/cases.md, generated from the case reader's tables
- * (lib/src/case_schema.c), so the document says what the reader does.
+ * (lib/src/io/case_schema.c), so the document says what the reader does.
  *
  *   case_docs                  print every table, between its markers
  *   case_docs --check FILE     exit 1 if a table of FILE differs from the reader's (CTest case_docs)
@@ -185,7 +185,7 @@ int main(int argc, char **argv)
     int rc = 0;
     if (strcmp(argv[1], "--check") == 0) {
         if (differs) {
-            fprintf(stderr, "%s: the key table of section %s differs from the case reader's (lib/src/case_schema.c); "
+            fprintf(stderr, "%s: the key table of section %s differs from the case reader's (lib/src/io/case_schema.c); "
                     "regenerate the tables with: case_docs --update %s\n", argv[2], differs, argv[2]);
             rc = 1;
         } else {

@@ -37,7 +37,7 @@ error, so how far its maximum run-up ends from V1's is the floor under the diffe
 runs at that spacing (how much the splashing run-up tongue amplifies a perturbation of round-off
 size). A difference V2 - V1 or V4 - V1 no larger than that floor decides no ordering.
 
-Run-up (the case's monitor ``run_up``, lib/src/monitors.c): the highest z of a water particle
+Run-up (the case's monitor ``run_up``, lib/src/io/monitors.c): the highest z of a water particle
 centre over the opposite slope (x in [0.75, 1.81] m) among the water particles that have at least
 3 water neighbours within the kernel support 2h (isolated spray does not count), sampled every
 0.005 s; the maximum over the run and its time. Full scale Z = 1211.8 z + 0.3 m a.m.s.l. (the

@@ -1,4 +1,4 @@
-/* test_sim_query.c - the library queries the FMU asks (lib/src/sim_query.c, the last section of
+/* test_sim_query.c - the library queries the FMU asks (lib/src/io/sim_query.c, the last section of
  * mixsph.h): a case's walls, whether they move and which way, and the parameters a case file
  * declares. On the two landslide cases the FMU runs, cases/vajont_padua.json and
  * cases/slope_tank.json, whose walls and motions are named differently, and on the water dam

@@ -1,5 +1,5 @@
 """tools/erosive_dambreak.py: the two interface measures on snapshots and profiles written by hand
-in the formats of cli/main.c and lib/src/monitors.c, and the campaign's options on short, coarse
+in the formats of cli/main.c and lib/src/io/monitors.c, and the campaign's options on short, coarse
 runs of mixsph."""
 
 import math

@@ -1,5 +1,5 @@
 """tools/erosive_ensemble.py: the within / between / mean-profile errors on run folders written by
-hand in the formats of cli/main.c and lib/src/monitors.c (no mixsph run needed)."""
+hand in the formats of cli/main.c and lib/src/io/monitors.c (no mixsph run needed)."""
 
 import json
 import os

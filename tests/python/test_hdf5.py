@@ -1,5 +1,5 @@
 """The HDF5 run file, its XDMF sidecar, checkpoints and restart, through the mixsph executable
-(lib/src/output.c, cli/main.c) and the plot tool (tools/plot_snapshot.py).
+(lib/src/io/output.c, cli/main.c) and the plot tool (tools/plot_snapshot.py).
 
 - h5py reads every field of every snapshot with its shape, dtype and units;
 - meshio (a real XDMF reader) loads run.xdmf and gets the same points and fields;

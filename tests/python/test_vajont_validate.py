@@ -1,6 +1,6 @@
 """tools/vajont_validate.py without running mixsph: the error (13), the reference densities of the
 runs, and the analysis of a run folder written by hand (summary.json, monitors.csv, profiles,
-snapshots in the formats of cli/main.c and lib/src/monitors.c)."""
+snapshots in the formats of cli/main.c and lib/src/io/monitors.c)."""
 
 import json
 import math

@@ -10,7 +10,7 @@
 Every reader raises ``ToolError`` with a message naming the file and what is wrong; the scripts
 catch it and print it (no traceback for a user's mistake).
 
-File formats (cli/main.c, lib/src/monitors.c):
+File formats (cli/main.c, lib/src/io/monitors.c):
 
 - ``monitors.csv``: header ``t,step,<output>...``, one row per monitor interval, ``nan`` where a
   monitor has no value (e.g. no particle in its window);
