@@ -23,12 +23,16 @@
  * debug-logging setting. The library never exits, so neither does the FMU. */
 #include "fmi2_glue.h"
 
+#include <ctype.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#if defined(_WIN32)
+#include <windows.h>
+#endif
 
 /* ---- logging ------------------------------------------------------------------------------ */
 
@@ -147,7 +151,21 @@ static int uri_to_path(const char *uri, char *path, size_t len)
     }
     while (j > 1 && path[j - 1] == '/') j--;
     path[j] = '\0';
+#if defined(_WIN32)
+    /* file:///C:/a/b names C:/a/b */
+    if (isalpha((unsigned char)path[1]) && path[2] == ':') memmove(path, path + 1, j);
+#endif
     return 0;
+}
+
+/* An absolute path of the platform: /a/b; on Windows also C:\a, C:/a and \\server\share. */
+static int is_absolute(const char *path)
+{
+#if defined(_WIN32)
+    if (isalpha((unsigned char)path[0]) && path[1] == ':' && (path[2] == '\\' || path[2] == '/')) return 1;
+    if (path[0] == '\\') return 1;
+#endif
+    return path[0] == '/';
 }
 
 /* ---- the simulation ----------------------------------------------------------------------- */
@@ -156,7 +174,7 @@ static int uri_to_path(const char *uri, char *path, size_t len)
 static fmi2Status case_path(struct fmu_instance *in, const char *case_file, char *path, size_t len)
 {
     if (!case_file || case_file[0] == '\0') return fmu_fail(in, "case_file is empty");
-    if (case_file[0] == '/') {
+    if (is_absolute(case_file)) {
         if ((size_t)snprintf(path, len, "%s", case_file) >= len) return fmu_fail(in, "case_file '%s': path too long", case_file);
         return fmi2OK;
     }
@@ -250,6 +268,20 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
     return fmi2OK;
 }
 
+/* The binary stays loaded until the process ends, whatever the host unloads: OpenMP's idle
+ * worker threads outlive a multi-threaded run, waiting inside the OpenMP runtime for the next
+ * parallel region, and unloading the code under them crashes the host (docs/fmu.md,
+ * "Unloading"). On Linux the linker marks the .so so (-z nodelete, fmu/CMakeLists.txt); the
+ * win64 DLL, which has GNU OpenMP linked in, pins itself here, before its first thread starts. */
+static void keep_loaded(void)
+{
+#if defined(_WIN32)
+    HMODULE self;
+    GetModuleHandleExW(GET_MODULE_HANDLE_EX_FLAG_FROM_ADDRESS | GET_MODULE_HANDLE_EX_FLAG_PIN,
+                       (LPCWSTR)(const void *)&keep_loaded, &self);
+#endif
+}
+
 static void free_instance(struct fmu_instance *in)
 {
     mixsph_sim_destroy(in->sim);
@@ -263,6 +295,7 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
                               fmi2Boolean visible, fmi2Boolean loggingOn)
 {
     (void)visible;
+    keep_loaded();
     if (!functions) return NULL;
     struct fmu_instance *in = calloc(1, sizeof *in);
     if (!in) return NULL;

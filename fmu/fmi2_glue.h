@@ -22,7 +22,10 @@
 #define FMU_MSG_LEN 2048
 #define FMU_MAX_OVERRIDES 32
 
-#if defined(__GNUC__)
+#if defined(__MINGW32__)
+/* the win64 binary's printf family is mingw's C99 one (__USE_MINGW_ANSI_STDIO) */
+#define FMU_PRINTF(a, b) __attribute__((format(gnu_printf, a, b)))
+#elif defined(__GNUC__)
 #define FMU_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #else
 #define FMU_PRINTF(a, b)

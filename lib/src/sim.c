@@ -8,6 +8,9 @@
 #include <string.h>
 #include <time.h>
 #include <sys/stat.h>
+#if defined(_WIN32)
+#include <direct.h> /* the FMU's Windows binary (fmu/): its C runtime's mkdir takes no mode */
+#endif
 
 #include "eos.h"
 #include "geometry.h"
@@ -15,6 +18,15 @@
 #include "monitors.h"
 #include "output.h"
 #include "status.h"
+
+static int make_dir(const char *path)
+{
+#if defined(_WIN32)
+    return _mkdir(path);
+#else
+    return mkdir(path, 0777);
+#endif
+}
 
 /* A lattice site of a body, for the hydrostatic initialisation. */
 struct site {
@@ -355,11 +367,11 @@ static mixsph_status sim_output_dir(mixsph_sim *s, const char *dir, int resume)
     for (char *p = path + 1; *p; p++) {
         if (*p != '/') continue;
         *p = '\0';
-        if (mkdir(path, 0777) != 0 && errno != EEXIST)
+        if (make_dir(path) != 0 && errno != EEXIST)
             return SIM_FAIL(s, MIXSPH_ERR_IO, "output folder %s: cannot create %s: %s", dir, path, strerror(errno));
         *p = '/';
     }
-    if (mkdir(path, 0777) != 0 && errno != EEXIST)
+    if (make_dir(path) != 0 && errno != EEXIST)
         return SIM_FAIL(s, MIXSPH_ERR_IO, "output folder %s: cannot create: %s", dir, strerror(errno));
     if (s->monitor_csv) {
         fclose(s->monitor_csv);

@@ -6,7 +6,9 @@
 #include <stddef.h>
 #include "mixsph.h"
 
-#if defined(__GNUC__)
+#if defined(__MINGW32__) /* the FMU's win64 binary: mingw's C99 printf (__USE_MINGW_ANSI_STDIO) */
+#define MIXSPH_PRINTF(a, b) __attribute__((format(gnu_printf, a, b)))
+#elif defined(__GNUC__)
 #define MIXSPH_PRINTF(a, b) __attribute__((format(printf, a, b)))
 #else
 #define MIXSPH_PRINTF(a, b)

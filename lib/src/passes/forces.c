@@ -52,8 +52,9 @@
 
 #include "mixsph.h"
 
+/* Not on Windows (the FMU's win64 binary): its loader has no ifunc to pick a clone. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(MIXSPH_NO_CLONES) && \
-    !defined(__SANITIZE_ADDRESS__)
+    !defined(__SANITIZE_ADDRESS__) && !defined(_WIN32)
 #define FORCES_CLONES __attribute__((target_clones("arch=x86-64-v4", "arch=x86-64-v3", "default"), noinline))
 #else
 #define FORCES_CLONES
@@ -67,6 +68,17 @@
  * to FORCES_CHUNK - 1 elements past a range (particles.c keeps that padding initialised). */
 #define FORCES_CHUNK 8
 _Static_assert(FORCES_CHUNK - 1 <= FORCES_PAD, "forces.h promises callers reads of at most FORCES_PAD past a range");
+
+/* 64-byte aligned blocks of the lane caches: C11's aligned_alloc, released by free; the C runtime
+ * of the FMU's Windows binary (fmu/) has no aligned_alloc, but _aligned_malloc and _aligned_free. */
+#if defined(_WIN32)
+#include <malloc.h>
+static void *aligned_block(size_t bytes) { return _aligned_malloc(bytes, 64); }
+static void aligned_block_free(void *p) { _aligned_free(p); }
+#else
+static void *aligned_block(size_t bytes) { return aligned_alloc(64, bytes); }
+static void aligned_block_free(void *p) { free(p); }
+#endif
 
 struct forces {
     double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
@@ -531,12 +543,12 @@ struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
 void forces_free(struct forces *F)
 {
     if (!F) return;
-    free(F->fk);
+    aligned_block_free(F->fk);
     free(F->fk_off);
     free(F->nbr_count);
     free(F->smooth_sum);
     free(F->smooth_weight);
-    free(F->visc_w);
+    aligned_block_free(F->visc_w);
     free(F);
 }
 
@@ -576,8 +588,8 @@ static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n
     F->fk_off[n] = total;
     if (F->fk_cap < total) {
         const size_t cap = total + total / 4 + FORCES_CHUNK;
-        free(F->fk);
-        F->fk = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
+        aligned_block_free(F->fk);
+        F->fk = aligned_block((cap * sizeof(double) + 63) / 64 * 64);
         F->fk_cap = F->fk ? cap : 0;
         if (!F->fk) return -1;
     }
@@ -709,8 +721,8 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         const size_t lanes = F->fk_off[n];
         if (F->visc_w_cap < lanes) {
             const size_t cap = lanes + lanes / 4 + FORCES_CHUNK;
-            free(F->visc_w);
-            F->visc_w = aligned_alloc(64, (cap * sizeof(double) + 63) / 64 * 64);
+            aligned_block_free(F->visc_w);
+            F->visc_w = aligned_block((cap * sizeof(double) + 63) / 64 * 64);
             F->visc_w_cap = F->visc_w ? cap : 0;
             if (!F->visc_w) return -1;
         }

@@ -1,0 +1,72 @@
+/* output_none.c - output.h and the checkpoint functions of mixsph.h for a library built without
+ * HDF5 (the FMU's binaries, fmu/CMakeLists.txt: they carry no HDF5, and an FMU writes no run
+ * files; its states are kept in memory by state.c). In place of output.c, chosen by CMake.
+ *
+ * An output folder (mixsph_sim_set_output_dir, _resume_output_dir) and checkpoint files need
+ * HDF5: asking for them is MIXSPH_ERR_IO saying that this build has no HDF5. Stepping, the
+ * monitors in memory and states (mixsph_sim_save_state / _load_state) work as in the full
+ * library. */
+#include "output.h"
+
+#include <stddef.h>
+
+#include "sim.h"
+#include "status.h"
+
+#define NO_HDF5 "this build of the mixsph library has no HDF5 (the FMU's): "
+
+mixsph_status output_open(mixsph_sim *s, int resume)
+{
+    (void)resume;
+    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "no output folder (%s): run files are HDF5 files", s->out_dir);
+}
+
+/* Never reached: output_open fails, so no output folder is ever set. */
+mixsph_status output_resume_monitors(mixsph_sim *s)
+{
+    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "no output folder");
+}
+
+mixsph_status output_snapshot(mixsph_sim *s)
+{
+    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "no snapshots");
+}
+
+void output_close(mixsph_sim *s) { (void)s; }
+
+mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "cannot write the checkpoint %s (checkpoints are HDF5 files)",
+                    path ? path : "(null)");
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
+                                                              mixsph_sim **out, char *err, size_t err_len)
+{
+    (void)interrupt;
+    if (out) *out = NULL;
+    return status_set(err, err_len, MIXSPH_ERR_IO, NO_HDF5 "cannot read the checkpoint %s (checkpoints are HDF5 files)",
+                      path ? path : "(null)");
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
+{
+    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
+}
+
+mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)
+{
+    if (!s) return MIXSPH_ERR_ARG;
+    s->csv_snapshots_off = !on;
+    return MIXSPH_OK;
+}
+
+/* Nothing is ever written. */
+void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, double *checkpoint_s)
+{
+    (void)s;
+    if (csv_s) *csv_s = 0.0;
+    if (hdf5_s) *hdf5_s = 0.0;
+    if (checkpoint_s) *checkpoint_s = 0.0;
+}
