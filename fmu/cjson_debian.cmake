@@ -73,3 +73,5 @@ configure_file(${MIXSPH_CJSON_SOURCE_DIR}/cJSON.h ${CMAKE_BINARY_DIR}/_deps/cjso
 add_library(cjson_static STATIC ${MIXSPH_CJSON_SOURCE_DIR}/cJSON.c)
 target_include_directories(cjson_static SYSTEM PUBLIC ${CMAKE_BINARY_DIR}/_deps/cjson-include)
 target_compile_options(cjson_static PRIVATE -w) # third-party code: its warnings are not ours to fix
+# Its functions stay inside the FMU's binary (cJSON.h would otherwise mark them dllexport on Windows)
+target_compile_definitions(cjson_static PUBLIC CJSON_HIDE_SYMBOLS)

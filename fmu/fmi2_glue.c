@@ -79,6 +79,27 @@ void fmu_log_info(struct fmu_instance *in, const char *fmt, ...)
     va_end(ap);
 }
 
+static void log_fatal(struct fmu_instance *in, const char *fmt, ...) FMU_PRINTF(2, 3);
+static void log_fatal(struct fmu_instance *in, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    log_message(in, fmi2Fatal, "logStatusFatal", fmt, ap);
+    va_end(ap);
+}
+
+/* Log a fatal error and make the instance unusable (FMU_MODE_FATAL); returns fmi2Fatal. */
+static fmi2Status fmu_fatal(struct fmu_instance *in, const char *fmt, ...) FMU_PRINTF(2, 3);
+static fmi2Status fmu_fatal(struct fmu_instance *in, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    in->mode = FMU_MODE_FATAL;
+    log_message(in, fmi2Fatal, "logStatusFatal", fmt, ap);
+    va_end(ap);
+    return fmi2Fatal;
+}
+
 fmi2Status fmu_fail(struct fmu_instance *in, const char *fmt, ...)
 {
     va_list ap;
@@ -104,18 +125,30 @@ fmi2Status fmu_reject(struct fmu_instance *in, const char *fmt, ...)
 #define M_ANY (M(FMU_MODE_INSTANTIATED) | M(FMU_MODE_INIT) | M(FMU_MODE_STEP) | M(FMU_MODE_TERMINATED) | M(FMU_MODE_ERROR))
 #define M_ALIVE (M(FMU_MODE_INSTANTIATED) | M(FMU_MODE_INIT) | M(FMU_MODE_STEP) | M(FMU_MODE_TERMINATED))
 
-/* The instance pointer is there and fn may be called in its state. */
-static int check(struct fmu_instance *in, const char *fn, int allowed_modes)
+/* fmi2OK if the instance pointer is there and fn may be called in its state; else what fn
+ * returns: fmi2Fatal for an instance made unusable by an earlier fmi2Fatal, fmi2Error otherwise. */
+static fmi2Status check(struct fmu_instance *in, const char *fn, int allowed_modes)
 {
-    if (!in) return 0;
+    if (!in) return fmi2Error;
+    if (in->mode == FMU_MODE_FATAL) {
+        log_fatal(in, "%s: the instance is unusable since an earlier fmi2Fatal; only fmi2FreeInstance may be called", fn);
+        return fmi2Fatal;
+    }
     if (!(allowed_modes & M(in->mode))) {
         static const char *const names[] = {"instantiated", "initialization mode", "step mode", "terminated",
                                             "error"};
         log_error(in, "%s: not allowed in %s", fn, names[in->mode]);
-        return 0;
+        return fmi2Error;
     }
-    return 1;
+    return fmi2OK;
 }
+
+/* Return from the calling fmi2 function unless check() allows the call. */
+#define CHECK(in, fn, allowed_modes)                                        \
+    do {                                                                    \
+        const fmi2Status check_status_ = check((in), (fn), (allowed_modes)); \
+        if (check_status_ != fmi2OK) return check_status_;                  \
+    } while (0)
 
 /* ---- resource location -------------------------------------------------------------------- */
 
@@ -261,7 +294,7 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
                                const fmi2String categories[])
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2SetDebugLogging", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2SetDebugLogging", M_ANY);
     (void)nCategories;
     (void)categories;
     in->logging_on = loggingOn ? 1 : 0;
@@ -276,9 +309,10 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
 static void keep_loaded(void)
 {
 #if defined(_WIN32)
+    static const char inside_this_dll = 0; /* any address in the DLL names it */
     HMODULE self;
     GetModuleHandleExW(GET_MODULE_HANDLE_EX_FLAG_FROM_ADDRESS | GET_MODULE_HANDLE_EX_FLAG_PIN,
-                       (LPCWSTR)(const void *)&keep_loaded, &self);
+                       (LPCWSTR)(const void *)&inside_this_dll, &self);
 #endif
 }
 
@@ -340,7 +374,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
     struct fmu_instance *in = c;
     (void)toleranceDefined;
     (void)tolerance;
-    if (!check(in, "fmi2SetupExperiment", M(FMU_MODE_INSTANTIATED))) return fmi2Error;
+    CHECK(in, "fmi2SetupExperiment", M(FMU_MODE_INSTANTIATED));
     if (!isfinite(startTime) || startTime != 0.0)
         return fmu_reject(in, "fmi2SetupExperiment: startTime %g: the case starts at t = 0", startTime);
     if (stopTimeDefined && !(isfinite(stopTime) && stopTime > startTime))
@@ -352,7 +386,7 @@ fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fm
 fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2EnterInitializationMode", M(FMU_MODE_INSTANTIATED))) return fmi2Error;
+    CHECK(in, "fmi2EnterInitializationMode", M(FMU_MODE_INSTANTIATED));
     in->mode = FMU_MODE_INIT;
     return fmi2OK;
 }
@@ -360,7 +394,7 @@ fmi2Status fmi2EnterInitializationMode(fmi2Component c)
 fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2ExitInitializationMode", M(FMU_MODE_INIT))) return fmi2Error;
+    CHECK(in, "fmi2ExitInitializationMode", M(FMU_MODE_INIT));
     if (!in->sim && create_simulation(in) != fmi2OK) return fmi2Error;
     in->time = in->start_time;
     in->mode = FMU_MODE_STEP;
@@ -370,7 +404,7 @@ fmi2Status fmi2ExitInitializationMode(fmi2Component c)
 fmi2Status fmi2Terminate(fmi2Component c)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2Terminate", M(FMU_MODE_STEP))) return fmi2Error;
+    CHECK(in, "fmi2Terminate", M(FMU_MODE_STEP));
     in->mode = FMU_MODE_TERMINATED;
     return fmi2OK;
 }
@@ -378,7 +412,7 @@ fmi2Status fmi2Terminate(fmi2Component c)
 fmi2Status fmi2Reset(fmi2Component c)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2Reset", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2Reset", M_ANY);
     mixsph_sim_destroy(in->sim);
     in->sim = NULL;
     memset(in->data, 0, fmu_model.data_size);
@@ -395,7 +429,7 @@ fmi2Status fmi2Reset(fmi2Component c)
 #define FMU_ACCESS(fn, allowed, accessor, value_expr)                                        \
     do {                                                                                     \
         struct fmu_instance *in = c;                                                         \
-        if (!check(in, fn, allowed)) return fmi2Error;                                       \
+        CHECK(in, fn, allowed);                                                              \
         if (nvr > 0 && (!vr || !value)) return fmu_reject(in, "%s: NULL array", fn);         \
         for (size_t i = 0; i < nvr; i++)                                                     \
             if (fmu_model.accessor(in, vr[i], value_expr) != fmi2OK) return fmi2Error;       \
@@ -449,12 +483,19 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 {
     struct fmu_instance *in = c;
     (void)noSetFMUStatePriorToCurrentPoint;
-    if (!check(in, "fmi2DoStep", M(FMU_MODE_STEP))) return fmi2Error;
+    CHECK(in, "fmi2DoStep", M(FMU_MODE_STEP));
     if (!isfinite(currentCommunicationPoint) || !isfinite(communicationStepSize) || communicationStepSize < 0.0)
         return fmu_reject(in, "fmi2DoStep: communication point %g and step %g must be finite, the step >= 0",
                           currentCommunicationPoint, communicationStepSize);
     const double t_end = currentCommunicationPoint + communicationStepSize;
     const mixsph_status st = mixsph_sim_advance_to(in->sim, t_end);
+    /* Out of memory part-way through a step: the simulation's arrays may be resized and not yet
+     * filled, and neither a restored state nor a reset can be relied on to find memory in a
+     * process that has none; every other failure (an unstable run, ...) leaves a simulation that
+     * fmi2SetFMUstate or fmi2Reset can replace. */
+    if (st == MIXSPH_ERR_NOMEM)
+        return fmu_fatal(in, "fmi2DoStep to t = %g s: %s: %s; the instance is unusable (free it)", t_end,
+                         mixsph_status_string(st), mixsph_sim_last_error(in->sim));
     if (st != MIXSPH_OK)
         return fmu_fail(in, "fmi2DoStep to t = %g s: %s: %s", t_end, mixsph_status_string(st), mixsph_sim_last_error(in->sim));
     in->time = t_end;
@@ -464,14 +505,14 @@ fmi2Status fmi2DoStep(fmi2Component c, fmi2Real currentCommunicationPoint, fmi2R
 fmi2Status fmi2CancelStep(fmi2Component c)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2CancelStep", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2CancelStep", M_ANY);
     return fmu_reject(in, "fmi2CancelStep: doStep is synchronous, nothing to cancel");
 }
 
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2GetStatus", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetStatus", M_ANY);
     if (s == fmi2DoStepStatus && value) {
         *value = in->mode == FMU_MODE_ERROR ? fmi2Error : fmi2OK;
         return fmi2OK;
@@ -482,7 +523,7 @@ fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *va
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2GetRealStatus", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetRealStatus", M_ANY);
     if (s == fmi2LastSuccessfulTime && value) {
         *value = in->time;
         return fmi2OK;
@@ -494,14 +535,14 @@ fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Int
 {
     struct fmu_instance *in = c;
     (void)value;
-    if (!check(in, "fmi2GetIntegerStatus", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetIntegerStatus", M_ANY);
     return fmu_reject(in, "fmi2GetIntegerStatus: status kind %d not provided", (int)s);
 }
 
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2GetBooleanStatus", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetBooleanStatus", M_ANY);
     if (s == fmi2Terminated && value) {
         *value = fmi2False;
         return fmi2OK;
@@ -512,7 +553,7 @@ fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boo
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2GetStringStatus", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetStringStatus", M_ANY);
     if (s == fmi2PendingStatus && value) {
         *value = "";
         return fmi2OK;
@@ -525,7 +566,7 @@ fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference
 {
     struct fmu_instance *in = c;
     (void)vr, (void)nvr, (void)order, (void)value;
-    if (!check(in, "fmi2SetRealInputDerivatives", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2SetRealInputDerivatives", M_ANY);
     return fmu_reject(in, "fmi2SetRealInputDerivatives: not supported (canInterpolateInputs = false)");
 }
 
@@ -534,7 +575,7 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
 {
     struct fmu_instance *in = c;
     (void)vr, (void)nvr, (void)order, (void)value;
-    if (!check(in, "fmi2GetRealOutputDerivatives", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetRealOutputDerivatives", M_ANY);
     return fmu_reject(in, "fmi2GetRealOutputDerivatives: not supported (maxOutputDerivativeOrder = 0)");
 }
 
@@ -544,7 +585,7 @@ fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReferenc
 {
     struct fmu_instance *in = c;
     (void)vUnknown_ref, (void)nUnknown, (void)vKnown_ref, (void)nKnown, (void)dvKnown, (void)dvUnknown;
-    if (!check(in, "fmi2GetDirectionalDerivative", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2GetDirectionalDerivative", M_ANY);
     return fmu_reject(in, "fmi2GetDirectionalDerivative: not supported (providesDirectionalDerivative = false)");
 }
 
@@ -663,7 +704,7 @@ static struct fmu_state *new_state(void)
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2GetFMUstate", M(FMU_MODE_STEP) | M(FMU_MODE_TERMINATED))) return fmi2Error;
+    CHECK(in, "fmi2GetFMUstate", M(FMU_MODE_STEP) | M(FMU_MODE_TERMINATED));
     if (!FMUstate) return fmu_reject(in, "fmi2GetFMUstate: NULL state pointer");
     struct fmu_state *fs = *FMUstate; /* a state given back is overwritten */
     if (!fs && !(fs = new_state())) return fmu_reject(in, "fmi2GetFMUstate: out of memory");
@@ -687,7 +728,7 @@ fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *FMUstate)
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate FMUstate)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2SetFMUstate", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2SetFMUstate", M_ANY);
     const struct fmu_state *fs = FMUstate;
     if (!fs || !fs->lib) return fmu_reject(in, "fmi2SetFMUstate: NULL state");
     /* Same case and overrides: load in place; else (another instance's parameters, or no
@@ -735,7 +776,7 @@ static size_t ser_size(size_t lib_len)
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, size_t *size)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2SerializedFMUstateSize", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2SerializedFMUstateSize", M_ANY);
     if (!FMUstate || !size) return fmu_reject(in, "fmi2SerializedFMUstateSize: NULL argument");
     *size = ser_size(((const struct fmu_state *)FMUstate)->lib_len);
     return fmi2OK;
@@ -747,7 +788,7 @@ fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate FMUstate, si
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byte serializedState[], size_t size)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2SerializeFMUstate", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2SerializeFMUstate", M_ANY);
     const struct fmu_state *fs = FMUstate;
     if (!fs || !serializedState) return fmu_reject(in, "fmi2SerializeFMUstate: NULL argument");
     if (size < ser_size(fs->lib_len))
@@ -769,7 +810,7 @@ fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate FMUstate, fmi2Byt
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte serializedState[], size_t size, fmi2FMUstate *FMUstate)
 {
     struct fmu_instance *in = c;
-    if (!check(in, "fmi2DeSerializeFMUstate", M_ANY)) return fmi2Error;
+    CHECK(in, "fmi2DeSerializeFMUstate", M_ANY);
     if (!serializedState || !FMUstate) return fmu_reject(in, "fmi2DeSerializeFMUstate: NULL argument");
     const unsigned char *p = (const unsigned char *)serializedState;
     if (size < ser_size(0) || memcmp(p, SER_MAGIC, 8) != 0)

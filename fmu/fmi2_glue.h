@@ -31,8 +31,10 @@
 #define FMU_PRINTF(a, b)
 #endif
 
-/* The FMI 2.0 co-simulation calling states. */
-enum fmu_mode { FMU_MODE_INSTANTIATED, FMU_MODE_INIT, FMU_MODE_STEP, FMU_MODE_TERMINATED, FMU_MODE_ERROR };
+/* The FMI 2.0 co-simulation calling states. ERROR: a call failed, the instance can be restored
+ * (fmi2SetFMUstate), reset or freed (fmi2Error); FATAL: it is unusable and may only be freed
+ * (fmi2Fatal: out of memory part-way through a step, docs/fmu.md "Errors"). */
+enum fmu_mode { FMU_MODE_INSTANTIATED, FMU_MODE_INIT, FMU_MODE_STEP, FMU_MODE_TERMINATED, FMU_MODE_ERROR, FMU_MODE_FATAL };
 
 struct fmu_instance {
     char *name;
