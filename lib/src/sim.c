@@ -2,6 +2,8 @@
  * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
 #include "sim.h"
 
+#include "law_registry.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -122,7 +124,8 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         const struct medium *m = &s->cfg.media[sites[q].medium];
         const double p = above + 0.5 * m->rho0 * s->cfg.g * dx;
         above += m->rho0 * s->cfg.g * dx;
-        const double rho = eos_density(p, m->rho0, m->c);
+        double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
+        const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
         particles_push(&s->P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
                        (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
         s->P.mu[s->P.n - 1] = m->mu;
@@ -184,14 +187,33 @@ static void set_domain(mixsph_sim *s)
     s->domain[3] = z1 + 0.5 * (z1 - z0) + pad;
 }
 
+/* The states of the material laws the media use, and the velocity gradient when one asks for it. */
+static mixsph_status create_laws(mixsph_sim *s)
+{
+    const struct law_setup setup = {.media = s->cfg.media, .n_media = s->cfg.n_media, .cap = s->P.n,
+                                     .x_min = s->domain[0], .x_max = s->domain[1], .dx = s->dx, .h = s->h,
+                                     .g = s->cfg.g, .p_background = s->cfg.p_background,
+                                     .fixed_bed_speed = s->cfg.fixed_bed_speed};
+    for (size_t k = 0; k < s->cfg.n_media; k++) {
+        const int id = s->cfg.media[k].law;
+        const struct material_law *law = law_get(id);
+        s->law_features |= law->features;
+        if (law->create && !s->law_state[id] && !(s->law_state[id] = law->create(&setup)))
+            return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (the state of the material law of medium %s)",
+                            s->cfg.media[k].name);
+    }
+    if ((s->law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->grad, s->P.n) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
+    return MIXSPH_OK;
+}
+
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
     s->dx = s->cfg.dx;
     s->h = s->cfg.h_over_dx * s->dx;
     s->K = kernel_make_type(s->h, s->cfg.kernel);
-    s->c_max = 0.0;
-    for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
+    s->c_max = law_max_wave_speed(s->cfg.media, s->cfg.n_media);
     walls_start(&s->cfg, s->walls);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
     const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->interrupt, &s->P);
@@ -200,10 +222,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->n_wall = (size_t)n_wall;
     set_domain(s);
-    int has_granular = 0;
-    for (size_t k = 0; k < s->cfg.n_media; k++) has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
-    if (has_granular && !(s->mixture = mixture_create(&s->cfg, s->P.n, s->domain[0], s->domain[1], s->dx, s->h)))
-        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (granular phase)");
+    if ((st = create_laws(s)) != MIXSPH_OK) return st;
     if (!(s->forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
     for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */
@@ -317,7 +336,9 @@ void mixsph_sim_destroy(mixsph_sim *s)
     if (!s) return;
     if (s->monitor_csv) fclose(s->monitor_csv);
     output_close(s);
-    mixture_free(s->mixture);
+    for (int id = 0; id < LAW_COUNT; id++)
+        if (s->law_state[id]) law_get(id)->destroy(s->law_state[id]);
+    velocity_gradient_free(&s->grad);
     forces_free(s->forces);
     viscous_free(s->viscous);
     walls_mirror_free(s->wall_mirror);

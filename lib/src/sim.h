@@ -13,7 +13,7 @@
 #include "forces.h"
 #include "kernel.h"
 #include "mixsph.h"
-#include "mixture.h"
+#include "law.h"
 #include "neighbours.h"
 #include "particles.h"
 #include "viscous.h"
@@ -57,7 +57,9 @@ struct mixsph_sim {
     double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct wall_state walls[CASE_MAX_WALLS];
-    struct mixture *mixture;      /* granular phase; NULL without granular media */
+    void *law_state[LAW_COUNT];   /* each material law's state (laws/law.h); NULL: stateless or unused */
+    unsigned law_features;        /* the union of the media's law features (enum law_feature) */
+    struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */
     long n_fixed;                 /* granular particles held fixed after the last step */
 
     double t, dt;                 /* time, next time step [s] */

@@ -27,6 +27,9 @@ struct particles {
     double *visc_dvpx, *visc_dvpz; /* visc_dv of the step before the last (the warm starts'
                                     * linear extrapolation) [m/s] */
     double *visc_d1px, *visc_d1pz; /* visc_d1 of the step before the last [m/s] */
+    double *sxx, *sxz, *szz; /* deviatoric stress in the plane [Pa] (tension positive; laws with
+                              * LAW_HAS_STRESS, 0 elsewhere); walls: their neighbours' (walls.c) */
+    double *syy;          /* its out-of-plane component (plane strain) [Pa] */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index
                            * (read it through particles_wall_index) */
     uint8_t *state;       /* MIXSPH_STATE_* */
@@ -37,7 +40,7 @@ struct particles {
 /* The double-valued fields, for code that treats them all alike (permute, copy, state). */
 #define PARTICLES_DOUBLE_FIELDS(X) \
     X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc) X(visc_dvx) X(visc_dvz) X(visc_d1x) X(visc_d1z) \
-        X(visc_dvpx) X(visc_dvpz) X(visc_d1px) X(visc_d1pz)
+        X(visc_dvpx) X(visc_dvpz) X(visc_d1px) X(visc_d1pz) X(sxx) X(sxz) X(szz) X(syy)
 
 /** The wall a wall particle belongs to (its `medium` field holds the wall's index). */
 static inline size_t particles_wall_index(const struct particles *P, size_t i) { return P->medium[i]; }

@@ -30,6 +30,9 @@
 #include "integrate.h"
 
 #include "eos.h"
+#include "time_step.h"
+#include "law_registry.h"
+#include "mixture_paper.h"
 #include "status.h"
 #include "viscous.h"
 
@@ -47,11 +50,9 @@ static inline double particle_time_step(const mixsph_sim *s, size_t i, int impli
     const struct particles *P = &s->P;
     const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
     double mu = implicit ? 0.0 : P->mu[i];
-    if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) { /* the viscosity it will have once mobilised */
-        const struct medium *m = &s->cfg.media[P->medium[i]];
-        mu = m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
-    }
-    return integrate_particle_dt(s->cfg.cfl, s->cfg.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
+    if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) /* the viscosity it will have once mobilised */
+        mu = mixture_paper_held_viscosity(&s->cfg.media[P->medium[i]]);
+    return time_step_bound(s->cfg.cfl, s->cfg.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
 }
 
 double integrate_time_step(const mixsph_sim *s)
@@ -111,7 +112,7 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     if (neighbours_gather_reserve(&s->G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     for (size_t i = 0; i < n; i++) {
         uint8_t mode = NEIGHBOURS_GATHER_NONE;
-        if (P->state[i] == MIXSPH_STATE_WALL || s->cfg.media[P->medium[i]].kind == MEDIUM_GRANULAR)
+        if (P->state[i] == MIXSPH_STATE_WALL || (s->cfg.media[P->medium[i]].features & LAW_USES_GRADIENT))
             mode = NEIGHBOURS_GATHER_ALL;
         s->G.mode[i] = mode;
     }
@@ -156,25 +157,48 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.params.av_separating = s->cfg.av_separating;
     S.params.implicit_viscosity = s->cfg.viscosity_implicit;
     S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
+    S.params.stress = (s->law_features & LAW_HAS_STRESS) != 0;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
 
 static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.ncell]; }
 
+/* Whether a medium of the case uses law `id`. */
+static int law_in_use(const mixsph_sim *s, int id)
+{
+    for (size_t k = 0; k < s->cfg.n_media; k++)
+        if (s->cfg.media[k].law == id) return 1;
+    return 0;
+}
+
 int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 {
-    if (s->mixture) return forces_density_rate_gradient(s->forces, S, mixture_gradient(s->mixture));
+    if (s->law_features & LAW_USES_GRADIENT) return forces_density_rate_gradient(s->forces, S, &s->grad);
     return forces_density_rate(s->forces, S);
+}
+
+/* The material laws' updates over law_dt (0: at the current state, no advance), in the order of
+ * their ids; the paper's law reports the grains it holds fixed. */
+void integrate_update_laws(mixsph_sim *s, double law_dt)
+{
+    const struct law_step step = {.P = &s->P, .n = active_particles(s), .media = s->cfg.media, .grad = &s->grad,
+                                  .G = &s->G, .K = &s->K, .dt = law_dt, .n_threads = SIM_THREADS(s)};
+    for (int id = 0; id < LAW_COUNT; id++) {
+        const struct material_law *law = law_get(id);
+        if (!law->update || !law_in_use(s, id)) continue;
+        const long count = law->update(s->law_state[id], &step);
+        if (id == LAW_MIXTURE_PAPER) s->n_fixed = count;
+    }
 }
 
 /* After the densities are updated and the equation of state: pressures smoothed (with
  * numerics.pressure_smoothing), the grains' regimes, the walls' extrapolated state. Returns -1
  * when out of memory. */
-static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth)
+static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth, double law_dt)
 {
     if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
-    if (s->mixture) s->n_fixed = mixture_update(s->mixture, &s->K, &s->G, &s->P, active_particles(s), S->n_threads);
+    integrate_update_laws(s, law_dt);
     walls_extrapolate_fluid(&s->cfg, s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
     return 0;
 }
@@ -188,7 +212,8 @@ static void kick_velocities(mixsph_sim *s, double dt)
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && (rigid || s->cfg.media[P->medium[i]].hold_fixed)) continue;
+        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], rigid))
+            continue;
         P->vx[i] += dt * P->ax[i];
         P->vz[i] += dt * P->az[i];
     }
@@ -267,7 +292,7 @@ mixsph_status integrate_initial_rates(mixsph_sim *s)
     if (bad < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     integrate_pressure_and_derived(s);
-    pressures_and_regimes(s, &S, 0);
+    pressures_and_regimes(s, &S, 0, 0.0);
     const int bad_a = forces_momentum(s->forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad_a) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
@@ -313,7 +338,9 @@ mixsph_status integrate_step(mixsph_sim *s)
     for (size_t i = 0; i < P->n; i++) {
         const int st = P->state[i];
         if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
-            const double kick = st == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed ? 0.0 : half_kick;
+            const double kick =
+                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0) ? 0.0
+                                                                                                           : half_kick;
             double vx = P->vx[i] + kick * P->ax[i];
             double vz = P->vz[i] + kick * P->az[i];
             if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
@@ -354,7 +381,7 @@ mixsph_status integrate_step(mixsph_sim *s)
         bad_rho |= !(P->rho[i] > 0.0);
         particle_pressure(s, i);
     }
-    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0) != 0)
+    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -371,7 +398,8 @@ mixsph_status integrate_step(mixsph_sim *s)
 #pragma omp parallel for schedule(static) reduction(min : dt_next) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (!implicit && !(P->state[i] == MIXSPH_STATE_FIXED && s->cfg.media[P->medium[i]].hold_fixed)) {
+        if (!implicit &&
+            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0))) {
             P->vx[i] += last_kick * P->ax[i];
             P->vz[i] += last_kick * P->az[i];
         }
