@@ -51,9 +51,9 @@ double drucker_prager_wave_speed(double K, double G, double rho)
     return sqrt((K + 4.0 * G / 3.0) / rho);
 }
 
-double drucker_prager_dt_bound(double cfl, double h, double K, double G, double rho)
+double drucker_prager_dt_bound(double cfl, double h, double speed, double K, double G, double rho)
 {
-    return cfl * h / drucker_prager_wave_speed(K, G, rho);
+    return cfl * 2.0 * h / (drucker_prager_wave_speed(K, G, rho) + speed);
 }
 
 double drucker_prager_static_strain(double rho, double g, double H, double E)

@@ -49,7 +49,8 @@
  *
  * (d) Isotropic elasticity: K = E / (3 (1 - 2 nu)), G = E / (2 (1 + nu)), -1 < nu < 1/2, E > 0.
  * (e) P-wave speed c_p = sqrt((K + 4 G/3) / rho); with the pressure from a linear equation of state
- *     of sound speed c0, K = rho0 c0^2. Time step bound dt <= cfl h / c_p.
+ *     of sound speed c0, K = rho0 c0^2 (c_p^2 = c0^2 + 4 G / (3 rho)). Time step bound of the form of
+ *     the paper's acoustic criterion (4), docs/model.md section 4: dt <= cfl 2 h / (c_p + |u|).
  * Static strain of a deposit of height H: eps = rho g H / E, to stay below
  * DRUCKER_PRAGER_STATIC_STRAIN_MAX (small-strain hypoelasticity). */
 #ifndef MIXSPH_DRUCKER_PRAGER_H
@@ -97,8 +98,9 @@ const char *drucker_prager_material(double E, double nu, double phi, double c, d
 /** P-wave speed sqrt((K + 4G/3) / rho) [m/s]. */
 double drucker_prager_wave_speed(double K, double G, double rho);
 
-/** Time step bound cfl h / sqrt((K + 4G/3) / rho) [s], h the smoothing length [m]. */
-double drucker_prager_dt_bound(double cfl, double h, double K, double G, double rho);
+/** Time step bound cfl 2 h / (c_p + speed) [s], c_p the P-wave speed, h the smoothing length [m],
+ *  speed the particle's speed |u| [m/s]. */
+double drucker_prager_dt_bound(double cfl, double h, double speed, double K, double G, double rho);
 
 /** Static strain rho g H / E [-] of a deposit of height H [m]; compare with
  *  DRUCKER_PRAGER_STATIC_STRAIN_MAX. */
