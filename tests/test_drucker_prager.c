@@ -68,7 +68,8 @@ static void split(double sxx, double szz, double sxz, double syy, struct drucker
 }
 
 /* K, G from E, nu; E and nu recovered through the inverse relations E = 9KG/(3K + G),
- * nu = (3K - 2G)/(2(3K + G)) (any elasticity text); bad inputs refused with nothing written. */
+ * nu = (3K - 2G)/(2(3K + G)) (any elasticity text), and G from K and nu the same; bad inputs
+ * refused with nothing written. */
 static void test_elastic_constants(void **state)
 {
     (void)state;
@@ -78,7 +79,15 @@ static void test_elastic_constants(void **state)
         assert_null(drucker_prager_elastic_constants(E_SAND, nus[k], &K, &G));
         assert_rel(9.0 * K * G / (3.0 * K + G), E_SAND, ULPS, "E from K, G");
         assert_abs((3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G)), nus[k], ULPS, "nu from K, G");
+        double G2 = 0.0;
+        assert_null(drucker_prager_shear_from_bulk(K, nus[k], &G2));
+        assert_rel(G2, G, ULPS, "G from K and nu");
     }
+    double G3 = -7.0;
+    assert_non_null(drucker_prager_shear_from_bulk(1e6, 0.5, &G3));
+    assert_non_null(drucker_prager_shear_from_bulk(0.0, 0.3, &G3));
+    assert_non_null(drucker_prager_shear_from_bulk(NAN, 0.3, &G3));
+    assert_true(G3 == -7.0); /* nothing written */
     const double bad[][2] = {{E_SAND, 0.5}, {E_SAND, -1.0}, {E_SAND, 0.7}, {0.0, 0.3}, {-1.0, 0.3},
                              {NAN, 0.3},    {E_SAND, NAN},  {INFINITY, 0.3}};
     for (size_t k = 0; k < sizeof bad / sizeof bad[0]; k++) {

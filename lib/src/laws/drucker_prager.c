@@ -16,6 +16,14 @@ const char *drucker_prager_elastic_constants(double E, double nu, double *K, dou
     return NULL;
 }
 
+const char *drucker_prager_shear_from_bulk(double K, double nu, double *G)
+{
+    if (!(K > 0.0) || !isfinite(K)) return "bulk modulus K must be a positive finite number of pascals";
+    if (!(nu > -1.0 && nu < 0.5)) return "Poisson's ratio nu must lie in (-1, 0.5): K and G are positive only there";
+    *G = 3.0 * K * (1.0 - 2.0 * nu) / (2.0 * (1.0 + nu));
+    return NULL;
+}
+
 const char *drucker_prager_matching(double phi, double c, double psi, double *alpha_phi, double *k_c,
                                     double *alpha_psi)
 {

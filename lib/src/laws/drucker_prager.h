@@ -85,6 +85,11 @@ enum drucker_prager_outcome {
  *  NULL when done, else a message saying which value is out of range and why (nothing written). */
 const char *drucker_prager_elastic_constants(double E, double nu, double *K, double *G);
 
+/** Shear modulus G [Pa] that Poisson's ratio nu gives with the bulk modulus K [Pa], G = 3 K (1 - 2 nu) /
+ *  (2 (1 + nu)): for a law whose pressure comes from the equation of state, K = rho0 c0^2 is fixed
+ *  there. NULL when done, else a message saying which value is out of range (nothing written). */
+const char *drucker_prager_shear_from_bulk(double K, double nu, double *G);
+
 /** Plane-strain matched cone (b) from the friction angle phi [rad], cohesion c [Pa] and dilatancy
  *  angle psi [rad]. NULL when done, else a message naming the value out of range (nothing written). */
 const char *drucker_prager_matching(double phi, double c, double psi, double *alpha_phi, double *k_c,
