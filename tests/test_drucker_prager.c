@@ -174,7 +174,7 @@ static void test_return_inside(void **state)
     assert_true(z.xx == 0.0 && z.zz == 0.0 && z.xz == 0.0 && z.yy == 0.0 && pz == 0.0);
 }
 
-/* psi = 0 (non-associated, the default): a trial outside the cone lands on it (|f| below 1e-9 of
+/* psi = 0 (non-associated, the default): a trial outside the cone lands on it (|f| below 1e-12 of
  * sqrt(J2), round-off of a few operations on 1e5 Pa numbers), along the flow rule dg/dsigma = s /
  * (2 sqrt(J2)): the deviator scaled by one factor (each component to 1e-14 relative, so its
  * direction and tracelessness are kept), sqrt(J2) reduced by G dlambda = f (to 1e-12), the
@@ -193,7 +193,7 @@ static void test_return_cone_non_associated(void **state)
         const struct drucker_prager_deviator s0 = s;
         const double p0 = p, j0 = drucker_prager_sqrt_j2(&s0);
         assert_int_equal(drucker_prager_return(&s, &p, &m), DRUCKER_PRAGER_CONE);
-        assert_abs(drucker_prager_yield(&s, p, &m), 0.0, 1e-9 * j0, "f after the return");
+        assert_abs(drucker_prager_yield(&s, p, &m), 0.0, 1e-12 * j0, "f after the return");
         assert_true(p == p0);
         const double r = s.xx / s0.xx;
         assert_true(r > 0.0 && r < 1.0);
@@ -204,7 +204,7 @@ static void test_return_cone_non_associated(void **state)
     }
 }
 
-/* psi > 0: the return lands on the yield cone (|f| < 1e-9 sqrt(J2)) and its correction follows
+/* psi > 0: the return lands on the yield cone (|f| < 1e-12 sqrt(J2)) and its correction follows
  * the elastic stiffness applied to dg/dsigma = s/(2 sqrt(J2)) + alpha_psi I: the deviator radial,
  * and the pressure raised by 3 K alpha_psi dlambda while sqrt(J2) drops by G dlambda, so
  * dp / (-d sqrt(J2)) = 3 K alpha_psi / G (to 1e-12 relative). */
@@ -221,7 +221,7 @@ static void test_return_cone_dilatant(void **state)
         const struct drucker_prager_deviator s0 = s;
         const double p0 = p, j0 = drucker_prager_sqrt_j2(&s0);
         assert_int_equal(drucker_prager_return(&s, &p, &m), DRUCKER_PRAGER_CONE);
-        assert_abs(drucker_prager_yield(&s, p, &m), 0.0, 1e-9 * j0, "f after the return");
+        assert_abs(drucker_prager_yield(&s, p, &m), 0.0, 1e-12 * j0, "f after the return");
         const double r = s.xx / s0.xx;
         assert_rel(s.zz / s0.zz, r, ULPS, "radial deviator, zz");
         assert_rel(s.xz / s0.xz, r, ULPS, "radial deviator, xz");
@@ -267,7 +267,7 @@ static void test_return_apex(void **state)
     p = pa - 1.0;
     assert_int_equal(drucker_prager_return(&s, &p, &dil), DRUCKER_PRAGER_CONE);
     assert_true(p > pa);
-    assert_abs(drucker_prager_yield(&s, p, &dil), 0.0, 1e-9 * 1.0e5, "f after a dilatant return near the apex");
+    assert_abs(drucker_prager_yield(&s, p, &dil), 0.0, 1e-12 * 1.0e5, "f after a dilatant return near the apex");
 }
 
 /* Rigid rotation u = -Omega z, w = Omega x (counter-clockwise from x to z; D = 0, W_xz = -Omega).
