@@ -5,6 +5,9 @@
 
 #include <math.h>
 
+#include "status.h"
+
+#include "elasticity.h"
 #include "law.h"
 
 static const struct case_choice elastic_type[] = {{"elastic", LAW_ELASTIC_SOLID}, {NULL, 0}};
@@ -28,9 +31,8 @@ static const struct case_section elastic_section = {
 
 static mixsph_status elastic_finish(struct medium *m, const struct law_finish_ctx *ctx)
 {
-    (void)ctx;
-    m->bulk_modulus = m->youngs_modulus / (3.0 * (1.0 - 2.0 * m->poisson));
-    m->shear_modulus = m->youngs_modulus / (2.0 * (1.0 + m->poisson));
+    const char *why = elasticity_constants(m->youngs_modulus, m->poisson, &m->bulk_modulus, &m->shear_modulus);
+    if (why) return status_set(ctx->err, ctx->err_len, MIXSPH_ERR_CASE, "%s: %s: %s", ctx->origin, ctx->path, why);
     m->c = sqrt(m->bulk_modulus / m->rho0);
     m->mu = 0.0;
     return MIXSPH_OK;
@@ -38,7 +40,7 @@ static mixsph_status elastic_finish(struct medium *m, const struct law_finish_ct
 
 static double elastic_wave_speed(const struct medium *m)
 {
-    return sqrt((m->bulk_modulus + 4.0 / 3.0 * m->shear_modulus) / m->rho0);
+    return elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0);
 }
 
 static double elastic_viscosity_bound(const struct medium *m)
@@ -65,10 +67,10 @@ static long elastic_update(void *state, const struct law_step *step)
 #pragma omp parallel for schedule(static) num_threads(step->n_threads)
     for (size_t i = 0; i < step->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || media[P->medium[i]].law != LAW_ELASTIC_SOLID) continue;
-        double grad[4];
-        velocity_gradient_corrected(step->grad, i, grad);
-        const struct deviatoric_stress s0 = {P->sxx[i], P->sxz[i], P->szz[i], P->syy[i]};
-        const struct deviatoric_stress s = elastic_solid_jaumann_step(s0, grad, media[P->medium[i]].shear_modulus, dt);
+        double g[4];
+        velocity_gradient_corrected(step->grad, i, g);
+        struct deviatoric_stress s = {.xx = P->sxx[i], .zz = P->szz[i], .xz = P->sxz[i], .yy = P->syy[i]};
+        elasticity_jaumann_step(&s, g[0], g[1], g[2], g[3], media[P->medium[i]].shear_modulus, dt);
         P->sxx[i] = s.xx;
         P->sxz[i] = s.xz;
         P->szz[i] = s.zz;
