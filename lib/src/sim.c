@@ -341,6 +341,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
     velocity_gradient_free(&s->grad);
     forces_free(s->forces);
     viscous_free(s->viscous);
+    free(s->viscous_unknown);
     walls_mirror_free(s->wall_mirror);
     particles_free(&s->P);
     cells_free(&s->C);

@@ -53,6 +53,7 @@ struct mixsph_sim {
     struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
     struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
     struct viscous_report viscous_last; /* the last solve */
+    unsigned char *viscous_unknown; /* per particle: an unknown of the implicit viscous step */
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
     double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
