@@ -2,6 +2,7 @@
  * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
 #include "sim.h"
 
+#include "budget.h"
 #include "law_registry.h"
 
 #include <errno.h>
@@ -11,6 +12,7 @@
 #include <time.h>
 #include <sys/stat.h>
 
+#include "clock.h"
 #include "eos.h"
 #include "geometry.h"
 #include "integrate.h"
@@ -300,6 +302,7 @@ mixsph_status sim_create_from_text(const char *json_text, const char *origin, co
     if (!s) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
     mixsph_sim_set_interrupt(s, interrupt);
     mixsph_status st = case_parse(json_text, origin, ov, n_ov, &s->cfg, s->err, sizeof s->err);
+    if (st == MIXSPH_OK) st = budget_check(&s->cfg, s->err, sizeof s->err); /* before anything is allocated */
     if (st == MIXSPH_OK) st = sim_keep_source(s, json_text, origin, ov, n_ov);
     if (st == MIXSPH_OK) st = sim_init(s);
     if (st != MIXSPH_OK) {
@@ -436,21 +439,15 @@ static mixsph_status sim_outputs_due(mixsph_sim *s)
 mixsph_status mixsph_sim_step(mixsph_sim *s)
 {
     if (!s) return MIXSPH_ERR_ARG;
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
     if (s->step == 0 && s->n_samples == 0) st = sim_outputs_due(s);
     if (st == MIXSPH_OK) st = integrate_step(s);
     if (st == MIXSPH_OK) st = sim_outputs_due(s);
-    s->run_wall_s += sim_clock_s() - t0;
+    s->run_wall_s += clock_monotonic_s() - t0;
     return st;
 }
 
-double sim_clock_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->run_wall_s : NAN; }
 

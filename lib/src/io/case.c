@@ -11,7 +11,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "budget.h"
 #include "case_schema.h"
 #include "law_registry.h"
 #include "status.h"
@@ -609,8 +608,7 @@ static mixsph_status read_root(const struct case_reader *r, const cJSON *root, s
     const mixsph_status st = case_schema_read(r, o ? o : none, "output", section("output"), 0, c);
     cJSON_Delete(none);
     if (st != MIXSPH_OK) return st;
-    TRY(read_domain_rules(r, c));
-    return budget_check(c, r->err, r->err_len);
+    return read_domain_rules(r, c);
 }
 
 mixsph_status case_parse(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,

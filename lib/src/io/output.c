@@ -63,6 +63,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "monitors.h"
 #include "sim.h"
 #include "status.h"
@@ -645,11 +646,11 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
 mixsph_status output_snapshot(mixsph_sim *s)
 {
     const long index = s->snap_index;
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
     if (s->csv_snapshots_off) s->snap_index++;
     else st = monitors_snapshot(s);
-    const double t1 = sim_clock_s();
+    const double t1 = clock_monotonic_s();
     s->out_seconds[T_CSV] += t1 - t0;
     struct output *o = s->h5;
     if (st != MIXSPH_OK || !o) return st;
@@ -662,7 +663,7 @@ mixsph_status output_snapshot(mixsph_sim *s)
     if (snaps_push(o, (struct snap_rec){index, s->t, s->step, s->P.n}))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     if (xdmf_write(s, o) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));
-    s->out_seconds[T_HDF5] += sim_clock_s() - t1;
+    s->out_seconds[T_HDF5] += clock_monotonic_s() - t1;
     return MIXSPH_OK;
 }
 
@@ -695,7 +696,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
 {
     if (!s) return MIXSPH_ERR_ARG;
     if (!path || !*path) return SIM_FAIL(s, MIXSPH_ERR_ARG, "checkpoint: no file name");
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     void *buf = NULL;
     size_t len = 0;
     mixsph_status st = mixsph_sim_save_state(s, &buf, &len);
@@ -743,7 +744,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     }
     if (bad) remove(tmp);
     free(tmp);
-    const double spent = sim_clock_s() - t0;
+    const double spent = clock_monotonic_s() - t0;
     s->out_seconds[T_CKPT] += spent;
     s->run_wall_s += spent; /* the run's time includes its checkpoints (after this one's attribute) */
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;

@@ -4,7 +4,10 @@
 #ifndef MIXSPH_INTEGRATE_H
 #define MIXSPH_INTEGRATE_H
 
-#include "sim.h"
+#include "sim_object.h"
+
+/** What the pair loops of forces.h run over, from the simulation's current parts and options. */
+struct pair_system sim_pair_system(mixsph_sim *s);
 
 /** Sort the particles by cell (marking those that left the domain lost) and rebuild the pair
  *  ranges, the gather lists and the near-wall flags. */
