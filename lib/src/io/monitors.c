@@ -26,6 +26,7 @@
 #include <string.h>
 
 #include "monitors.h"
+#include "particle_fields.h"
 
 #include "status.h"
 
@@ -265,18 +266,57 @@ mixsph_status monitors_sample(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-/* Particle snapshot as CSV (snap_NNNN.csv): one row per particle, walls included. */
+/* The fields of the CSV snapshots, in their column order: the PF_KEY rows of the particle-field
+ * table first, then its other PF_CSV rows in table order (those the simulation has). */
+static size_t csv_fields(const struct particles *P, const struct particle_field **out)
+{
+    size_t n = 0;
+    for (unsigned key = 2; key-- > 0;)
+        for (size_t k = 0; k < particle_field_count; k++) {
+            const struct particle_field *f = &particle_fields[k];
+            if ((f->where & PF_CSV) && !!(f->where & PF_KEY) == (int)key && particle_field_present(f, P->features))
+                out[n++] = f;
+        }
+    return n;
+}
+
+/* One value: %.*g with the field's digits, integers as %u. */
+static void csv_value(FILE *f, const struct particle_field *pf, const void *a, size_t i)
+{
+    switch (pf->type) {
+    case PF_F64: fprintf(f, "%.*g", pf->csv_digits, ((const double *)a)[i]); break;
+    case PF_U8: fprintf(f, "%u", (unsigned)((const uint8_t *)a)[i]); break;
+    case PF_U16: fprintf(f, "%u", (unsigned)((const uint16_t *)a)[i]); break;
+    case PF_U32: fprintf(f, "%u", (unsigned)((const uint32_t *)a)[i]); break;
+    }
+}
+
+/* Particle snapshot as CSV (snap_NNNN.csv): a line "# t = T s", a header of the column names,
+ * one row per particle, walls included. */
 mixsph_status monitors_snapshot(mixsph_sim *s)
 {
     char path[600];
     snprintf(path, sizeof path, "%s/snap_%04d.csv", s->out_dir, s->snap_index);
+    const struct particles *P = &s->P;
+    const struct particle_field *cols[64];
+    const void *arrays[64][PARTICLE_FIELD_MAX_COMPONENTS];
+    if (particle_field_count > 64) return SIM_FAIL(s, MIXSPH_ERR_ARG, "%s: more particle fields than 64", path);
+    const size_t nc = csv_fields(P, cols);
+    for (size_t c = 0; c < nc; c++)
+        for (unsigned k = 0; k < cols[c]->components; k++) arrays[c][k] = particles_array(P, cols[c]->member[k]);
     FILE *f = fopen(path, "w");
     if (!f) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-    const struct particles *P = &s->P;
-    fprintf(f, "# t = %.9g s\nid,x,z,vx,vz,rho,p,mu,medium,state\n", s->t);
-    for (size_t i = 0; i < P->n; i++)
-        fprintf(f, "%u,%.7g,%.7g,%.6g,%.6g,%.7g,%.6g,%.6g,%u,%u\n", P->id[i], P->x[i], P->z[i], P->vx[i], P->vz[i],
-                P->rho[i], P->p[i], P->mu[i], P->medium[i], P->state[i]);
+    fprintf(f, "# t = %.9g s\n", s->t);
+    for (size_t c = 0; c < nc; c++) fprintf(f, "%s%s", c ? "," : "", cols[c]->columns);
+    fputc('\n', f);
+    for (size_t i = 0; i < P->n; i++) {
+        for (size_t c = 0; c < nc; c++)
+            for (unsigned k = 0; k < cols[c]->components; k++) {
+                if (c || k) fputc(',', f);
+                csv_value(f, cols[c], arrays[c][k], i);
+            }
+        fputc('\n', f);
+    }
     const int bad = ferror(f);
     if (fclose(f) != 0 || bad) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: write failed", path);
     s->snap_index++;
