@@ -616,13 +616,22 @@ static hid_t field_mem_type(enum particle_field_type t)
  * row = the particle's id when the ids are 0..n-1 (by_id), else storage order. */
 static int write_field(struct output *o, hid_t g, const struct particles *P, int by_id, const struct particle_field *f)
 {
-    const size_t n = P->n, m = f->components, elem = particle_field_size(f->type);
-    char *buf = scratch(o, (n ? n : 1) * m * elem);
+    const size_t n = P->n, m = f->components;
+    void *buf = scratch(o, (n ? n : 1) * m * particle_field_size(f->type));
     if (!buf) return -1;
-    for (unsigned c = 0; c < m; c++) {
-        const char *a = particles_array(P, f->member[c]);
-        for (size_t i = 0; i < n; i++) memcpy(buf + ((by_id ? P->id[i] : i) * m + c) * elem, a + i * elem, elem);
-    }
+#define GATHER(T)                                                                         \
+    do {                                                                                  \
+        const T *a_ = particles_array(P, f->member[c]);                                   \
+        T *b_ = buf;                                                                      \
+        for (size_t i = 0; i < n; i++) b_[(by_id ? P->id[i] : i) * m + c] = a_[i];       \
+    } while (0)
+    for (unsigned c = 0; c < m; c++) switch (f->type) {
+        case PF_F64: GATHER(double); break;
+        case PF_U8: GATHER(uint8_t); break;
+        case PF_U16: GATHER(uint16_t); break;
+        case PF_U32: GATHER(uint32_t); break;
+        }
+#undef GATHER
     return dset_write(g, f->name, field_file_type(f->type), field_mem_type(f->type), n, m > 1 ? m : 0, buf, f->unit,
                       f->description);
 }
