@@ -105,6 +105,8 @@ mixsph_status mixsph_case_parameter_names(const char *case_path, char *names, si
 
 /* ---- particle fields: the rows of the particle-field table marked PF_VIEW the simulation has -- */
 
+_Static_assert(PARTICLE_FIELD_MAX_COMPONENTS == MIXSPH_FIELD_MAX_COMPONENTS, "the view holds every component");
+
 static const struct particle_field *view_field(const mixsph_sim *s, size_t k)
 {
     for (size_t r = 0; r < particle_field_count; r++) {
