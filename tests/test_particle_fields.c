@@ -157,7 +157,8 @@ static void test_view_shows_the_view_rows(void **state)
     mixsph_sim *s = make(0);
     assert_int_equal(mixsph_sim_step(s), MIXSPH_OK);
     size_t rows = 0;
-    for (size_t k = 0; k < particle_field_count; k++) rows += (particle_fields[k].where & PF_VIEW) != 0;
+    for (size_t k = 0; k < particle_field_count; k++)
+        rows += (particle_fields[k].where & PF_VIEW) && particle_field_present(&particle_fields[k], s->P.features);
     assert_int_equal(mixsph_sim_particle_field_count(s), rows);
     mixsph_particles_view v;
     assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
