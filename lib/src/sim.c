@@ -18,6 +18,7 @@
 #include "integrate.h"
 #include "monitors.h"
 #include "output.h"
+#include "particle_fields.h"
 #include "status.h"
 
 /* A lattice site of a body, for the hydrostatic initialisation. */
@@ -116,6 +117,9 @@ static mixsph_status fill_bodies(mixsph_sim *s)
                         "(numerics.max_particles)", s->cfg.origin, dx, n, s->cfg.max_particles);
     }
     qsort(sites, n, sizeof *sites, site_cmp);
+    s->P.features = s->cfg.viscosity_implicit ? PARTICLE_FEATURE_IMPLICIT_VISCOUS : 0u;
+    for (size_t k = 0; k < s->cfg.n_media; k++)
+        if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->P.features |= PARTICLE_FEATURE_STRESS;
     if (particles_alloc(&s->P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
