@@ -4,6 +4,7 @@
 
 #include "budget.h"
 #include "law_registry.h"
+#include "state.h"
 
 #include <errno.h>
 #include <math.h>
@@ -335,6 +336,60 @@ mixsph_status mixsph_sim_create_interruptible(const char *case_path, const mixsp
     if (st != MIXSPH_OK) return st;
     st = sim_create_from_text(text, case_path, ov, n_ov, interrupt, out, err, err_len);
     free(text);
+    return st;
+}
+
+mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
+{
+    return sim_create_from_state(buf, len, NULL, out, err, err_len);
+}
+
+mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
+                                    char *err, size_t err_len)
+{
+    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
+    *out = NULL;
+    struct state_source src;
+    mixsph_status st = state_read_source(buf, len, &src, err, err_len);
+    mixsph_override *ov = NULL;
+    if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    if (st == MIXSPH_OK) {
+        for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
+        st = sim_create_from_text(src.text, src.origin, ov, src.n_ov, interrupt, out, err, err_len);
+    }
+    free(ov);
+    state_source_free(&src);
+    if (st != MIXSPH_OK) return st;
+    st = mixsph_sim_load_state(*out, buf, len);
+    if (st != MIXSPH_OK) {
+        status_set(err, err_len, st, "%s", (*out)->err);
+        mixsph_sim_destroy(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
+{
+    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
+                                                              mixsph_sim **out, char *err, size_t err_len)
+{
+    if (out) *out = NULL;
+    if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    double run_wall = NAN;
+    mixsph_status st = output_read_checkpoint(path, &buf, &len, &run_wall, err, err_len);
+    if (st == MIXSPH_OK) {
+        char msg[900];
+        st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
+        if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
+        else (*out)->run_wall_s = run_wall;
+    }
+    free(buf);
     return st;
 }
 

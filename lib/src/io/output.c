@@ -70,7 +70,7 @@
 #include "clock.h"
 #include "monitors.h"
 #include "particle_fields.h"
-#include "sim.h"
+#include "sim_object.h"
 #include "status.h"
 
 #ifndef MIXSPH_VERSION
@@ -771,16 +771,12 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;
 }
 
-mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
+mixsph_status output_read_checkpoint(const char *path, unsigned char **state, size_t *len, double *run_wall_s,
+                                     char *err, size_t err_len)
 {
-    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
-}
-
-mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
-                                                              mixsph_sim **out, char *err, size_t err_len)
-{
-    if (out) *out = NULL;
-    if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
+    *state = NULL;
+    *len = 0;
+    *run_wall_s = NAN;
     if (access(path, R_OK) != 0)
         return status_set(err, err_len, MIXSPH_ERR_ARG, "checkpoint %s: cannot read: %s", path, strerror(errno));
     struct quiet q;
@@ -788,7 +784,7 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
     struct cause c;
     mixsph_status st = MIXSPH_OK;
     unsigned char *buf = NULL;
-    size_t len = 0;
+    size_t n_read = 0;
     double run_wall = NAN;
     const hid_t fapl = fapl_nolock();
     const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
@@ -807,7 +803,7 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
         } else if (H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
             st = status_set(err, err_len, MIXSPH_ERR_IO, "checkpoint %s: cannot read /state (HDF5: %s)", path, h5_cause(&c));
         } else {
-            len = (size_t)n;
+            n_read = (size_t)n;
         }
         if (sp >= 0) H5Sclose(sp);
         if (d >= 0) H5Dclose(d);
@@ -817,14 +813,14 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
         H5Fclose(f);
     }
     quiet_off(&q);
-    if (st == MIXSPH_OK) {
-        char msg[900];
-        st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
-        if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
-        else (*out)->run_wall_s = run_wall;
+    if (st != MIXSPH_OK) {
+        free(buf);
+        return st;
     }
-    free(buf);
-    return st;
+    *state = buf;
+    *len = (size_t)n_read;
+    *run_wall_s = run_wall;
+    return MIXSPH_OK;
 }
 
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)

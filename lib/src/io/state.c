@@ -16,7 +16,8 @@
 
 #include "integrate.h"
 #include "particle_fields.h"
-#include "sim.h"
+#include "sim_object.h"
+#include "state.h"
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
@@ -231,15 +232,7 @@ static mixsph_status check_header(struct reader *r, char *err, size_t err_len)
     return MIXSPH_OK;
 }
 
-/* The case source stored in a state: text and origin copied (NUL-terminated), overrides. */
-struct source {
-    char *text, *origin;
-    size_t n_ov;
-    char **keys;
-    double *values;
-};
-
-static void source_free(struct source *src)
+void state_source_free(struct state_source *src)
 {
     for (size_t k = 0; k < src->n_ov; k++) free(src->keys[k]);
     free(src->keys);
@@ -260,7 +253,7 @@ static char *copy_str(struct reader *r)
     return d;
 }
 
-static mixsph_status read_source(struct reader *r, struct source *src, char *err, size_t err_len)
+static mixsph_status read_source(struct reader *r, struct state_source *src, char *err, size_t err_len)
 {
     memset(src, 0, sizeof *src);
     src->text = copy_str(r);
@@ -360,14 +353,14 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     struct reader r = {buf, len, 0, 0};
     mixsph_status st = check_header(&r, s->err, sizeof s->err);
     if (st != MIXSPH_OK) return st;
-    struct source src;
+    struct state_source src;
     st = read_source(&r, &src, s->err, sizeof s->err);
     if (st == MIXSPH_OK && !state_same_case(s, src.text, (const char *const *)src.keys, src.values, src.n_ov))
         st = SIM_FAIL(s, MIXSPH_ERR_ARG,
                       "state: saved from another case or other overrides (%s) than this simulation's (%s); create a "
                       "new simulation from the state instead",
                       src.origin, s->case_origin);
-    source_free(&src);
+    state_source_free(&src);
     if (st != MIXSPH_OK) return st;
     /* keep a copy so that a malformed payload leaves the simulation unchanged */
     mixsph_sim *keep = malloc(sizeof *keep);
@@ -403,35 +396,10 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     return st;
 }
 
-mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
+mixsph_status state_read_source(const void *buf, size_t len, struct state_source *src, char *err, size_t err_len)
 {
-    return sim_create_from_state(buf, len, NULL, out, err, err_len);
-}
-
-mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
-                                    char *err, size_t err_len)
-{
-    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
-    *out = NULL;
+    memset(src, 0, sizeof *src);
     struct reader r = {buf, len, 0, 0};
-    mixsph_status st = check_header(&r, err, err_len);
-    if (st != MIXSPH_OK) return st;
-    struct source src;
-    st = read_source(&r, &src, err, err_len);
-    mixsph_override *ov = NULL;
-    if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
-    if (st == MIXSPH_OK) {
-        for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
-        st = sim_create_from_text(src.text, src.origin, ov, src.n_ov, interrupt, out, err, err_len);
-    }
-    free(ov);
-    source_free(&src);
-    if (st != MIXSPH_OK) return st;
-    st = mixsph_sim_load_state(*out, buf, len);
-    if (st != MIXSPH_OK) {
-        status_set(err, err_len, st, "%s", (*out)->err);
-        mixsph_sim_destroy(*out);
-        *out = NULL;
-    }
-    return st;
+    const mixsph_status st = check_header(&r, err, err_len);
+    return st != MIXSPH_OK ? st : read_source(&r, src, err, err_len);
 }
