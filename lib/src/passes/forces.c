@@ -138,6 +138,16 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
     return kernel_f_q(&X->K, kernel_q(&X->K, r2), wendland);
 }
 
+/* The skeleton every pair pass runs over particle i's candidates: its nr ranges
+ * [rng[2r], rng[2r + 1]) of the neighbour lists, in chunks of FORCES_CHUNK lanes from jb, the
+ * first `lanes` of them inside the range (the rest masked off by FORCES_LANE_IN; the innermost
+ * loop runs once, to declare it). A pass's body evaluates its pair term on the chunk's lanes with
+ * `omp simd` and adds what j receives with chunk_add. */
+#define FORCES_FOR_EACH_CHUNK(rng, nr, jb, lanes)                                                  \
+    for (int r_ = 0; r_ < (nr); r_++)                                                               \
+        for (size_t jb = (rng)[2 * r_], e_ = (rng)[2 * r_ + 1]; jb < e_; jb += FORCES_CHUNK)        \
+            for (size_t lanes = e_ - jb < FORCES_CHUNK ? e_ - jb : FORCES_CHUNK, once_ = 1; once_; once_ = 0)
+
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
 #define FORCES_LANE_IN(k, m) ((k) < (m) ? 1.0 : 0.0)
 
@@ -164,9 +174,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -207,9 +215,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
     const double *restrict vol = P->vol, *restrict tag = P->tag;
     const struct pair_ctx Xl = *X;
     double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -245,9 +251,7 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
     const double *restrict vol = P->vol;
     const struct pair_ctx Xl = *X;
     double a[7][FORCES_CHUNK] = {{0}};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
@@ -292,9 +296,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t n = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, n) {
         double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -414,9 +416,7 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
     double *restrict ox = X->out_x, *restrict oz = X->out_z, *restrict od = X->out_diag;
     const double uxi = ux[i], uzi = uz[i];
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}, sd[FORCES_CHUNK] = {0};
-    for (int r = 0; r < 2; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
         double jx[FORCES_CHUNK], jz[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -471,9 +471,7 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
         double *gw = X->group_w + 5 * (size_t)gi;
         const uint32_t *rng = NB->rng + 4 * i;
         const double *wl = X->visc_w + X->fk_off[i];
-        for (int r = 0; r < 2; r++)
-            for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-                const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
                 for (size_t k = 0; k < m; k++) {
                     const int32_t gj = group[jb + k];
                     if (gj < 0) continue;
