@@ -209,6 +209,10 @@ static mixsph_status create_laws(mixsph_sim *s)
             return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (the state of the material law of medium %s)",
                             s->cfg.media[k].name);
     }
+    if (s->law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
+        for (size_t i = 0; i < s->P.n; i++)
+            s->P.wall_rough[i] = s->P.state[i] == MIXSPH_STATE_WALL &&
+                                 s->cfg.walls[particles_wall_index(&s->P, i)].slip == WALL_NO_SLIP;
     if ((s->law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->grad, s->P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
     return MIXSPH_OK;

@@ -36,6 +36,8 @@ struct particles {
     double *sxx, *sxz, *szz; /* deviatoric stress in the plane [Pa] (tension positive; laws with
                               * LAW_HAS_STRESS, 0 elsewhere); walls: their neighbours' (walls.c) */
     double *syy;          /* its out-of-plane component (plane strain) [Pa] */
+    double *wall_rough;   /* wall particles: 1 where the wall takes the stress of the solid it meets (a
+                           * no-slip wall), 0 where it takes none (free-slip); 0 for the others [-] */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index
                            * (read it through particles_wall_index) */
     uint8_t *state;       /* MIXSPH_STATE_* */

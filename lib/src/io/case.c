@@ -257,12 +257,20 @@ static double entry_number(const void *entry, const char *key)
 static mixsph_status read_medium(const struct case_reader *r, const cJSON *it, const char *path, struct case_def *c,
                                  struct medium *md)
 {
-    struct case_choice types[LAW_COUNT + 1];
-    for (int id = 0; id < LAW_COUNT; id++) types[id] = (struct case_choice){law_get(id)->type, id};
-    types[LAW_COUNT] = (struct case_choice){NULL, 0};
+    struct case_choice types[LAW_COUNT + 1]; /* each type once, with its first law */
+    size_t n_types = 0;
+    for (int id = 0; id < LAW_COUNT; id++) {
+        size_t k = 0;
+        while (k < n_types && strcmp(types[k].name, law_get(id)->type) != 0) k++;
+        if (k == n_types) types[n_types++] = (struct case_choice){law_get(id)->type, id};
+    }
+    types[n_types] = (struct case_choice){NULL, 0};
     const struct case_key type_key = {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = types,
                                       .field = CASE_FIELD(medium, law)};
     TRY(case_schema_read_key(r, it, path, &type_key, md));
+    /* a type with several laws: its key `law` (a row of each of their tables) chooses one */
+    const struct case_key *law_key = case_schema_key(law_get(md->law)->keys, "law");
+    if (law_key) TRY(case_schema_read_key(r, it, path, law_key, md));
     const struct material_law *law = law_get(md->law);
     TRY(case_schema_read(r, it, path, law->keys, 0, md));
     if (case_schema_key(law->keys, "K") && case_schema_key(law->keys, "c") && !item(it, "K") == !item(it, "c"))

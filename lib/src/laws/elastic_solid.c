@@ -81,6 +81,7 @@ static long elastic_update(void *state, const struct law_step *step)
 
 const struct material_law law_elastic_solid = {
     .type = "elastic",
+    .name = "linear",
     .keys = &elastic_section,
     .features = LAW_USES_GRADIENT | LAW_HAS_STRESS,
     .finish = elastic_finish,

@@ -54,11 +54,19 @@ struct law_step {
     const struct gather *G;                  /* gather ranges (all neighbours of those particles) */
     const struct kernel *K;
     double dt;                               /* the step the state advances over [s]; 0: no advance */
+    double p_background;                     /* the equation of state's background pressure [Pa] */
     int n_threads;
 };
 
+/* The laws of type "granular": the choices of media.<name>.law, a row of each of their key tables
+ * (the first, the paper's, is the default). */
+static const struct case_choice law_granular_choices[] = {
+    {"paper", LAW_MIXTURE_PAPER}, {"elastic_plastic", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
+
 struct material_law {
     const char *type;                 /* media.<name>.type that selects it */
+    const char *name;                 /* media.<name>.law among the laws of one type (the first
+                                         registered is the type's default) */
     const struct case_section *keys;  /* its keys: the section media.<type> */
     unsigned features;                /* enum law_feature */
     /** Rules between its keys and the values it derives (after the keys are read); a message

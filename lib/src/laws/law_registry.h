@@ -7,9 +7,6 @@
 /** The law of id `id` (enum law_id), NULL if none. */
 const struct material_law *law_get(int id);
 
-/** The id of the law whose medium type is `type` ("fluid", "granular", ...), -1 if none. */
-int law_find_type(const char *type);
-
 /** The fastest wave of the media [m/s] (the acoustic bound of the time step). */
 double law_max_wave_speed(const struct medium *media, size_t n_media);
 

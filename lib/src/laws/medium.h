@@ -13,6 +13,7 @@ enum law_id {
     LAW_NEWTONIAN = 0,     /* "fluid": Newtonian viscosity (laws/newtonian.c) */
     LAW_MIXTURE_PAPER = 1, /* "granular": the paper's KTGF mixture with mu_thr / mu0 (laws/mixture_paper.c) */
     LAW_ELASTIC_SOLID = 2, /* "elastic": a linear-elastic solid, Jaumann rate (laws/elastic_solid.c) */
+    LAW_ELASTIC_PLASTIC = 3, /* "granular" with law "elastic_plastic": Drucker-Prager (laws/elastic_plastic.c) */
     LAW_COUNT
 };
 
@@ -49,6 +50,10 @@ struct medium {
     double poisson;        /* nu [-] */
     double shear_modulus;  /* G = E / (2 (1 + nu)) [Pa] */
     double bulk_modulus;   /* K = E / (3 (1 - 2 nu)) [Pa]: the equation of state's, c = sqrt(K / rho0) */
+    /* the elastic-perfectly-plastic granular law (also phi_deg, porosity, rho_grain, poisson) */
+    double cohesion;       /* c [Pa] */
+    double dilatancy_deg;  /* psi [deg] */
+    double alpha_phi, k_c, alpha_psi; /* the plane-strain matched Drucker-Prager cone (drucker_prager.h) */
 };
 
 #endif

@@ -53,6 +53,9 @@ static const struct case_choice granular_type[] = {{"granular", LAW_MIXTURE_PAPE
 static const struct case_key granular_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_type,
      .field = CASE_FIELD(medium, law), .meaning = "\"granular\": a mixture at the packing limit"},
+    {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices,
+     SCHEMA_DEF(LAW_MIXTURE_PAPER), .field = CASE_FIELD(medium, law),
+     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
      .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
@@ -353,6 +356,7 @@ static long mixture_update(void *state, const struct law_step *step)
 
 const struct material_law law_mixture_paper = {
     .type = "granular",
+    .name = "paper",
     .keys = &granular_section,
     .features = LAW_USES_GRADIENT,
     .finish = granular_finish,

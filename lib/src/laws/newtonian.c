@@ -37,6 +37,7 @@ static double fluid_viscosity_bound(const struct medium *m) { return m->mu; }
 
 const struct material_law law_newtonian = {
     .type = "fluid",
+    .name = "newtonian",
     .keys = &fluid_section,
     .features = 0,
     .finish = fluid_finish,

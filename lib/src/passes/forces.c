@@ -294,6 +294,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict avc = P->avc;
     const double *restrict sxx = P->sxx, *restrict sxz = P->sxz, *restrict szz = P->szz;
     const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
+    const double *restrict wall_rough = P->wall_rough;
+    const double roughi = stress ? wall_rough[i] : 0.0;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, n) {
@@ -340,8 +342,11 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 fx = F * (fr * rx + fv * (uvxi - uvx[j]));
                 fz = F * (fr * rz + fv * (uvzi - uvz[j]));
             }
-            if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W (walls hold none) */
-                const double txx = vv * (sxxi + sxx[j]), txz = vv * (sxzi + sxz[j]), tzz = vv * (szzi + szz[j]);
+            if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W; a wall holds none,
+                           * and a rough (no-slip) wall takes the stress of the particle it meets */
+                const double ci = 1.0 + wall_rough[j], cj = 1.0 + roughi;
+                const double txx = vv * (ci * sxxi + cj * sxx[j]), txz = vv * (ci * sxzi + cj * sxz[j]);
+                const double tzz = vv * (ci * szzi + cj * szz[j]);
                 fx += F * (txx * rx + txz * rz);
                 fz += F * (txz * rx + tzz * rz);
             }

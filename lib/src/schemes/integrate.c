@@ -184,7 +184,8 @@ int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 void integrate_update_laws(mixsph_sim *s, double law_dt)
 {
     const struct law_step step = {.P = &s->P, .n = active_particles(s), .media = s->cfg.media, .grad = &s->grad,
-                                  .G = &s->G, .K = &s->K, .dt = law_dt, .n_threads = SIM_THREADS(s)};
+                                  .G = &s->G, .K = &s->K, .dt = law_dt,
+                                  .p_background = s->cfg.p_background, .n_threads = SIM_THREADS(s)};
     for (int id = 0; id < LAW_COUNT; id++) {
         const struct material_law *law = law_get(id);
         if (!law->update || !law_in_use(s, id)) continue;
