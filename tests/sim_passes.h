@@ -21,11 +21,8 @@ static inline int sim_momentum_pass(mixsph_sim *s)
     return forces_momentum(s->forces, &S);
 }
 
-/* Regimes of the grains. */
-static inline void sim_mixture_update(mixsph_sim *s)
-{
-    s->n_fixed = mixture_update(s->mixture, &s->K, &s->G, &s->P, s->C.start[s->C.ncell], SIM_THREADS(s));
-}
+/* Regimes of the grains (the material laws' updates at the current state). */
+static inline void sim_mixture_update(mixsph_sim *s) { integrate_update_laws(s, 0.0); }
 
 /* SPHERA's pressure smoothing with the case's theta_P and the current dt. */
 static inline void sim_smooth_pressure(mixsph_sim *s)

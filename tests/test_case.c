@@ -624,7 +624,7 @@ static void test_table_defaults(void **state)
     assert_int_equal(c.monitors[0].min_neighbours, 3);
     assert_true(c.monitors[0].x_min == -INFINITY && c.monitors[0].z_max == INFINITY);
     const struct medium *sand = &c.media[1];
-    assert_int_equal(sand->kind, MEDIUM_GRANULAR);
+    assert_int_equal(sand->law, LAW_MIXTURE_PAPER);
     assert_true(sand->mu0 == INFINITY && sand->alpha_m == 0.0);
     assert_true(sand->saturated == 0 && sand->tension_cutoff == 0 && sand->hold_fixed == 0 && sand->pore_fluid == -1);
     assert_true(sand->rho0 == (1.0 - 0.35) * 2650.0);

@@ -37,9 +37,9 @@
  *     varies from grain to grain (mu_ij -> 0 next to any grain whose mu -> 0). The test asserts
  *     what holds today (all grains mobile after the first step, within 0.1 dx at t = 0.02 s, no
  *     grain through the floor) and the criterion over 0.1 s is kept as a known failure:
- *     `test_granular known_failure heap_mobile` (CTest test_granular_known_heap_mobile,
- *     WILL_FAIL) fails while the heap moves, so CTest reports it the day the rheology holds the
- *     heap.
+ *     `test_granular known_failure heap_mobile` (CTest test_granular_known_heap_mobile) passes
+ *     while the heap moves as far as it does today (known_failure.h), so CTest reports both the
+ *     day the rheology holds the heap and a heap that moves much farther.
  * (a3) The heap with the implicit viscous step and mu0 off (mu0 = mu_thr): the grains carry their
  *     full frictional viscosity. With mu_thr = 1e12 Pa s it stays at rest over 1 s (the criterion
  *     of (a2), met); with the Vajont mu_thr = 320 kPa s it holds until about 0.35 s and then
@@ -64,6 +64,7 @@
 
 #include <cmocka.h>
 
+#include "known_failure.h"
 #include "mixsph.h"
 
 #define PI 3.14159265358979323846
@@ -240,14 +241,24 @@ static void test_heap_mobile(void **state)
     assert_true(worst <= 0.1 * HEAP_DX);
 }
 
+/* Today's band of test_heap_mobile_at_rest: the largest displacement over 0.1 s, 0.759452 dx,
+ * measured on 2026-12-06 (GCC 12, -O3, aa173ae with these tests), the same to 6 digits at 1
+ * and 2 threads. Margin 20 % of the value (0.61-0.91 dx): the run is deterministic, so
+ * the margin is what counts as a change, wide because the heap's motion is a growing instability
+ * (kinetic energy x26 over 0.1 s) that small changes of the numerics shift, and still well clear
+ * of the criterion (0.1 dx). */
+#define HEAP_MOBILE_MEASURED 0.7595
+#define HEAP_MOBILE_MARGIN 0.20
 /* (a2) the criterion: at rest to 0.1 dx over 0.1 s. A known failure (header). */
 static void test_heap_mobile_at_rest(void **state)
 {
     (void)state;
     const double worst = mobile_heap(MOBILE_T);
     /* reference: at rest (slope 25 deg < phi = 35 deg, up to the creep of mu0: below 0.068 dx
-     * by t = 0.1 s, header); tolerance 0.1 dx (issue) */
-    assert_true(worst <= 0.1 * HEAP_DX);
+     * by t = 0.1 s, header); tolerance 0.1 dx (issue). Not met: today's band is the measured
+     * largest displacement, HEAP_MOBILE_MEASURED, +- HEAP_MOBILE_MARGIN */
+    known_failure_check("heap_mobile", worst <= 0.1 * HEAP_DX, worst / HEAP_DX,
+                        HEAP_MOBILE_MEASURED * (1.0 - HEAP_MOBILE_MARGIN), HEAP_MOBILE_MEASURED * (1.0 + HEAP_MOBILE_MARGIN));
 }
 
 /* ---- (a3) the heap with the implicit viscous step and no limiting viscosity ------------------ */
@@ -305,6 +316,13 @@ static void test_heap_implicit_frictional(void **state)
     assert_true(worst <= 0.1 * HEAP_DX);
 }
 
+/* Today's band of test_heap_implicit_vajont: the largest displacement over 1 s, 3.05896 dx,
+ * measured on 2026-12-06 (GCC 12, -O3, aa173ae with these tests), the same to 6 digits at 1
+ * and 2 threads. Margin 25 % of the value (2.29-3.82 dx): wider than the mobile heap's
+ * because the slump follows a release at about 0.35 s (header) and what 1 s shows of it moves
+ * with the moment of that release; far from the criterion (0.1 dx). */
+#define HEAP_VAJONT_MEASURED 3.059
+#define HEAP_VAJONT_MARGIN 0.25
 /* mu_thr = 320 kPa s (the Vajont case's), held grains "solved" (unknowns of the viscous solve at
  * mu_thr): within the step a held grain is a fluid of viscosity mu_thr, so the heap creeps at
  * about rho g S d^2 / (2 mu_thr) ~ 1e-4 m/s and about half its grains, those whose creep gives
@@ -319,8 +337,11 @@ static void test_heap_implicit_vajont(void **state)
     (void)state;
     size_t mobile = 0;
     const double worst = implicit_heap(320.0e3, 0, 0, 1.0, &mobile);
-    /* reference: at rest (slope 25 deg < phi = 35 deg); tolerance 0.1 dx (issue) over 1 s */
-    assert_true(worst <= 0.1 * HEAP_DX);
+    /* reference: at rest (slope 25 deg < phi = 35 deg); tolerance 0.1 dx (issue) over 1 s. Not
+     * met: today's band is the measured largest displacement, HEAP_VAJONT_MEASURED, +-
+     * HEAP_VAJONT_MARGIN */
+    known_failure_check("heap_implicit_vajont", worst <= 0.1 * HEAP_DX, worst / HEAP_DX,
+                        HEAP_VAJONT_MEASURED * (1.0 - HEAP_VAJONT_MARGIN), HEAP_VAJONT_MEASURED * (1.0 + HEAP_VAJONT_MARGIN));
 }
 
 /* The same heap with rigid held grains (numerics.held_grains = "rigid"): prescribed at rest in the
@@ -558,6 +579,13 @@ static void test_column_collapse(void **state)
     assert_true(runout <= RUNOUT_HI + FRONT_TOL);
 }
 
+/* Today's band of test_column_runout: the run-out, 0.992966 r0,
+ * measured on 2026-12-06 (GCC 12, -O3, aa173ae with these tests), the same to 6 digits at 1
+ * and 2 threads. Margin 0.04 r0 (0.64 dx; band 0.953-1.033 r0): the run-out of a
+ * collapse that stops is a settled quantity, so a fraction of a particle spacing is a change;
+ * the band ends below the criterion's lower edge (1.2 - 0.163 = 1.037 r0). */
+#define COLUMN_RUNOUT_MEASURED 0.993
+#define COLUMN_RUNOUT_MARGIN 0.04
 /* (b) the criterion: within the experiments' band, to 2h. A known failure (comment above). */
 static void test_column_runout(void **state)
 {
@@ -566,13 +594,17 @@ static void test_column_runout(void **state)
     print_message("run-out %.3f r0 against the experiments' %.1f to %.1f r0, tolerance 2h = %.3f r0\n", runout, RUNOUT_LO,
                   RUNOUT_HI, FRONT_TOL);
     /* reference: lambda a with lambda = 1.2 (Lube et al. 2005) to 1.8 (Lajeunesse et al. 2005),
-     * a = 1; tolerance 2h / r0 = 0.16 (the kernel support) */
-    assert_true(runout >= RUNOUT_LO - FRONT_TOL && runout <= RUNOUT_HI + FRONT_TOL);
+     * a = 1; tolerance 2h / r0 = 0.16 (the kernel support). Not met: today's band is the
+     * measured run-out, COLUMN_RUNOUT_MEASURED, +- COLUMN_RUNOUT_MARGIN */
+    known_failure_check("column_runout", runout >= RUNOUT_LO - FRONT_TOL && runout <= RUNOUT_HI + FRONT_TOL, runout,
+                        COLUMN_RUNOUT_MEASURED - COLUMN_RUNOUT_MARGIN, COLUMN_RUNOUT_MEASURED + COLUMN_RUNOUT_MARGIN);
 }
 
 /* `test_granular` runs the tests the model meets; `test_granular known_failure NAME` one of the
- * criteria it does not meet yet (header): heap_mobile or column_runout. CTest runs each of these
- * on its own and expects it to fail (WILL_FAIL), so each reports the day the model meets it. */
+ * criteria it does not meet yet (header): heap_mobile, heap_implicit_vajont or column_runout.
+ * CTest runs each of these on its own; each passes while its criterion is not met and its value
+ * stays in today's band (known_failure.h), so it reports both the day the model meets the
+ * criterion and a regression. */
 int main(int argc, char **argv)
 {
     if (argc > 2 && strcmp(argv[1], "known_failure") == 0) {

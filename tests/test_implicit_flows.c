@@ -40,6 +40,7 @@
 
 #include <cmocka.h>
 
+#include "known_failure.h"
 #include "sim.h"
 
 #define PI 3.14159265358979323846
@@ -234,15 +235,28 @@ static void test_couette_50x(void **state)
 /* The Couette start-up before tau1 (0.25 and 0.5 tau1: 3 and 6 steps at 20x, 2 and 3 at 50x)
  * does not meet 2 % (measured 3.3 % and 4.9 % of U at the first instant): the impulsive start
  * excites every mode, and the viscous step's SDIRK2 (viscous.c), second order, still carries
- * them a few % off over its first steps. A known failure (CTest WILL_FAIL), so that the
+ * them a few % off over its first steps. A known failure (known_failure.h), so that the
  * tolerance stays what the criterion asks. */
+/* Today's band of test_couette_early: the largest error before tau1 [% of U], measured at 20x
+ * 3.316102139 and at 50x 4.925835592, the same to 10 digits at 1 and 2 threads (GCC 12, -O3; the
+ * flow is smooth, not sensitive to rounding). Margin 5 % of the value (0.17 and 0.25 % of U): far
+ * above rounding, far below the distance to the criterion (1.3 and 2.9 % of U), so a change of
+ * the scheme or the solver that moves the early error by a twentieth shows. */
+#define COUETTE_EARLY_20X 3.3161
+#define COUETTE_EARLY_50X 4.9258
+#define COUETTE_EARLY_MARGIN 0.05
 static void test_couette_early(void **state)
 {
     (void)state;
     const struct flow f20 = couette_flow(330.0), f50 = couette_flow(820.0);
-    /* reference: the series solution (header); tolerance 2 % of U */
-    assert_true(flow_error_between(&f20, 20.0, 0.0, 0.99) <= 0.02);
-    assert_true(flow_error_between(&f50, 50.0, 0.0, 0.99) <= 0.02);
+    const double e20 = flow_error_between(&f20, 20.0, 0.0, 0.99), e50 = flow_error_between(&f50, 50.0, 0.0, 0.99);
+    /* reference: the series solution (header); tolerance 2 % of U, both flows. Not met: today's
+     * bands are the measured errors [% of U], COUETTE_EARLY_20X and _50X, +- COUETTE_EARLY_MARGIN */
+    const int met = e20 <= 0.02 && e50 <= 0.02;
+    known_failure_check("couette_early 20x", met, 100.0 * e20, COUETTE_EARLY_20X * (1.0 - COUETTE_EARLY_MARGIN),
+                        COUETTE_EARLY_20X * (1.0 + COUETTE_EARLY_MARGIN));
+    known_failure_check("couette_early 50x", met, 100.0 * e50, COUETTE_EARLY_50X * (1.0 - COUETTE_EARLY_MARGIN),
+                        COUETTE_EARLY_50X * (1.0 + COUETTE_EARLY_MARGIN));
 }
 
 static void test_poiseuille_20x(void **state)
@@ -274,7 +288,8 @@ static void test_two_layer_couette(void **state)
 }
 
 /* `test_implicit_flows` runs the tests the scheme meets; `test_implicit_flows known_failure
- * couette_early` the criterion it does not meet yet (CTest expects it to fail, WILL_FAIL). */
+ * couette_early` the criterion it does not meet yet: it passes while the criterion is not met and
+ * the errors stay in today's band (known_failure.h). */
 int main(int argc, char **argv)
 {
     if (argc > 2 && strcmp(argv[1], "known_failure") == 0) {

@@ -86,7 +86,7 @@ static void expect_error(const char *media, const char *key)
 
 static int is_grain(const mixsph_sim *s, size_t i)
 {
-    return s->P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->P.medium[i]].kind == MEDIUM_GRANULAR;
+    return s->P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->P.medium[i]].law == LAW_MIXTURE_PAPER;
 }
 
 static void assert_rel(double got, double want, double rel)
@@ -104,7 +104,7 @@ static void test_parse_dry(void **state)
     (void)state;
     mixsph_sim *s = create_ok(DRY_SAND);
     const struct medium *m = &s->cfg.media[0];
-    assert_int_equal(m->kind, MEDIUM_GRANULAR);
+    assert_int_equal(m->law, LAW_MIXTURE_PAPER);
     assert_rel(m->rho0, (1.0 - POR) * RHO_S, 1e-15);   /* (5), dry: (1 - n) rho_s = 1722.5 */
     assert_rel(m->c, sqrt(K_S / RHO_S), 1e-15);         /* sqrt(K_s / rho_s) = 40 m/s, not of the mixture */
     assert_rel(m->sin_phi, sin(PHI * GEOM_PI / 180.0), 1e-15);
@@ -133,7 +133,7 @@ static void test_parse_saturated(void **state)
     (void)state;
     mixsph_sim *s = create_ok(WATER ", " WET_SAND);
     const struct medium *m = &s->cfg.media[1];
-    assert_int_equal(m->kind, MEDIUM_GRANULAR);
+    assert_int_equal(m->law, LAW_MIXTURE_PAPER);
     assert_int_equal(m->saturated, 1);
     assert_int_equal(m->pore_fluid, 0);
     assert_rel(m->rho0, POR * 1000.0 + (1.0 - POR) * RHO_S, 1e-15); /* (5), saturated: 2072.5 kg/m3 */

@@ -147,9 +147,11 @@ void mixsph_sim_output_extremes(const mixsph_sim *s, size_t k, double *max, doub
 /** Index of an output by name, or -1. */
 long mixsph_sim_output_find(const mixsph_sim *s, const char *name);
 
-/** Read-only view of the particles (for tools and tests): arrays of length n (fluid, granular
- *  and wall particles, told apart by `state`); the order changes every step (sorted by cell),
- *  `id` is stable. For wall particles `medium` is the wall's index. */
+/** Read-only view of the core particle fields (for tools and tests): arrays of length n (fluid,
+ *  granular and wall particles, told apart by `state`); the order changes every step (sorted by
+ *  cell), `id` is stable. For wall particles `medium` is the wall's index. Every field of a
+ *  simulation, those a material law or a scheme declares included, is read by name or index with
+ *  mixsph_sim_particle_field. */
 typedef struct {
     size_t n, n_fluid;
     const double *x, *z, *vx, *vz, *rho, *p, *mu; /* m, m/s, kg/m3, Pa, Pa s */
@@ -160,6 +162,33 @@ typedef struct {
 enum { MIXSPH_STATE_MOBILE = 0, MIXSPH_STATE_FIXED = 1, MIXSPH_STATE_WALL = 2, MIXSPH_STATE_LOST = 3 };
 
 mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v);
+
+/** Element type of a particle field's arrays. */
+typedef enum { MIXSPH_FIELD_F64, MIXSPH_FIELD_U8, MIXSPH_FIELD_U16, MIXSPH_FIELD_U32 } mixsph_field_type;
+
+#define MIXSPH_FIELD_MAX_COMPONENTS 4
+
+/** One per-particle field of a simulation, as its snapshots hold it: `name` is the dataset's
+ *  name in run.h5 (e.g. "velocity"), `columns` its components' names as snap_NNNN.csv heads
+ *  them, comma-separated (e.g. "vx,vz"); data[c] is component c, an array of mixsph_sim_particles
+ *  + mixsph_sim_wall_particles values in storage order (valid until the next step). */
+typedef struct {
+    const char *name, *columns, *unit, *description;
+    const char *owner; /**< "core", "scheme" or "law" */
+    unsigned components;
+    mixsph_field_type type;
+    size_t n;
+    const void *data[MIXSPH_FIELD_MAX_COMPONENTS];
+} mixsph_particle_field;
+
+/** Number of particle fields this simulation shows (those of its snapshots and its material
+ *  laws' or schemes' public fields; 0 for NULL). */
+size_t mixsph_sim_particle_field_count(const mixsph_sim *s);
+/** Field k (0 <= k < mixsph_sim_particle_field_count, in the order of run.h5);
+ *  MIXSPH_ERR_ARG out of range. */
+mixsph_status mixsph_sim_particle_field(const mixsph_sim *s, size_t k, mixsph_particle_field *f);
+/** The field named `name` (its run.h5 name); MIXSPH_ERR_ARG when this simulation has none. */
+mixsph_status mixsph_sim_particle_field_find(const mixsph_sim *s, const char *name, mixsph_particle_field *f);
 
 /* ---- external wall motion (co-simulation input) ------------------------------------------- */
 

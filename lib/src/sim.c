@@ -2,6 +2,10 @@
  * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
 #include "sim.h"
 
+#include "budget.h"
+#include "law_registry.h"
+#include "state.h"
+
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -12,11 +16,13 @@
 #include <direct.h> /* the FMU's Windows binary (fmu/): its C runtime's mkdir takes no mode */
 #endif
 
+#include "clock.h"
 #include "eos.h"
 #include "geometry.h"
 #include "integrate.h"
 #include "monitors.h"
 #include "output.h"
+#include "particle_fields.h"
 #include "status.h"
 
 static int make_dir(const char *path)
@@ -124,6 +130,9 @@ static mixsph_status fill_bodies(mixsph_sim *s)
                         "(numerics.max_particles)", s->cfg.origin, dx, n, s->cfg.max_particles);
     }
     qsort(sites, n, sizeof *sites, site_cmp);
+    s->P.features = s->cfg.viscosity_implicit ? PARTICLE_FEATURE_IMPLICIT_VISCOUS : 0u;
+    for (size_t k = 0; k < s->cfg.n_media; k++)
+        if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->P.features |= PARTICLE_FEATURE_STRESS;
     if (particles_alloc(&s->P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
@@ -134,7 +143,8 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         const struct medium *m = &s->cfg.media[sites[q].medium];
         const double p = above + 0.5 * m->rho0 * s->cfg.g * dx;
         above += m->rho0 * s->cfg.g * dx;
-        const double rho = eos_density(p, m->rho0, m->c);
+        double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
+        const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
         particles_push(&s->P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
                        (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
         s->P.mu[s->P.n - 1] = m->mu;
@@ -196,14 +206,37 @@ static void set_domain(mixsph_sim *s)
     s->domain[3] = z1 + 0.5 * (z1 - z0) + pad;
 }
 
+/* The states of the material laws the media use, and the velocity gradient when one asks for it. */
+static mixsph_status create_laws(mixsph_sim *s)
+{
+    const struct law_setup setup = {.media = s->cfg.media, .n_media = s->cfg.n_media, .cap = s->P.n,
+                                     .x_min = s->domain[0], .x_max = s->domain[1], .dx = s->dx, .h = s->h,
+                                     .g = s->cfg.g, .p_background = s->cfg.p_background,
+                                     .fixed_bed_speed = s->cfg.fixed_bed_speed};
+    for (size_t k = 0; k < s->cfg.n_media; k++) {
+        const int id = s->cfg.media[k].law;
+        const struct material_law *law = law_get(id);
+        s->law_features |= law->features;
+        if (law->create && !s->law_state[id] && !(s->law_state[id] = law->create(&setup)))
+            return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (the state of the material law of medium %s)",
+                            s->cfg.media[k].name);
+    }
+    if (s->law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
+        for (size_t i = 0; i < s->P.n; i++)
+            s->P.wall_rough[i] = s->P.state[i] == MIXSPH_STATE_WALL &&
+                                 s->cfg.walls[particles_wall_index(&s->P, i)].slip == WALL_NO_SLIP;
+    if ((s->law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->grad, s->P.n) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
+    return MIXSPH_OK;
+}
+
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
     s->dx = s->cfg.dx;
     s->h = s->cfg.h_over_dx * s->dx;
     s->K = kernel_make_type(s->h, s->cfg.kernel);
-    s->c_max = 0.0;
-    for (size_t k = 0; k < s->cfg.n_media; k++) s->c_max = fmax(s->c_max, s->cfg.media[k].c);
+    s->c_max = law_max_wave_speed(s->cfg.media, s->cfg.n_media);
     walls_start(&s->cfg, s->walls);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
     const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->interrupt, &s->P);
@@ -212,10 +245,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->n_wall = (size_t)n_wall;
     set_domain(s);
-    int has_granular = 0;
-    for (size_t k = 0; k < s->cfg.n_media; k++) has_granular |= s->cfg.media[k].kind == MEDIUM_GRANULAR;
-    if (has_granular && !(s->mixture = mixture_create(&s->cfg, s->P.n, s->domain[0], s->domain[1], s->dx, s->h)))
-        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (granular phase)");
+    if ((st = create_laws(s)) != MIXSPH_OK) return st;
     if (!(s->forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
     for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */
@@ -293,6 +323,7 @@ mixsph_status sim_create_from_text(const char *json_text, const char *origin, co
     if (!s) return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
     mixsph_sim_set_interrupt(s, interrupt);
     mixsph_status st = case_parse(json_text, origin, ov, n_ov, &s->cfg, s->err, sizeof s->err);
+    if (st == MIXSPH_OK) st = budget_check(&s->cfg, s->err, sizeof s->err); /* before anything is allocated */
     if (st == MIXSPH_OK) st = sim_keep_source(s, json_text, origin, ov, n_ov);
     if (st == MIXSPH_OK) st = sim_init(s);
     if (st != MIXSPH_OK) {
@@ -324,14 +355,71 @@ mixsph_status mixsph_sim_create_interruptible(const char *case_path, const mixsp
     return st;
 }
 
+mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
+{
+    return sim_create_from_state(buf, len, NULL, out, err, err_len);
+}
+
+mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
+                                    char *err, size_t err_len)
+{
+    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
+    *out = NULL;
+    struct state_source src;
+    mixsph_status st = state_read_source(buf, len, &src, err, err_len);
+    mixsph_override *ov = NULL;
+    if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    if (st == MIXSPH_OK) {
+        for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
+        st = sim_create_from_text(src.text, src.origin, ov, src.n_ov, interrupt, out, err, err_len);
+    }
+    free(ov);
+    state_source_free(&src);
+    if (st != MIXSPH_OK) return st;
+    st = mixsph_sim_load_state(*out, buf, len);
+    if (st != MIXSPH_OK) {
+        status_set(err, err_len, st, "%s", (*out)->err);
+        mixsph_sim_destroy(*out);
+        *out = NULL;
+    }
+    return st;
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
+{
+    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
+}
+
+mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
+                                                              mixsph_sim **out, char *err, size_t err_len)
+{
+    if (out) *out = NULL;
+    if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
+    unsigned char *buf = NULL;
+    size_t len = 0;
+    double run_wall = NAN;
+    mixsph_status st = output_read_checkpoint(path, &buf, &len, &run_wall, err, err_len);
+    if (st == MIXSPH_OK) {
+        char msg[900];
+        st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
+        if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
+        else (*out)->run_wall_s = run_wall;
+    }
+    free(buf);
+    return st;
+}
+
 void mixsph_sim_destroy(mixsph_sim *s)
 {
     if (!s) return;
     if (s->monitor_csv) fclose(s->monitor_csv);
     output_close(s);
-    mixture_free(s->mixture);
+    for (int id = 0; id < LAW_COUNT; id++)
+        if (s->law_state[id]) law_get(id)->destroy(s->law_state[id]);
+    velocity_gradient_free(&s->grad);
     forces_free(s->forces);
     viscous_free(s->viscous);
+    free(s->viscous_unknown);
     walls_mirror_free(s->wall_mirror);
     particles_free(&s->P);
     cells_free(&s->C);
@@ -426,21 +514,15 @@ static mixsph_status sim_outputs_due(mixsph_sim *s)
 mixsph_status mixsph_sim_step(mixsph_sim *s)
 {
     if (!s) return MIXSPH_ERR_ARG;
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
     if (s->step == 0 && s->n_samples == 0) st = sim_outputs_due(s);
     if (st == MIXSPH_OK) st = integrate_step(s);
     if (st == MIXSPH_OK) st = sim_outputs_due(s);
-    s->run_wall_s += sim_clock_s() - t0;
+    s->run_wall_s += clock_monotonic_s() - t0;
     return st;
 }
 
-double sim_clock_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->run_wall_s : NAN; }
 

@@ -1,97 +1,9 @@
-/* sim.h - the simulation object (internal definition of the opaque mixsph_sim). It owns all
- * state: the case, the particles, the cell list and neighbour ranges, the walls' motion, the
- * modules' private state (forces, mixture), the outputs and files. The physics modules
- * (forces, walls, mixture) do not see it: they take the parts they need; the time stepping
- * (integrate.c), the outputs (monitors.c, output.c) and the state (state.c) work on it. */
+/* sim.h - the simulation's creation (sim.c, on top of the library): from a case's text, from a
+ * saved state; the object itself is sim_object.h. */
 #ifndef MIXSPH_SIM_H
 #define MIXSPH_SIM_H
-#include <stdint.h>
-#include <stdio.h>
 
-#include "case.h"
-#include "cells.h"
-#include "forces.h"
-#include "kernel.h"
-#include "mixsph.h"
-#include "mixture.h"
-#include "neighbours.h"
-#include "particles.h"
-#include "viscous.h"
-#include "walls.h"
-
-#ifdef _OPENMP
-#include <omp.h>
-#define SIM_THREADS(s) ((s)->n_threads > 0 ? (s)->n_threads : omp_get_max_threads())
-#else
-#define SIM_THREADS(s) 1
-#endif
-
-/* Cell columns per neighbour-search radius (cells.c, neighbours.c). */
-#ifndef SIM_CELL_COLUMNS
-#define SIM_CELL_COLUMNS 4
-#endif
-
-#define SIM_MAX_OUTPUTS (10 + CASE_MAX_MONITORS)
-
-struct mixsph_sim {
-    struct case_def cfg;
-    /* what the simulation was created from (kept for state save/restore and metadata) */
-    char *case_text, *case_origin;
-    size_t n_ov;
-    char **ov_key;
-    double *ov_value;
-    struct kernel K;
-    double dx, h;
-    double c_max;                 /* highest sound speed [m/s] */
-    double domain[4];             /* x_min, x_max, z_min, z_max [m] */
-    struct particles P;
-    struct cells C;
-    struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
-    struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
-    uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
-    struct forces *forces;        /* the pair loops' cache and scratch */
-    struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
-    struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
-    struct viscous_report viscous_last; /* the last solve */
-    uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
-    double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
-    size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
-    struct wall_state walls[CASE_MAX_WALLS];
-    struct mixture *mixture;      /* granular phase; NULL without granular media */
-    long n_fixed;                 /* granular particles held fixed after the last step */
-
-    double t, dt;                 /* time, next time step [s] */
-    uint64_t step;
-    int n_threads;
-    long n_lost;                  /* particles that left the domain */
-    long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
-
-    /* outputs: diagnostics then the case's monitors */
-    size_t n_out;
-    char out_name[SIM_MAX_OUTPUTS][CASE_NAME_LEN];
-    int out_monitor[SIM_MAX_OUTPUTS];             /* case monitor behind output k, -1 for diagnostics */
-    size_t profile_next[CASE_MAX_MONITORS];       /* profile monitors: next time to write */
-    double out_max[SIM_MAX_OUTPUTS], out_tmax[SIM_MAX_OUTPUTS];
-    double out_min[SIM_MAX_OUTPUTS], out_tmin[SIM_MAX_OUTPUTS];
-    long n_samples;
-    double next_sample, next_snapshot;
-    int snap_index;
-    char out_dir[512];
-    FILE *monitor_csv;
-    struct output *h5;            /* run.h5 and run.xdmf (output.c); NULL without an output folder */
-    double out_seconds[3];        /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
-    double run_wall_s;            /* wall time stepping this run since t = 0, incl. before a restart [s] */
-    int csv_snapshots_off;        /* no snap_NNNN.csv (run.h5 only) */
-
-    mixsph_interrupt interrupt;   /* the host's request to stop, polled during creation and stepping */
-    char err[1024];
-};
-
-/** Has the host asked to stop (mixsph_interrupt)? */
-static inline int sim_interrupted(const mixsph_sim *s)
-{
-    return s->interrupt.requested && s->interrupt.requested(s->interrupt.user);
-}
+#include "sim_object.h"
 
 /** mixsph_sim_create_from_text polling `interrupt` (may be NULL) during the creation. */
 mixsph_status sim_create_from_text(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,
@@ -99,13 +11,5 @@ mixsph_status sim_create_from_text(const char *json_text, const char *origin, co
 /** mixsph_sim_create_from_state polling `interrupt` (may be NULL) while the case is rebuilt (state.c). */
 mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
                                     char *err, size_t err_len);
-
-/** What the pair loops of forces.h run over, from the simulation's current parts and options. */
-struct pair_system sim_pair_system(mixsph_sim *s);
-
-/** Monotonic wall clock [s]. */
-double sim_clock_s(void);
-
-#define SIM_FAIL(s, st, ...) status_set((s)->err, sizeof (s)->err, (st), __VA_ARGS__)
 
 #endif

@@ -104,11 +104,8 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     # run's over both pieces. Run 6 at dx 0.02 to t = 0.1 s, cut off after t = 0.03 s.
     import json
     import subprocess
-    from tool_helpers import ENV, cut_off
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        import pytest
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import ENV, built, cut_off
+    mixsph = built("mixsph")
     tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph,
             "--runs", "6", "--dx", "0.02", "--t-end", "0.1", "--threads", "1", "--progress", "0",
             "--checkpoint-every", "0.5"]
@@ -154,11 +151,8 @@ def test_set_reaches_every_run_and_its_stamp(tmp_path):
     # settings: a folder run without it is not reused for a sweep with it. Run 6, dx 0.02, 0.01 s.
     import json
     import subprocess
-    from tool_helpers import ENV
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        import pytest
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import ENV, built
+    mixsph = built("mixsph")
     tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph, "--runs", "6",
             "--dx", "0.02", "--t-end", "0.01", "--threads", "1", "--progress", "0", "--out", str(tmp_path)]
     r = subprocess.run(tool, capture_output=True, text=True, env=ENV, timeout=600)
@@ -182,11 +176,8 @@ def test_a_run_of_an_edited_case_file_is_not_reused(tmp_path):
     import json
     import shutil
     import subprocess
-    from tool_helpers import ENV
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        import pytest
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import ENV, built
+    mixsph = built("mixsph")
     case = tmp_path / "erosive.json"
     shutil.copy(os.path.join(ROOT, "cases", "erosive_dambreak.json"), case)
     tool = [sys.executable, os.path.join(ROOT, "tools", "erosive_dambreak.py"), "--mixsph", mixsph, "--runs", "6",
@@ -213,11 +204,8 @@ def test_sphera_option_passes_spheras_own_settings_to_every_run(tmp_path):
     import json
     import subprocess
     import vajont_validate as vv
-    from tool_helpers import ENV
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        import pytest
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import ENV, built
+    mixsph = built("mixsph")
     for mod, args, run_dir in ((ed, ["--runs", "6", "--dx", "0.02"], "run6_dx0.02"),
                                (vv, ["--runs", "1", "--dx", "0.03"], "V1_dx0.03")):
         out = tmp_path / mod.__name__

@@ -155,9 +155,8 @@ def test_set_reaches_every_run(tmp_path):
     # stamp (so --reuse tells the runs apart) and named in the table's header; a malformed one is
     # refused before anything runs (exit 2). Runs build/mixsph for 0.01 s of V1 and V4 at dx 0.03.
     import subprocess
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import built
+    mixsph = built("mixsph")
     tool = [sys.executable, os.path.join(ROOT, "tools", "vajont_validate.py"), "--mixsph", mixsph,
             "--runs", "1,4", "--dx", "0.03", "--t-end", "0.01", "--threads", "1", "--progress", "0",
             "--out", str(tmp_path)]
@@ -182,10 +181,8 @@ def test_reuse_continues_a_killed_run_from_its_checkpoint(tmp_path):
     # CLI's restart guarantees), and the elapsed time is the run's over both pieces. V1 at dx 0.03
     # to t = 0.3 s (seconds), checkpoints every 0.5 s of wall time, cut off after t = 0.1 s.
     import subprocess
-    from tool_helpers import ENV, cut_off
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        pytest.skip("build/mixsph not built")
+    from tool_helpers import ENV, built, cut_off
+    mixsph = built("mixsph")
     tool = [sys.executable, os.path.join(ROOT, "tools", "vajont_validate.py"), "--mixsph", mixsph,
             "--runs", "1", "--dx", "0.03", "--t-end", "0.3", "--threads", "1", "--progress", "0",
             "--checkpoint-every", "0.5"]

@@ -11,16 +11,28 @@ sys.path.insert(0, os.path.join(ROOT, "tools"))
 import mixsph_tools as mt  # noqa: E402
 
 ENV = dict(os.environ, OMP_WAIT_POLICY="passive")   # the tests share the cores
+BUILD = os.environ.get("MIXSPH_BUILD_DIR", os.path.join(ROOT, "build"))
+
+
+def built(name, how="./tools/do build"):
+    """The path of ``name`` (e.g. "mixsph") in the build folder (MIXSPH_BUILD_DIR, default
+    build/). When it is not there the test cannot run: in CI (environment CI=true) that is a
+    broken pipeline, so the test fails; elsewhere it is skipped. Either way the message names
+    what is missing and how to build it."""
+    import pytest
+    path = os.path.join(BUILD, name)
+    if os.path.isfile(path):
+        return path
+    message = f"{path} is not built (build it with {how})"
+    if os.environ.get("CI", "").lower() in ("true", "1"):
+        pytest.fail(f"{message}; CI=true, so a missing build fails the test instead of skipping it", pytrace=False)
+    pytest.skip(message)
 
 
 def script_command(script, *opts):
-    """[python, tools/<script>, --mixsph build/mixsph, *opts]; skips the test when build/mixsph
-    is not built."""
-    import pytest
-    mixsph = os.path.join(ROOT, "build", "mixsph")
-    if not os.access(mixsph, os.X_OK):
-        pytest.skip("build/mixsph not built")
-    return [sys.executable, os.path.join(ROOT, "tools", script), "--mixsph", mixsph, *opts]
+    """[python, tools/<script>, --mixsph build/mixsph, *opts]; the test fails in CI and is skipped
+    elsewhere when build/mixsph is not built (built())."""
+    return [sys.executable, os.path.join(ROOT, "tools", script), "--mixsph", built("mixsph"), *opts]
 
 
 def assert_refused(tool, cases, out, timeout=120):

@@ -155,7 +155,30 @@ def first_time_below(t, v, threshold):
 
 
 _SNAP_HEAD = re.compile(r"#\s*t\s*=\s*([-+0-9.eE]+)\s*s")
+# The columns every snapshot has, in this order (the core fields of the particle-field table,
+# lib/src/core/particle_fields.c); a snapshot of a simulation whose material law or scheme
+# declares fields of its own has more, named by its header. tests/python/test_particle_fields.py
+# checks this against the C table.
 SNAP_COLUMNS = ("id", "x", "z", "vx", "vz", "rho", "p", "mu", "medium", "state")
+# run.h5 datasets whose columns are not the dataset's own name (a scalar dataset named as its
+# column, e.g. a law's "sxx", needs no entry; a vector dataset without one gives NAME_0, NAME_1,
+# ...). tests/python/test_particle_fields.py checks every row of the C table against it.
+H5_COLUMNS = {
+    "position": ("x", "z"),
+    "velocity": ("vx", "vz"),
+    "density": ("rho",),
+    "pressure": ("p",),
+    "viscosity": ("mu",),
+    "mass": ("m",),
+}
+
+
+def h5_columns(name, components):
+    """The snapshot columns of a run.h5 dataset `name` of `components` components (1: scalar)."""
+    cols = H5_COLUMNS.get(name)
+    if cols is not None and len(cols) == components:
+        return cols
+    return (name,) if components == 1 else tuple(f"{name}_{k}" for k in range(components))
 STATE_MOBILE, STATE_FIXED, STATE_WALL, STATE_LOST = 0, 1, 2, 3
 
 
@@ -203,39 +226,53 @@ def _h5_snapshots(path):
 
 
 def _read_h5_snapshot(ref):
-    """(t, {column: array}) of a run.h5 snapshot, the columns of the CSV snapshots."""
+    """(t, {column: array}) of a run.h5 snapshot: every dataset of its group, split into the
+    columns of the CSV snapshots (h5_columns), rows by id."""
     import h5py
     path, name = ref.split(H5_REF, 1)
     try:
         with h5py.File(path, "r", locking=False) as f:
             g = f["snapshots"][name]
-            pos, vel = g["position"][()], g["velocity"][()]
-            cols = {"id": g["id"][()], "x": pos[:, 0], "z": pos[:, 1], "vx": vel[:, 0], "vz": vel[:, 1],
-                    "rho": g["density"][()], "p": g["pressure"][()], "mu": g["viscosity"][()],
-                    "medium": g["medium"][()], "state": g["state"][()]}
+            cols = {}
+            for dname, d in g.items():
+                if not isinstance(d, h5py.Dataset) or d.ndim not in (1, 2):
+                    continue
+                v = d[()]
+                if d.ndim == 1:
+                    v = v[:, None]
+                for k, col in enumerate(h5_columns(dname, v.shape[1])):
+                    cols[col] = v[:, k]
             t = float(g.attrs["time"])
     except (OSError, KeyError) as e:
         raise ToolError(f"{path}: cannot read snapshot {name}: {e}") from None
+    missing = [c for c in SNAP_COLUMNS if c not in cols]
+    if missing:
+        raise ToolError(f"{path}: snapshot {name} has no column {', '.join(missing)}")
     return t, {k: np.asarray(v, dtype=float) for k, v in cols.items()}
 
 
 def read_snapshot(path):
-    """(t, {column: array}) of one snapshot of list_snapshots: a snap_NNNN.csv (columns
-    id,x,z,vx,vz,rho,p,mu,medium,state) or a run.h5 snapshot (the same columns)."""
+    """(t, {column: array}) of one snapshot of list_snapshots: a snap_NNNN.csv (the columns its
+    header names: SNAP_COLUMNS and any a material law or scheme adds) or a run.h5 snapshot (the
+    same columns, and the fields run.h5 has beyond the CSV, such as the mass m)."""
     if H5_REF in path:
         return _read_h5_snapshot(path)
     t = snapshot_time(path)
     with open(path) as f:
         f.readline()
         header = f.readline().strip().split(",")
-    if tuple(header) != SNAP_COLUMNS:
-        raise ToolError(f"{path}: second line '{','.join(header)}' is not '{','.join(SNAP_COLUMNS)}'")
+    missing = [c for c in SNAP_COLUMNS if c not in header]
+    if missing or len(set(header)) != len(header) or not all(header):
+        raise ToolError(f"{path}: second line '{','.join(header)}' is not a header of distinct names with "
+                        f"the columns {','.join(SNAP_COLUMNS)}")
     try:
         data = np.loadtxt(path, delimiter=",", skiprows=2, ndmin=2)
     except ValueError as e:
         raise ToolError(f"{path}: cannot read: {e}") from None
-    data = data.reshape(-1, len(SNAP_COLUMNS))
-    return t, {name: data[:, k] for k, name in enumerate(SNAP_COLUMNS)}
+    if data.size and data.shape[1] != len(header):
+        raise ToolError(f"{path}: {data.shape[1]} columns, the header names {len(header)}")
+    data = data.reshape(-1, len(header))
+    return t, {name: data[:, k] for k, name in enumerate(header)}
 
 
 def nearest_snapshot(outdir, t):

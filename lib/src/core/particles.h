@@ -1,13 +1,19 @@
 /* particles.h - struct-of-arrays particle storage (fluid, granular and wall particles in one
  * set, told apart by `state`), growth and permutation (the cell sort reorders them at each
- * rebuild of the neighbour ranges). */
+ * rebuild of the neighbour ranges). Every array member has its row in the particle-field table
+ * (particle_fields.c), which everything that treats the fields alike walks: a member without a
+ * row is neither allocated nor permuted nor saved (test_particle_fields checks every member has
+ * one). */
 #ifndef MIXSPH_PARTICLES_H
 #define MIXSPH_PARTICLES_H
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 struct particles {
     size_t n, cap;
+    unsigned features;    /* PARTICLE_FEATURE_* of the simulation: the table rows it has (set before
+                           * the first particles_alloc; the arrays of the other rows stay NULL) */
     double *x, *z;        /* position [m] */
     double *vx, *vz;      /* velocity [m/s]; walls: the wall's prescribed velocity */
     double *uvx, *uvz;    /* velocity seen by viscous terms [m/s]: walls: no-slip mirror velocity */
@@ -27,6 +33,11 @@ struct particles {
     double *visc_dvpx, *visc_dvpz; /* visc_dv of the step before the last (the warm starts'
                                     * linear extrapolation) [m/s] */
     double *visc_d1px, *visc_d1pz; /* visc_d1 of the step before the last [m/s] */
+    double *sxx, *sxz, *szz; /* deviatoric stress in the plane [Pa] (tension positive; laws with
+                              * LAW_HAS_STRESS, 0 elsewhere); walls: their neighbours' (walls.c) */
+    double *syy;          /* its out-of-plane component (plane strain) [Pa] */
+    double *wall_rough;   /* wall particles: 1 where the wall takes the stress of the solid it meets (a
+                           * no-slip wall), 0 where it takes none (free-slip); 0 for the others [-] */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index
                            * (read it through particles_wall_index) */
     uint8_t *state;       /* MIXSPH_STATE_* */
@@ -34,15 +45,20 @@ struct particles {
     uint32_t *id;         /* stable id */
 };
 
-/* The double-valued fields, for code that treats them all alike (permute, copy, state). */
-#define PARTICLES_DOUBLE_FIELDS(X) \
-    X(x) X(z) X(vx) X(vz) X(uvx) X(uvz) X(rho) X(p) X(m) X(vol) X(mu) X(ax) X(az) X(drho) X(tag) X(inv_rho) X(inv_m) X(avc) X(visc_dvx) X(visc_dvz) X(visc_d1x) X(visc_d1z) \
-        X(visc_dvpx) X(visc_dvpz) X(visc_d1px) X(visc_d1pz)
+/* The array of struct particles at byte offset `member` (a particle_field's member[c]; copied
+ * out as bytes: the member is a typed pointer). */
+static inline void *particles_array(const struct particles *P, size_t member)
+{
+    void *a;
+    memcpy(&a, (const char *)P + member, sizeof a);
+    return a;
+}
 
 /** The wall a wall particle belongs to (its `medium` field holds the wall's index). */
 static inline size_t particles_wall_index(const struct particles *P, size_t i) { return P->medium[i]; }
 
-/** Allocate room for cap particles (n = 0). Returns 0 on success. */
+/** Allocate room for cap particles (first call: n = 0; later calls grow, keeping the particles),
+ *  the arrays of the table's rows present with P->features. Returns 0 on success. */
 int particles_alloc(struct particles *P, size_t cap);
 void particles_free(struct particles *P);
 /** Append one particle with zero velocity and rates; returns its index or (size_t)-1. */
@@ -52,5 +68,7 @@ size_t particles_push(struct particles *P, double x, double z, double rho, doubl
 void particles_permute(struct particles *P, const size_t *perm, void *scratch);
 /** Deep copy (dst must be zeroed or freed). Returns 0 on success. */
 int particles_copy(struct particles *dst, const struct particles *src);
+/** Copy the values of src's n particles into dst (same features, dst->cap >= src->n). */
+void particles_copy_values(struct particles *dst, const struct particles *src);
 
 #endif

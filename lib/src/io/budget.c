@@ -13,7 +13,8 @@
 
 #include "case_schema.h"
 #include "geometry.h"
-#include "integrate.h"
+#include "law_registry.h"
+#include "time_step.h"
 #include "status.h"
 
 /* Bytes one particle adds to one snapshot: a row of snap_NNNN.csv (ten fields of 1-13 characters,
@@ -55,13 +56,13 @@ static double wall_sites(const struct case_def *c, size_t k)
 static double largest_time_step(const struct case_def *c)
 {
     const double h = c->h_over_dx * c->dx;
-    double c_max = 0.0, dt = INFINITY;
-    for (size_t k = 0; k < c->n_media; k++) c_max = fmax(c_max, c->media[k].c);
+    double c_max, dt = INFINITY;
+    c_max = law_max_wave_speed(c->media, c->n_media);
     for (size_t k = 0; k < c->n_media; k++) {
         const struct medium *m = &c->media[k];
-        double mu = m->kind == MEDIUM_GRANULAR ? fmin(m->mu0, m->mu_thr) : m->mu;
+        double mu = law_get(m->law)->viscosity_bound(m);
         if (c->viscosity_implicit) mu = 0.0;
-        dt = fmin(dt, integrate_particle_dt(c->cfl, c->cfl_visc, h, c_max, 0.0, m->rho0, mu));
+        dt = fmin(dt, time_step_bound(c->cfl, c->cfl_visc, h, c_max, 0.0, m->rho0, mu));
     }
     return dt;
 }

@@ -11,8 +11,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "budget.h"
 #include "case_schema.h"
+#include "law_registry.h"
 #include "status.h"
 
 #define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
@@ -237,71 +237,58 @@ static mixsph_status read_numerics(const struct case_reader *r, const cJSON *roo
     return MIXSPH_OK;
 }
 
-/* Sound speed from exactly one of K (bulk modulus, with density rho_pure) or c (already read). */
-static mixsph_status read_sound_speed(const struct case_reader *r, const cJSON *it, const char *path, double rho_pure,
-                                      double *c)
+/* What a material law's finish may ask of the case entry it reads (laws/law.h). */
+static int entry_given(const void *entry, const char *key) { return item(entry, key) != NULL; }
+
+static const char *entry_text(const void *entry, const char *key)
 {
-    const cJSON *k = item(it, "K");
-    if (!k == !item(it, "c"))
-        return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
-    if (k) *c = sqrt(k->valuedouble / rho_pure);
-    return MIXSPH_OK;
+    const cJSON *v = item(entry, key);
+    return cJSON_IsString(v) ? v->valuestring : NULL;
 }
 
-static mixsph_status read_granular(const struct case_reader *r, const cJSON *it, const char *path, struct case_def *c,
-                                   struct medium *md)
+static double entry_number(const void *entry, const char *key)
 {
-    TRY(case_schema_read(r, it, path, section("media.granular"), 0, md));
-    TRY(read_sound_speed(r, it, path, md->rho_grain, &md->c));
-    md->sin_phi = sin(md->phi_deg * GEOM_PI / 180.0);
-    md->pore_fluid = -1;
-    const cJSON *fluid = item(it, "pore_fluid");
-    if (fluid) {
-        md->pore_fluid = find_medium(c, fluid->valuestring);
-        if (md->pore_fluid < 0 || c->media[md->pore_fluid].kind != MEDIUM_FLUID)
-            return FAIL(r, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", r->origin, path,
-                        fluid->valuestring);
+    const cJSON *v = item(entry, key);
+    return cJSON_IsNumber(v) ? v->valuedouble : NAN;
+}
+
+/* A medium: its type selects its material law (laws/law_registry.h), whose key table it is read
+ * by; a law with both K and c takes exactly one of them; then the law's own rules (finish). */
+static mixsph_status read_medium(const struct case_reader *r, const cJSON *it, const char *path, struct case_def *c,
+                                 struct medium *md)
+{
+    struct case_choice types[LAW_COUNT + 1]; /* each type once, with its first law */
+    size_t n_types = 0;
+    for (int id = 0; id < LAW_COUNT; id++) {
+        size_t k = 0;
+        while (k < n_types && strcmp(types[k].name, law_get(id)->type) != 0) k++;
+        if (k == n_types) types[n_types++] = (struct case_choice){law_get(id)->type, id};
     }
-    if (md->saturated && md->pore_fluid < 0)
-        return FAIL(r, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", r->origin, path);
-    const double n = md->porosity;
-    if (md->saturated) {
-        const struct medium *f = &c->media[md->pore_fluid];
-        md->rho_f = f->rho0;
-        md->eps_f_mu_f = n * f->mu;
-        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
-    } else {
-        md->rho_f = 0.0;
-        md->eps_f_mu_f = 0.0;
-        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
-    }
-    const cJSON *mu1 = item(it, "mu1");
-    if (mu1) {
-        if (item(it, "mu_thr") || item(it, "mu0"))
-            return FAIL(r, "%s: %s.mu1: the mu1 rheology (Run 7) replaces mu_thr and mu0: give mu1 alone", r->origin, path);
-        md->mu_thr = mu1->valuedouble; /* mu0 keeps its default: no limit */
-        md->mu1_mode = 1;
-    } else if (!item(it, "mu_thr")) {
-        return FAIL(r, "%s: %s.mu_thr: missing (expected a number, or mu1)", r->origin, path);
-    }
-    md->mu = 0.0; /* set by the rheology */
-    return MIXSPH_OK;
+    types[n_types] = (struct case_choice){NULL, 0};
+    const struct case_key type_key = {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = types,
+                                      .field = CASE_FIELD(medium, law)};
+    TRY(case_schema_read_key(r, it, path, &type_key, md));
+    /* a type with several laws: its key `law` (a row of each of their tables) chooses one */
+    const struct case_key *law_key = case_schema_key(law_get(md->law)->keys, "law");
+    if (law_key) TRY(case_schema_read_key(r, it, path, law_key, md));
+    const struct material_law *law = law_get(md->law);
+    TRY(case_schema_read(r, it, path, law->keys, 0, md));
+    if (case_schema_key(law->keys, "K") && case_schema_key(law->keys, "c") && !item(it, "K") == !item(it, "c"))
+        return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
+    md->features = law->features;
+    const struct law_finish_ctx ctx = {.media = c->media, .n_media = c->n_media + 1, .given = entry_given,
+                                       .text = entry_text, .number = entry_number, .entry = it, .origin = r->origin,
+                                       .path = path, .err = r->err, .err_len = r->err_len};
+    return law->finish ? law->finish(md, &ctx) : MIXSPH_OK;
 }
 
 static mixsph_status read_media(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
-    const struct case_section *fluid = section("media.fluid");
     for (const cJSON *it = item(root, "media")->child; it; it = it->next) {
         char path[128];
         struct medium *md = &c->media[c->n_media < CASE_MAX_MEDIA ? c->n_media : 0];
         TRY(entry(r, it, "media", c->n_media, CASE_MAX_MEDIA, path, sizeof path, md->name));
-        TRY(case_schema_read_key(r, it, path, case_schema_key(fluid, "type"), md));
-        if (md->kind == MEDIUM_GRANULAR) {
-            TRY(read_granular(r, it, path, c, md));
-        } else {
-            TRY(case_schema_read(r, it, path, fluid, 0, md));
-            TRY(read_sound_speed(r, it, path, md->rho0, &md->c));
-        }
+        TRY(read_medium(r, it, path, c, md));
         c->n_media++;
     }
     if (c->n_media == 0) return FAIL(r, "%s: media: expected at least one medium", r->origin);
@@ -629,8 +616,7 @@ static mixsph_status read_root(const struct case_reader *r, const cJSON *root, s
     const mixsph_status st = case_schema_read(r, o ? o : none, "output", section("output"), 0, c);
     cJSON_Delete(none);
     if (st != MIXSPH_OK) return st;
-    TRY(read_domain_rules(r, c));
-    return budget_check(c, r->err, r->err_len);
+    return read_domain_rules(r, c);
 }
 
 mixsph_status case_parse(const char *json_text, const char *origin, const mixsph_override *ov, size_t n_ov,

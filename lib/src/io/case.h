@@ -5,39 +5,15 @@
 #define MIXSPH_CASE_H
 #include <stddef.h>
 #include "geometry.h"
+#include "medium.h"
 #include "mixsph.h"
 
-#define CASE_NAME_LEN 48
+#define CASE_NAME_LEN MEDIUM_NAME_LEN /* names of all entries */
 #define CASE_MAX_MEDIA 8
 #define CASE_MAX_BODIES 16
 #define CASE_MAX_WALLS 16
 #define CASE_MAX_MOTIONS 8
 #define CASE_MAX_MONITORS 16
-
-enum medium_kind { MEDIUM_FLUID = 0, MEDIUM_GRANULAR = 1 };
-
-struct medium {
-    char name[CASE_NAME_LEN];
-    int kind;          /* MEDIUM_FLUID / MEDIUM_GRANULAR */
-    double rho0;       /* reference density [kg/m3]; granular: the mixture density (5) */
-    double c;          /* sound speed [m/s]; granular: sqrt(K_s / rho_s) */
-    double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
-    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (granular: 0 unless given) */
-    /* granular media (docs/model.md sections 5-6) */
-    double rho_grain;  /* density of the grains rho_s [kg/m3] */
-    double porosity;   /* n = eps_f at the packing limit [-] */
-    double phi_deg;    /* angle of internal friction [deg] */
-    double sin_phi;
-    int saturated;     /* pores filled with the pore fluid (else dry) */
-    int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
-    double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */
-    double eps_f_mu_f; /* eps_f mu_f [Pa s] (0 if dry) */
-    double mu_thr;     /* threshold viscosity [Pa s] */
-    double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
-    int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
-    int hold_fixed;     /* granular: a fixed grain gets no acceleration (SPHERA's implementation) */
-    int tension_cutoff; /* granular: no tensile pressure, p >= background pressure (off: the paper's model) */
-};
 
 struct body {
     char name[CASE_NAME_LEN];

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "case.h"
+#include "law_registry.h"
 #include "status.h"
 
 #define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
@@ -22,9 +23,9 @@
         if (st_ != MIXSPH_OK) return st_; \
     } while (0)
 
-#define COUNT(a) (sizeof(a) / sizeof((a)[0]))
-#define DEF(v) .has_def = 1, .def = (v)
-#define RANGE(l, lopen, h, hopen) .lo = (l), .lo_open = (lopen), .hi = (h), .hi_open = (hopen)
+#define COUNT(a) SCHEMA_COUNT(a)
+#define DEF(v) SCHEMA_DEF(v)
+#define RANGE(l, lopen, h, hopen) SCHEMA_RANGE(l, lopen, h, hopen)
 #define ANYWHERE RANGE(-1e9, 0, 1e9, 0) /* coordinates [m] */
 #define V(kind) (1u << (kind))
 
@@ -36,7 +37,6 @@ static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit
 static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
 static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
-static const struct case_choice medium_types[] = {{"fluid", MEDIUM_FLUID}, {"granular", MEDIUM_GRANULAR}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
 static const struct case_choice directions[] = {{"+x", 1}, {"-x", -1}, {NULL, 0}};
@@ -159,59 +159,6 @@ static const struct case_key domain_keys[] = {
      .meaning = "top, > z_min"},
 };
 
-static const struct case_key fluid_keys[] = {
-    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = medium_types,
-     .field = CASE_FIELD(medium, kind), .meaning = "\"fluid\" (this table) or \"granular\" (the next)"},
-    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
-     .field = CASE_FIELD(medium, rho0), .meaning = "reference density ρ0"},
-    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e12, 0),
-     .unit = "Pa", .meaning = "bulk modulus of the linear equation of state: c = √(K/ρ0)"},
-    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e5, 0),
-     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
-    {.key = "mu", .type = CASE_NUMBER, RANGE(0, 0, 1e9, 0), DEF(0), .unit = "Pa s", .field = CASE_FIELD(medium, mu),
-     .meaning = "dynamic viscosity"},
-    {.key = "alpha_m", .type = CASE_NUMBER, RANGE(0, 0, 10, 0), DEF(0), .unit = "-",
-     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M"},
-};
-
-static const struct case_key granular_keys[] = {
-    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = medium_types,
-     .field = CASE_FIELD(medium, kind), .meaning = "\"granular\": a mixture at the packing limit"},
-    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
-     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
-    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e12, 0),
-     .unit = "Pa", .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s)"},
-    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", RANGE(0, 1, 1e5, 0),
-     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
-    {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 0.95, 0), .unit = "-",
-     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n = ε_f at the packing limit"},
-    {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 89, 0), .unit = "deg",
-     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
-    {.key = "saturated", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, saturated),
-     .meaning = "pores filled with the pore fluid (else dry)"},
-    {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
-     .meaning = "name of a fluid medium defined before this one"},
-    {.key = "mu_thr", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "unless mu1", RANGE(0, 1, 1e12, 0),
-     .unit = "Pa s", .field = CASE_FIELD(medium, mu_thr),
-     .meaning = "threshold viscosity μ_thr: a grain with μ_app ≥ μ_thr is held fixed"},
-    {.key = "mu0", .type = CASE_NUMBER, RANGE(0, 1, 1e12, 0), DEF(INFINITY), .def_text = "+∞ (no limit)",
-     .unit = "Pa s", .field = CASE_FIELD(medium, mu0),
-     .meaning = "limiting viscosity μ0: μ_app between μ0 and μ_thr is replaced by μ0; μ0 ≥ μ_thr: no limit"},
-    {.key = "mu1", .type = CASE_NUMBER, RANGE(0, 1, 1e12, 0), .unit = "Pa s",
-     .meaning = "instead of mu_thr and mu0: the rheology of Run 7, μ_thr = μ1 without a limit"},
-    {.key = "tension_cutoff", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, tension_cutoff),
-     .meaning = "no tensile pressure: p below the background pressure is raised to it (below)"},
-    {.key = "hold_fixed", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(medium, hold_fixed),
-     .meaning = "a grain held fixed gets no acceleration (below)"},
-    {.key = "alpha_m", .type = CASE_NUMBER, RANGE(0, 0, 10, 0), DEF(0), .unit = "-",
-     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M of the grains"},
-};
-
-static const struct case_refused granular_refused[] = {
-    {"d50", "not used by the model: the packing-limit law of the mixture has no grain size (docs/model.md "
-            "sections 5-6); remove the key"},
-    {NULL, NULL}};
-
 static const struct case_key body_keys[] = {
     {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .meaning = "name of one of the media"},
     {.key = "polygon", .type = CASE_POINTS, .need = CASE_REQUIRED, .lo = 3, .unit = "m",
@@ -314,13 +261,13 @@ static const struct case_key output_keys[] = {
      .meaning = "limit of the resource budget: bytes of all particle snapshots (CSV and HDF5), estimated"},
 };
 
-#define SECTION(id_, title_, keys_) .id = (id_), .title = (title_), .keys = (keys_), .n_keys = COUNT(keys_)
+#define SECTION(id_, title_, keys_) SCHEMA_SECTION(id_, title_, keys_)
+/* The case's own sections; the media's (one per material law, laws/law_registry.h) come after
+ * the first CASE_SECTIONS_BEFORE_MEDIA of them. */
 static const struct case_section sections[] = {
     {SECTION("case", "the case (top level)", top_keys)},
     {SECTION("numerics", "numerics", numerics_keys)},
     {SECTION("domain", "domain", domain_keys)},
-    {SECTION("media.fluid", "media.<name> of type fluid", fluid_keys)},
-    {SECTION("media.granular", "media.<name> of type granular", granular_keys), .refused = granular_refused},
     {SECTION("bodies", "bodies.<name>", body_keys)},
     {SECTION("walls", "walls.<name>", wall_keys)},
     {SECTION("motions", "motions.<name>", motion_keys)},
@@ -329,13 +276,20 @@ static const struct case_section sections[] = {
     {SECTION("full_scale.reference", "full_scale.reference", reference_keys)},
     {SECTION("output", "output", output_keys)},
 };
+#define CASE_SECTIONS_BEFORE_MEDIA 3
 
-const struct case_section *case_schema_section(size_t k) { return k < COUNT(sections) ? &sections[k] : NULL; }
+const struct case_section *case_schema_section(size_t k)
+{
+    if (k < CASE_SECTIONS_BEFORE_MEDIA) return &sections[k];
+    if (k < CASE_SECTIONS_BEFORE_MEDIA + LAW_COUNT) return law_get((int)(k - CASE_SECTIONS_BEFORE_MEDIA))->keys;
+    k -= LAW_COUNT;
+    return k < COUNT(sections) ? &sections[k] : NULL;
+}
 
 const struct case_section *case_schema_find(const char *id)
 {
-    for (size_t k = 0; k < COUNT(sections); k++)
-        if (strcmp(sections[k].id, id) == 0) return &sections[k];
+    for (size_t k = 0; case_schema_section(k); k++)
+        if (strcmp(case_schema_section(k)->id, id) == 0) return case_schema_section(k);
     return NULL;
 }
 

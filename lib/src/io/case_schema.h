@@ -1,6 +1,5 @@
-/* case_schema.h - the keys of a case file: one table per section ({key, type, range, default,
- * unit, meaning} and the field of struct case_def it fills), and the table-driven reading of one
- * JSON object. The same tables generate the key tables of docs/cases.md (tests/case_docs.c), so
+/* case_schema.h - the sections of a case file (rows: core/schema.h; a medium's section is its
+ * material law's, laws/law.h) and the table-driven reading of one JSON object. The same tables generate the key tables of docs/cases.md (tests/case_docs.c), so
  * the document cannot drift from the reader. Rules between keys (one of K and c, t/vx/vz of
  * equal length, a saturated medium's pore fluid, ...) are code in case.c. */
 #ifndef MIXSPH_CASE_SCHEMA_H
@@ -9,70 +8,9 @@
 
 #include "geometry.h"
 #include "mixsph.h"
+#include "schema.h"
 
 struct cJSON;
-
-enum case_type {
-    CASE_NUMBER,  /* a finite number in [lo, hi] (open ends as flagged) -> double */
-    CASE_INTEGER, /* an integral number in [lo, hi] -> int */
-    CASE_BOOL,    /* true or false, or 0 / 1 (the value of a parameter) -> int */
-    CASE_STRING,  /* a string of lo to hi characters -> char[hi + 1] (no field: free text) */
-    CASE_CHOICE,  /* one of the strings of `choices` -> int, the choice's value */
-    CASE_NAME,    /* the name of another entry (a medium, a wall, ...): resolved by case.c */
-    CASE_NUMBERS, /* an array of at least lo numbers: stored by case.c */
-    CASE_POINTS,  /* an array of at least lo [x, z] points -> struct polyline */
-    CASE_OBJECT   /* an object: a section of its own */
-};
-
-enum case_need {
-    CASE_OPTIONAL = 0,
-    CASE_REQUIRED = 1,
-    CASE_SOMETIMES = 2 /* required in the cases `need_text` states, checked by case.c */
-};
-
-/* The field of member m of struct s that a key fills (0: none; an entry left zero fills none). */
-#define CASE_FIELD(s, m) (offsetof(struct s, m) + 1)
-
-struct case_choice {
-    const char *name;
-    int value;
-};
-
-struct case_key {
-    const char *key;
-    enum case_type type;
-    enum case_need need;
-    const char *need_text;    /* CASE_SOMETIMES: when it is required (for the document) */
-    double lo, hi;            /* range of a number; characters of a string; least count of an array */
-    int lo_open, hi_open;     /* 1: the end is excluded */
-    int has_def;              /* 1: `def` is written to the field when the key is absent; 0: the field keeps
-                                 what case.c set (e.g. a default that depends on other keys) */
-    double def;               /* the default (a choice: its value; a Boolean: 0 or 1) */
-    const char *def_text;     /* the default for the document when it is not `def`; a string's default */
-    const char *unit;         /* SI unit, "-" for none, NULL where it does not apply */
-    const char *meaning;
-    size_t field;             /* CASE_FIELD(struct, member) of the field it fills, 0: none */
-    const struct case_choice *choices; /* CASE_CHOICE: NULL-terminated */
-    unsigned only;            /* sections with variants: the variants (bits) it belongs to, 0 = all */
-    int numeric_choice;       /* CASE_CHOICE: a number equal to a choice's value selects it too (so that a
-                                 numeric override such as --set numerics.viscosity=1 can) */
-};
-
-/* A key a case file may no longer use, and why. */
-struct case_refused {
-    const char *key;
-    const char *why;
-};
-
-struct case_section {
-    const char *id;           /* names the table in docs/cases.md: <!-- keys:<id> --> */
-    const char *title;        /* e.g. "media.<name> (type fluid)" */
-    const struct case_key *keys;
-    size_t n_keys;
-    const struct case_refused *refused; /* NULL-terminated, or NULL */
-    const char *variant_noun;           /* e.g. "monitor" (NULL: no variants) */
-    const struct case_choice *variants; /* variant v is bit (1u << value), NULL-terminated */
-};
 
 /* Where messages go: "<origin>: <key path>: <what was expected>". */
 struct case_reader {

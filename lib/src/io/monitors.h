@@ -4,7 +4,7 @@
 #define MIXSPH_MONITORS_H
 #include <stddef.h>
 
-#include "sim.h"
+#include "sim_object.h"
 
 /** Names and kinds of the outputs from the case (after creation). */
 void monitors_init(mixsph_sim *s);

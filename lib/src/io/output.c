@@ -14,7 +14,9 @@
  *   /metadata/case_json the case file's JSON text (string)
  *   /snapshots/NNNNNN   one group per snapshot (NNNNNN = snapshot index, as snap_NNNN.csv);
  *                       attributes time [s], step, index; datasets of all n particles (fluid,
- *                       granular and wall), row k = the particle of id k:
+ *                       granular and wall), row k = the particle of id k: the rows of the
+ *                       particle-field table marked PF_HDF5 the simulation has, in table order
+ *                       (core/particle_fields.c), today
  *       position  (n, 2) float64 [m]      x, z
  *       velocity  (n, 2) float64 [m/s]    vx, vz
  *       density   (n)    float64 [kg/m^3]
@@ -24,7 +26,8 @@
  *       medium    (n)    uint8   [1]      index into /metadata media (walls: into walls)
  *       state     (n)    uint8   [1]      0 mobile, 1 fixed, 2 wall, 3 lost
  *       id        (n)    uint32  [1]      stable particle id
- *     every dataset has the attributes units and description.
+ *     then any fields of the simulation's material laws or scheme; every dataset has the
+ *     attributes units and description.
  *   /xdmf/vertices_N    0..N-1, the XDMF Polyvertex topology of N particles
  *
  * A simulation sent back in time by mixsph_sim_load_state writes its snapshots again: each
@@ -37,7 +40,8 @@
  *
  * run.xdmf: XDMF 3 (XDMF 2 attribute names, which readers of both accept), a temporal
  * collection of uniform grids, one per snapshot: Polyvertex topology, XY geometry (x, z: in
- * ParaView x to the right and z up), the datasets above as node attributes.
+ * ParaView x to the right and z up: the PF_GEOMETRY row), the other datasets as node attributes
+ * (Scalar, Vector for 2 components, Matrix for more).
  *
  * checkpoint files (mixsph_sim_write_checkpoint): an HDF5 file with the dataset /state (uint8,
  * the buffer of mixsph_sim_save_state: case text, overrides, every particle field and counter,
@@ -63,8 +67,10 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "clock.h"
 #include "monitors.h"
-#include "sim.h"
+#include "particle_fields.h"
+#include "sim_object.h"
 #include "status.h"
 
 #ifndef MIXSPH_VERSION
@@ -454,11 +460,14 @@ static void xdmf_item(FILE *f, const char *indent, size_t n, int comps, const ch
             RUN_FILE, index, field);
 }
 
-static void xdmf_attribute(FILE *f, const struct snap_rec *r, const char *name, const char *kind, int comps,
-                           const char *type, int prec)
+/* A field as a node attribute: Scalar, Vector (2 components, as x and z) or Matrix (others). */
+static void xdmf_attribute(FILE *f, const struct snap_rec *r, const struct particle_field *pf)
 {
-    fprintf(f, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", name, kind);
-    xdmf_item(f, "          ", r->n, comps, type, prec, r->index, name);
+    const unsigned m = pf->components;
+    fprintf(f, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", pf->name,
+            m == 1 ? "Scalar" : m == 2 ? "Vector" : "Matrix");
+    xdmf_item(f, "          ", r->n, m > 1 ? (int)m : 0, pf->type == PF_F64 ? "Float" : "UInt",
+              (int)particle_field_size(pf->type), r->index, pf->name);
     fprintf(f, "        </Attribute>\n");
 }
 
@@ -497,16 +506,19 @@ static int xdmf_write(const mixsph_sim *s, const struct output *o)
                    "Format=\"HDF\">%s:/xdmf/vertices_%zu</DataItem>\n",
                 r->n, RUN_FILE, r->n);
         fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"XY\">\n");
-        xdmf_item(f, "          ", r->n, 2, "Float", 8, r->index, "position");
+        for (size_t k = 0; k < particle_field_count; k++) {
+            const struct particle_field *pf = &particle_fields[k];
+            if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == (PF_HDF5 | PF_GEOMETRY) &&
+                particle_field_present(pf, s->P.features))
+                xdmf_item(f, "          ", r->n, (int)pf->components, pf->type == PF_F64 ? "Float" : "UInt",
+                          (int)particle_field_size(pf->type), r->index, pf->name);
+        }
         fprintf(f, "        </Geometry>\n");
-        xdmf_attribute(f, r, "velocity", "Vector", 2, "Float", 8);
-        xdmf_attribute(f, r, "density", "Scalar", 0, "Float", 8);
-        xdmf_attribute(f, r, "pressure", "Scalar", 0, "Float", 8);
-        xdmf_attribute(f, r, "viscosity", "Scalar", 0, "Float", 8);
-        xdmf_attribute(f, r, "mass", "Scalar", 0, "Float", 8);
-        xdmf_attribute(f, r, "medium", "Scalar", 0, "UInt", 1);
-        xdmf_attribute(f, r, "state", "Scalar", 0, "UInt", 1);
-        xdmf_attribute(f, r, "id", "Scalar", 0, "UInt", 4);
+        for (size_t k = 0; k < particle_field_count; k++) {
+            const struct particle_field *pf = &particle_fields[k];
+            if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == PF_HDF5 && particle_field_present(pf, s->P.features))
+                xdmf_attribute(f, r, pf);
+        }
         fprintf(f, "      </Grid>\n");
     }
     fprintf(f, "    </Grid>\n  </Domain>\n</Xdmf>\n");
@@ -567,8 +579,6 @@ void output_close(mixsph_sim *s)
     s->h5 = NULL;
 }
 
-/* Gather field values into o->scratch in id order (row = id) when the ids are 0..n-1, else in
- * storage order. `comps` double fields (a[k] of comps arrays), or one uint8 / uint32 array. */
 static void *scratch(struct output *o, size_t bytes)
 {
     if (bytes > o->scratch_len) {
@@ -580,28 +590,51 @@ static void *scratch(struct output *o, size_t bytes)
     return o->scratch;
 }
 
-static int write_doubles(struct output *o, hid_t g, const struct particles *P, int by_id, const double *a,
-                         const double *b, const char *name, const char *units, const char *desc)
+/* HDF5 file (little-endian) and memory types of a field's elements. */
+static hid_t field_file_type(enum particle_field_type t)
 {
-    const size_t n = P->n, m = b ? 2 : 1;
-    double *buf = scratch(o, (n ? n : 1) * m * sizeof(double));
-    if (!buf) return -1;
-    for (size_t i = 0; i < n; i++) {
-        const size_t r = by_id ? P->id[i] : i;
-        buf[r * m] = a[i];
-        if (b) buf[r * m + 1] = b[i];
+    switch (t) {
+    case PF_F64: return H5T_IEEE_F64LE;
+    case PF_U8: return H5T_STD_U8LE;
+    case PF_U16: return H5T_STD_U16LE;
+    case PF_U32: return H5T_STD_U32LE;
     }
-    return dset_write(g, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, b ? 2 : 0, buf, units, desc);
+    return -1;
 }
 
-static int write_u8(struct output *o, hid_t g, const struct particles *P, int by_id, const uint8_t *a, const char *name,
-                    const char *desc)
+static hid_t field_mem_type(enum particle_field_type t)
 {
-    const size_t n = P->n;
-    uint8_t *buf = scratch(o, n ? n : 1);
+    switch (t) {
+    case PF_F64: return H5T_NATIVE_DOUBLE;
+    case PF_U8: return H5T_NATIVE_UINT8;
+    case PF_U16: return H5T_NATIVE_UINT16;
+    case PF_U32: return H5T_NATIVE_UINT32;
+    }
+    return -1;
+}
+
+/* Write field f of P as a dataset of g: its components interleaved, (n) or (n, components),
+ * row = the particle's id when the ids are 0..n-1 (by_id), else storage order. */
+static int write_field(struct output *o, hid_t g, const struct particles *P, int by_id, const struct particle_field *f)
+{
+    const size_t n = P->n, m = f->components;
+    void *buf = scratch(o, (n ? n : 1) * m * particle_field_size(f->type));
     if (!buf) return -1;
-    for (size_t i = 0; i < n; i++) buf[by_id ? P->id[i] : i] = a[i];
-    return dset_write(g, name, H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 0, buf, "1", desc);
+#define GATHER(T)                                                                         \
+    do {                                                                                  \
+        const T *a_ = particles_array(P, f->member[c]);                                   \
+        T *b_ = buf;                                                                      \
+        for (size_t i = 0; i < n; i++) b_[(by_id ? P->id[i] : i) * m + c] = a_[i];       \
+    } while (0)
+    for (unsigned c = 0; c < m; c++) switch (f->type) {
+        case PF_F64: GATHER(double); break;
+        case PF_U8: GATHER(uint8_t); break;
+        case PF_U16: GATHER(uint16_t); break;
+        case PF_U32: GATHER(uint32_t); break;
+        }
+#undef GATHER
+    return dset_write(g, f->name, field_file_type(f->type), field_mem_type(f->type), n, m > 1 ? m : 0, buf, f->unit,
+                      f->description);
 }
 
 static int write_snapshot(mixsph_sim *s, struct output *o, long index)
@@ -619,20 +652,9 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
     /* the attribute index is written last: a group without it is incomplete */
     int bad = attr_f64(g, "time", s->t) || attr_i64(g, "step", (long long)s->step) ||
               attr_i64(g, "n", (long long)P->n) || attr_str(g, "time_units", "s");
-    bad = bad || write_doubles(o, g, P, by_id, P->x, P->z, "position", "m", "x, z (z up)");
-    bad = bad || write_doubles(o, g, P, by_id, P->vx, P->vz, "velocity", "m/s", "vx, vz");
-    bad = bad || write_doubles(o, g, P, by_id, P->rho, NULL, "density", "kg/m^3", "density");
-    bad = bad || write_doubles(o, g, P, by_id, P->p, NULL, "pressure", "Pa", "pressure");
-    bad = bad || write_doubles(o, g, P, by_id, P->mu, NULL, "viscosity", "Pa s", "dynamic (apparent) viscosity");
-    bad = bad || write_doubles(o, g, P, by_id, P->m, NULL, "mass", "kg", "mass (per unit depth of the 2D model)");
-    bad = bad || write_u8(o, g, P, by_id, P->medium, "medium",
-                          "index into /metadata media (fluid and granular particles) or walls (wall particles)");
-    bad = bad || write_u8(o, g, P, by_id, P->state, "state", "0 mobile, 1 fixed, 2 wall, 3 lost");
-    if (!bad) {
-        uint32_t *ids = scratch(o, (P->n ? P->n : 1) * sizeof *ids);
-        if (!ids) bad = 1;
-        for (size_t i = 0; !bad && i < P->n; i++) ids[by_id ? P->id[i] : i] = P->id[i];
-        bad = bad || dset_write(g, "id", H5T_STD_U32LE, H5T_NATIVE_UINT32, P->n, 0, ids, "1", "stable particle id");
+    for (size_t k = 0; k < particle_field_count && !bad; k++) {
+        const struct particle_field *f = &particle_fields[k];
+        if ((f->where & PF_HDF5) && particle_field_present(f, P->features)) bad = write_field(o, g, P, by_id, f);
     }
     bad = bad || attr_i64(g, "index", index);
     bad |= H5Gclose(g) < 0;
@@ -645,11 +667,11 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
 mixsph_status output_snapshot(mixsph_sim *s)
 {
     const long index = s->snap_index;
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
     if (s->csv_snapshots_off) s->snap_index++;
     else st = monitors_snapshot(s);
-    const double t1 = sim_clock_s();
+    const double t1 = clock_monotonic_s();
     s->out_seconds[T_CSV] += t1 - t0;
     struct output *o = s->h5;
     if (st != MIXSPH_OK || !o) return st;
@@ -662,7 +684,7 @@ mixsph_status output_snapshot(mixsph_sim *s)
     if (snaps_push(o, (struct snap_rec){index, s->t, s->step, s->P.n}))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     if (xdmf_write(s, o) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));
-    s->out_seconds[T_HDF5] += sim_clock_s() - t1;
+    s->out_seconds[T_HDF5] += clock_monotonic_s() - t1;
     return MIXSPH_OK;
 }
 
@@ -695,7 +717,7 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
 {
     if (!s) return MIXSPH_ERR_ARG;
     if (!path || !*path) return SIM_FAIL(s, MIXSPH_ERR_ARG, "checkpoint: no file name");
-    const double t0 = sim_clock_s();
+    const double t0 = clock_monotonic_s();
     void *buf = NULL;
     size_t len = 0;
     mixsph_status st = mixsph_sim_save_state(s, &buf, &len);
@@ -743,22 +765,18 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     }
     if (bad) remove(tmp);
     free(tmp);
-    const double spent = sim_clock_s() - t0;
+    const double spent = clock_monotonic_s() - t0;
     s->out_seconds[T_CKPT] += spent;
     s->run_wall_s += spent; /* the run's time includes its checkpoints (after this one's attribute) */
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;
 }
 
-mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
+mixsph_status output_read_checkpoint(const char *path, unsigned char **state, size_t *len, double *run_wall_s,
+                                     char *err, size_t err_len)
 {
-    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
-}
-
-mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
-                                                              mixsph_sim **out, char *err, size_t err_len)
-{
-    if (out) *out = NULL;
-    if (!path || !out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_checkpoint: no file or no out");
+    *state = NULL;
+    *len = 0;
+    *run_wall_s = NAN;
     if (access(path, R_OK) != 0)
         return status_set(err, err_len, MIXSPH_ERR_ARG, "checkpoint %s: cannot read: %s", path, strerror(errno));
     struct quiet q;
@@ -766,7 +784,7 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
     struct cause c;
     mixsph_status st = MIXSPH_OK;
     unsigned char *buf = NULL;
-    size_t len = 0;
+    size_t n_read = 0;
     double run_wall = NAN;
     const hid_t fapl = fapl_nolock();
     const hid_t f = H5Fopen(path, H5F_ACC_RDONLY, fapl);
@@ -785,7 +803,7 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
         } else if (H5Dread(d, H5T_NATIVE_UINT8, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0) {
             st = status_set(err, err_len, MIXSPH_ERR_IO, "checkpoint %s: cannot read /state (HDF5: %s)", path, h5_cause(&c));
         } else {
-            len = (size_t)n;
+            n_read = (size_t)n;
         }
         if (sp >= 0) H5Sclose(sp);
         if (d >= 0) H5Dclose(d);
@@ -795,14 +813,14 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
         H5Fclose(f);
     }
     quiet_off(&q);
-    if (st == MIXSPH_OK) {
-        char msg[900];
-        st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
-        if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
-        else (*out)->run_wall_s = run_wall;
+    if (st != MIXSPH_OK) {
+        free(buf);
+        return st;
     }
-    free(buf);
-    return st;
+    *state = buf;
+    *len = (size_t)n_read;
+    *run_wall_s = run_wall;
+    return MIXSPH_OK;
 }
 
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)

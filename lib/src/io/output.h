@@ -5,6 +5,8 @@
 #ifndef MIXSPH_OUTPUT_H
 #define MIXSPH_OUTPUT_H
 
+#include <stddef.h>
+
 #include "mixsph.h"
 
 struct output; /* the open run file of one simulation (owned by mixsph_sim, field h5) */
@@ -25,6 +27,13 @@ mixsph_status output_resume_monitors(mixsph_sim *s);
  *  file and rewrite the sidecar, so that a run killed later leaves every snapshot so far
  *  readable. Advances s->snap_index. */
 mixsph_status output_snapshot(mixsph_sim *s);
+
+/** Read a checkpoint file (mixsph_sim_write_checkpoint): the saved state (*state, malloc'd, *len
+ *  bytes; the caller frees it) and the run's wall time up to it (*run_wall_s, NAN when the file
+ *  does not say). Errors: MIXSPH_ERR_ARG (not readable, not a mixsph checkpoint), MIXSPH_ERR_IO,
+ *  MIXSPH_ERR_NOMEM, with a message naming the file. */
+mixsph_status output_read_checkpoint(const char *path, unsigned char **state, size_t *len, double *run_wall_s,
+                                     char *err, size_t err_len);
 
 /** Close the run file (NULL-safe; s->h5 becomes NULL). */
 void output_close(mixsph_sim *s);

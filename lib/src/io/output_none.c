@@ -8,9 +8,10 @@
  * library. */
 #include "output.h"
 
+#include <math.h>
 #include <stddef.h>
 
-#include "sim.h"
+#include "sim_object.h"
 #include "status.h"
 
 #define NO_HDF5 "this build of the mixsph library has no HDF5 (the FMU's): "
@@ -41,18 +42,14 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
                     path ? path : "(null)");
 }
 
-mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, const mixsph_interrupt *interrupt,
-                                                              mixsph_sim **out, char *err, size_t err_len)
+mixsph_status output_read_checkpoint(const char *path, unsigned char **state, size_t *len, double *run_wall_s,
+                                     char *err, size_t err_len)
 {
-    (void)interrupt;
-    if (out) *out = NULL;
+    *state = NULL;
+    *len = 0;
+    *run_wall_s = NAN;
     return status_set(err, err_len, MIXSPH_ERR_IO, NO_HDF5 "cannot read the checkpoint %s (checkpoints are HDF5 files)",
                       path ? path : "(null)");
-}
-
-mixsph_status mixsph_sim_create_from_checkpoint(const char *path, mixsph_sim **out, char *err, size_t err_len)
-{
-    return mixsph_sim_create_from_checkpoint_interruptible(path, NULL, out, err, err_len);
 }
 
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)

@@ -1,12 +1,14 @@
 /* sim_query.c - read-only questions a host asks about a simulation or a case file before or
  * while it drives it (the FMU: which walls move and which way, which parameters a case lets a
- * host set). Nothing here changes a simulation. See the last section of mixsph.h. */
+ * host set) and its particle fields by the particle-field table. Nothing here changes a
+ * simulation. See the last section of mixsph.h. */
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "particle_fields.h"
 #include "sim.h"
 #include "status.h"
 
@@ -99,4 +101,60 @@ mixsph_status mixsph_case_parameter_names(const char *case_path, char *names, si
     }
     cJSON_Delete(root);
     return MIXSPH_OK;
+}
+
+/* ---- particle fields: the rows of the particle-field table marked PF_VIEW the simulation has -- */
+
+_Static_assert(PARTICLE_FIELD_MAX_COMPONENTS == MIXSPH_FIELD_MAX_COMPONENTS, "the view holds every component");
+
+static const struct particle_field *view_field(const mixsph_sim *s, size_t k)
+{
+    for (size_t r = 0; r < particle_field_count; r++) {
+        const struct particle_field *f = &particle_fields[r];
+        if ((f->where & PF_VIEW) && particle_field_present(f, s->P.features) && k-- == 0) return f;
+    }
+    return NULL;
+}
+
+size_t mixsph_sim_particle_field_count(const mixsph_sim *s)
+{
+    size_t n = 0;
+    while (s && view_field(s, n)) n++;
+    return n;
+}
+
+static void view_fill(const mixsph_sim *s, const struct particle_field *pf, mixsph_particle_field *f)
+{
+    static const mixsph_field_type types[] = {[PF_F64] = MIXSPH_FIELD_F64, [PF_U8] = MIXSPH_FIELD_U8,
+                                              [PF_U16] = MIXSPH_FIELD_U16, [PF_U32] = MIXSPH_FIELD_U32};
+    memset(f, 0, sizeof *f);
+    f->name = pf->name;
+    f->columns = pf->columns;
+    f->unit = pf->unit;
+    f->description = pf->description;
+    f->owner = particle_field_owner_name(pf->owner);
+    f->components = pf->components;
+    f->type = types[pf->type];
+    f->n = s->P.n;
+    for (unsigned c = 0; c < pf->components; c++) f->data[c] = particles_array(&s->P, pf->member[c]);
+}
+
+mixsph_status mixsph_sim_particle_field(const mixsph_sim *s, size_t k, mixsph_particle_field *f)
+{
+    const struct particle_field *pf = s && f ? view_field(s, k) : NULL;
+    if (!pf) return MIXSPH_ERR_ARG;
+    view_fill(s, pf, f);
+    return MIXSPH_OK;
+}
+
+mixsph_status mixsph_sim_particle_field_find(const mixsph_sim *s, const char *name, mixsph_particle_field *f)
+{
+    if (!s || !name || !f) return MIXSPH_ERR_ARG;
+    const struct particle_field *pf;
+    for (size_t k = 0; (pf = view_field(s, k)) != NULL; k++)
+        if (strcmp(pf->name, name) == 0) {
+            view_fill(s, pf, f);
+            return MIXSPH_OK;
+        }
+    return MIXSPH_ERR_ARG;
 }

@@ -4,7 +4,10 @@
  * Layout (native byte order, checked by a marker): a header "MIXSPHST", format version, byte
  * order marker; the case text, origin and overrides the simulation was created from; the
  * scalar state (time, step, time step, counters, output extremes and schedule); the walls'
- * displacement, velocity and external drive; every particle field; a 64-bit FNV-1a checksum of
+ * displacement, velocity and external drive; the particle fields the particle-field table marks
+ * PF_STATE and the simulation has, in table order, each as its name, component count, element
+ * size and component arrays (a state of a build with other fields is refused naming the first
+ * that differs); the neighbour lists' build positions; a 64-bit FNV-1a checksum of
  * all preceding bytes. Derived data (cell list, kernel, media constants) is rebuilt from the case
  * on load, so a restored simulation continues exactly as the saved one would have. */
 #include <math.h>
@@ -12,13 +15,16 @@
 #include <string.h>
 
 #include "integrate.h"
-#include "sim.h"
+#include "particle_fields.h"
+#include "sim_object.h"
+#include "state.h"
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 5u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
+#define STATE_VERSION 6u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
                             4: the increments of the implicit step's first stage; 5: those of the
-                            step before (the warm starts' extrapolation) */
+                            step before (the warm starts' extrapolation); 6: the particle fields of
+                            the particle-field table, each named */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
@@ -166,13 +172,15 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
     put_u64(w, P->n);
     put_u64(w, s->n_fluid);
     put_u64(w, s->n_wall);
-#define W(f) put(w, P->f, P->n * sizeof(double));
-    PARTICLES_DOUBLE_FIELDS(W)
-#undef W
-    put(w, P->medium, P->n);
-    put(w, P->state, P->n);
-    put(w, P->nneigh, P->n * sizeof(uint16_t));
-    put(w, P->id, P->n * sizeof(uint32_t));
+    for (size_t k = 0; k < particle_field_count; k++) {
+        const struct particle_field *f = &particle_fields[k];
+        if (!(f->where & PF_STATE) || !particle_field_present(f, P->features)) continue;
+        put_str(w, f->name);
+        put_u64(w, f->components);
+        put_u64(w, particle_field_size(f->type));
+        for (unsigned c = 0; c < f->components; c++)
+            put(w, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
+    }
     /* the neighbour lists' build positions: the lists (and the pair order) are rebuilt from them */
     put(w, s->NB.x0, P->n * sizeof(double));
     put(w, s->NB.z0, P->n * sizeof(double));
@@ -224,15 +232,7 @@ static mixsph_status check_header(struct reader *r, char *err, size_t err_len)
     return MIXSPH_OK;
 }
 
-/* The case source stored in a state: text and origin copied (NUL-terminated), overrides. */
-struct source {
-    char *text, *origin;
-    size_t n_ov;
-    char **keys;
-    double *values;
-};
-
-static void source_free(struct source *src)
+void state_source_free(struct state_source *src)
 {
     for (size_t k = 0; k < src->n_ov; k++) free(src->keys[k]);
     free(src->keys);
@@ -253,7 +253,7 @@ static char *copy_str(struct reader *r)
     return d;
 }
 
-static mixsph_status read_source(struct reader *r, struct source *src, char *err, size_t err_len)
+static mixsph_status read_source(struct reader *r, struct state_source *src, char *err, size_t err_len)
 {
     memset(src, 0, sizeof *src);
     src->text = copy_str(r);
@@ -324,13 +324,22 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
     if (r->bad || n != P->n || n_fluid != s->n_fluid || n_wall != s->n_wall)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particle counts differ from the case's (%llu vs %zu)", (unsigned long long)n,
                         P->n);
-#define R(f) get(r, P->f, P->n * sizeof(double));
-    PARTICLES_DOUBLE_FIELDS(R)
-#undef R
-    get(r, P->medium, P->n);
-    get(r, P->state, P->n);
-    get(r, P->nneigh, P->n * sizeof(uint16_t));
-    get(r, P->id, P->n * sizeof(uint32_t));
+    for (size_t k = 0; k < particle_field_count; k++) {
+        const struct particle_field *f = &particle_fields[k];
+        if (!(f->where & PF_STATE) || !particle_field_present(f, P->features)) continue;
+        size_t len;
+        const char *name = get_str(r, &len);
+        const uint64_t components = get_u64(r), elem = get_u64(r);
+        if (r->bad) break;
+        if (len != strlen(f->name) || memcmp(name, f->name, len) != 0 || components != f->components ||
+            elem != particle_field_size(f->type))
+            return SIM_FAIL(s, MIXSPH_ERR_ARG,
+                            "state: particle field '%.*s' (%llu x %llu bytes) where this build has '%s' (%u x %zu bytes)",
+                            (int)(len < 64 ? len : 64), name, (unsigned long long)components, (unsigned long long)elem,
+                            f->name, f->components, particle_field_size(f->type));
+        for (unsigned c = 0; c < f->components; c++)
+            get(r, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
+    }
     get(r, s->NB.x0, P->n * sizeof(double));
     get(r, s->NB.z0, P->n * sizeof(double));
     s->NB.builds = get_u64(r);
@@ -344,14 +353,14 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     struct reader r = {buf, len, 0, 0};
     mixsph_status st = check_header(&r, s->err, sizeof s->err);
     if (st != MIXSPH_OK) return st;
-    struct source src;
+    struct state_source src;
     st = read_source(&r, &src, s->err, sizeof s->err);
     if (st == MIXSPH_OK && !state_same_case(s, src.text, (const char *const *)src.keys, src.values, src.n_ov))
         st = SIM_FAIL(s, MIXSPH_ERR_ARG,
                       "state: saved from another case or other overrides (%s) than this simulation's (%s); create a "
                       "new simulation from the state instead",
                       src.origin, s->case_origin);
-    source_free(&src);
+    state_source_free(&src);
     if (st != MIXSPH_OK) return st;
     /* keep a copy so that a malformed payload leaves the simulation unchanged */
     mixsph_sim *keep = malloc(sizeof *keep);
@@ -374,14 +383,7 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
         struct particles P = s->P;
         memcpy(s, keep, sizeof *s);
         s->P = P;
-        const size_t n = P.n;
-#define C(f) memcpy(s->P.f, Pk.f, n * sizeof(double));
-        PARTICLES_DOUBLE_FIELDS(C)
-#undef C
-        memcpy(s->P.medium, Pk.medium, n);
-        memcpy(s->P.state, Pk.state, n);
-        memcpy(s->P.nneigh, Pk.nneigh, n * sizeof(uint16_t));
-        memcpy(s->P.id, Pk.id, n * sizeof(uint32_t));
+        particles_copy_values(&s->P, &Pk);
         memcpy(s->NB.x0, x0k, nb);
         memcpy(s->NB.z0, z0k, nb);
         state_relist(s);
@@ -394,35 +396,10 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     return st;
 }
 
-mixsph_status mixsph_sim_create_from_state(const void *buf, size_t len, mixsph_sim **out, char *err, size_t err_len)
+mixsph_status state_read_source(const void *buf, size_t len, struct state_source *src, char *err, size_t err_len)
 {
-    return sim_create_from_state(buf, len, NULL, out, err, err_len);
-}
-
-mixsph_status sim_create_from_state(const void *buf, size_t len, const mixsph_interrupt *interrupt, mixsph_sim **out,
-                                    char *err, size_t err_len)
-{
-    if (!out) return status_set(err, err_len, MIXSPH_ERR_ARG, "create_from_state: out is NULL");
-    *out = NULL;
+    memset(src, 0, sizeof *src);
     struct reader r = {buf, len, 0, 0};
-    mixsph_status st = check_header(&r, err, err_len);
-    if (st != MIXSPH_OK) return st;
-    struct source src;
-    st = read_source(&r, &src, err, err_len);
-    mixsph_override *ov = NULL;
-    if (st == MIXSPH_OK && !(ov = calloc(src.n_ov + 1, sizeof *ov))) st = status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory");
-    if (st == MIXSPH_OK) {
-        for (size_t k = 0; k < src.n_ov; k++) ov[k] = (mixsph_override){src.keys[k], src.values[k]};
-        st = sim_create_from_text(src.text, src.origin, ov, src.n_ov, interrupt, out, err, err_len);
-    }
-    free(ov);
-    source_free(&src);
-    if (st != MIXSPH_OK) return st;
-    st = mixsph_sim_load_state(*out, buf, len);
-    if (st != MIXSPH_OK) {
-        status_set(err, err_len, st, "%s", (*out)->err);
-        mixsph_sim_destroy(*out);
-        *out = NULL;
-    }
-    return st;
+    const mixsph_status st = check_header(&r, err, err_len);
+    return st != MIXSPH_OK ? st : read_source(&r, src, err, err_len);
 }

@@ -106,6 +106,7 @@ struct pair_ctx {
     double av_cap;   /* u_ij.x_ij is capped at this: 0 (approaching pairs only) or +inf (all pairs) */
     int wendland;
     int arithmetic_mean;  /* implicit viscosity with the pair viscosity (mu_i + mu_j) / 2 */
+    int stress;           /* the particles' deviatoric stresses enter the momentum pass */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -130,6 +131,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->av_cap = fp->av_separating ? INFINITY : 0.0;
     X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
     X->arithmetic_mean = fp->arithmetic_mean;
+    X->stress = fp->stress;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -147,6 +149,16 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
 {
     return kernel_f_q(&X->K, kernel_q(&X->K, r2), wendland);
 }
+
+/* The skeleton every pair pass runs over particle i's candidates: its nr ranges
+ * [rng[2r], rng[2r + 1]) of the neighbour lists, in chunks of FORCES_CHUNK lanes from jb, the
+ * first `lanes` of them inside the range (the rest masked off by FORCES_LANE_IN; the innermost
+ * loop runs once, to declare it). A pass's body evaluates its pair term on the chunk's lanes with
+ * `omp simd` and adds what j receives with chunk_add. */
+#define FORCES_FOR_EACH_CHUNK(rng, nr, jb, lanes)                                                  \
+    for (int r_ = 0; r_ < (nr); r_++)                                                               \
+        for (size_t jb = (rng)[2 * r_], e_ = (rng)[2 * r_ + 1]; jb < e_; jb += FORCES_CHUNK)        \
+            for (size_t lanes = e_ - jb < FORCES_CHUNK ? e_ - jb : FORCES_CHUNK, once_ = 1; once_; once_ = 0)
 
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
 #define FORCES_LANE_IN(k, m) ((k) < (m) ? 1.0 : 0.0)
@@ -174,9 +186,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -217,9 +227,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
     const double *restrict vol = P->vol, *restrict tag = P->tag;
     const struct pair_ctx Xl = *X;
     double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -255,9 +263,7 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
     const double *restrict vol = P->vol;
     const struct pair_ctx Xl = *X;
     double a[7][FORCES_CHUNK] = {{0}};
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
@@ -288,7 +294,7 @@ enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double *axi, double *azi,
                                   const double *restrict fk, double *restrict wl, const int wendland,
-                                  const int cached, const int implicit)
+                                  const int cached, const int implicit, const int stress)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
@@ -298,11 +304,13 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
     const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
     const double *restrict avc = P->avc;
+    const double *restrict sxx = P->sxx, *restrict sxz = P->sxz, *restrict szz = P->szz;
+    const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
+    const double *restrict wall_rough = P->wall_rough;
+    const double roughi = stress ? wall_rough[i] : 0.0;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
-    for (int r = 0; r < nr; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t n = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, n) {
         double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -345,6 +353,14 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             } else {
                 fx = F * (fr * rx + fv * (uvxi - uvx[j]));
                 fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+            }
+            if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W; a wall holds none,
+                           * and a rough (no-slip) wall takes the stress of the particle it meets */
+                const double ci = 1.0 + wall_rough[j], cj = 1.0 + roughi;
+                const double txx = vv * (ci * sxxi + cj * sxx[j]), txz = vv * (ci * sxzi + cj * sxz[j]);
+                const double tzz = vv * (ci * szzi + cj * szz[j]);
+                fx += F * (txx * rx + txz * rz);
+                fz += F * (txz * rx + tzz * rz);
             }
             sx[k] += fx;
             sz[k] += fz;
@@ -395,12 +411,13 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit)
+                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
+                                 const int stress)
 {
     for (size_t i = b0; i < b1; i++) {
         double sx = 0.0, sz = 0.0;
         momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL,
-                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit);
+                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit, stress);
         P->ax[i] += sx;
         P->az[i] += sz;
     }
@@ -416,9 +433,7 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
     double *restrict ox = X->out_x, *restrict oz = X->out_z, *restrict od = X->out_diag;
     const double uxi = ux[i], uzi = uz[i];
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}, sd[FORCES_CHUNK] = {0};
-    for (int r = 0; r < 2; r++)
-    for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-        const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+    FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
         double jx[FORCES_CHUNK], jz[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -473,9 +488,7 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
         double *gw = X->group_w + 5 * (size_t)gi;
         const uint32_t *rng = NB->rng + 4 * i;
         const double *wl = X->visc_w + X->fk_off[i];
-        for (int r = 0; r < 2; r++)
-            for (size_t jb = rng[2 * r], e = rng[2 * r + 1]; jb < e; jb += FORCES_CHUNK) {
-                const size_t m = e - jb < FORCES_CHUNK ? e - jb : FORCES_CHUNK;
+        FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
                 for (size_t k = 0; k < m; k++) {
                     const int32_t gj = group[jb + k];
                     if (gj < 0) continue;
@@ -518,24 +531,32 @@ static void continuity_band(const struct pair_ctx *X, const struct neighbours *N
     FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1);
 }
 
-FORCES_CLONES
-static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                          size_t b0, size_t b1)
+/* The momentum band walk, one inlined copy with and one without the stress term. */
+FORCES_INLINE void momentum_band_variant(const struct pair_ctx *X, const struct neighbours *NB,
+                                         struct particles *restrict P, size_t b0, size_t b1, const int stress)
 {
     if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
         if (X->arithmetic_mean) {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress);
         } else {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress);
         }
         return;
     }
 #define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
-    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY)
+    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress)
     FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
 #undef MOMENTUM_EXPLICIT
+}
+
+FORCES_CLONES
+static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
+                          size_t b0, size_t b1)
+{
+    if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1);
+    else momentum_band_variant(X, NB, P, b0, b1, 0);
 }
 
 struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
@@ -673,7 +694,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
         if (grad) {
 #pragma omp for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
+                if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
                     gradient_particle(&X, S->G, P, grad, i);
         }
 #pragma omp for schedule(static) reduction(| : bad) nowait
@@ -702,7 +723,7 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
     const size_t n = active_count(S);
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++)
-        if (P->state[i] <= MIXSPH_STATE_FIXED && M[P->medium[i]].kind == MEDIUM_GRANULAR)
+        if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
             gradient_particle(&X, S->G, P, out, i);
 }
 
@@ -804,7 +825,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY);
+    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress);
     *ax = sx * P->inv_m[i];
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];

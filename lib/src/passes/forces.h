@@ -13,6 +13,7 @@
 #include "kernel.h"
 #include "neighbours.h"
 #include "particles.h"
+#include "velocity_gradient.h"
 
 /* Entries past the active rows that a per-particle array handed to a pass must hold, finite and
  * neutral (the chunked pair loops read them with zero weight). */
@@ -29,6 +30,8 @@ struct forces_params {
     int implicit_viscosity; /* the momentum pass leaves the viscous term out and stores its
                                couplings for forces_viscous_apply (docs/numerics.md) */
     int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */
+    int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
+                               stress (P->sxx, sxz, szz; a law with LAW_HAS_STRESS) */
 };
 
 /* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */
@@ -42,13 +45,6 @@ struct pair_system {
     int n_threads;
 };
 
-/* Velocity gradient of the grains (uncorrected G = sum_j V_j (u_j - u_i) (x) grad W) and the
- * correction matrix L = sum_j V_j (x_j - x_i) (x) grad W (symmetric), per particle; filled
- * within a step for the granular particles only, not permuted. */
-struct velocity_gradient {
-    double *dudx, *dudz, *dwdx, *dwdz; /* [1/s] */
-    double *lxx, *lxz, *lzz;           /* [-] */
-};
 
 /* Module state: the kernel-factor cache that the density pass fills and the momentum pass of the
  * same step reads, and the scratch sums of the passes. */

@@ -4,7 +4,10 @@
 #ifndef MIXSPH_INTEGRATE_H
 #define MIXSPH_INTEGRATE_H
 
-#include "sim.h"
+#include "sim_object.h"
+
+/** What the pair loops of forces.h run over, from the simulation's current parts and options. */
+struct pair_system sim_pair_system(mixsph_sim *s);
 
 /** Sort the particles by cell (marking those that left the domain lost) and rebuild the pair
  *  ranges, the gather lists and the near-wall flags. */
@@ -19,22 +22,12 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s);
  *  memory, 0 otherwise. */
 int integrate_density_rates(mixsph_sim *s, const struct pair_system *S);
 
+/** The material laws' per-step updates (laws/law.h) over law_dt [s] (0: at the current state,
+ *  nothing advanced), after this step's density pass, equation of state and velocity gradient. */
+void integrate_update_laws(mixsph_sim *s, double law_dt);
+
 /** The next time step from criterion (4). */
 double integrate_time_step(const mixsph_sim *s);
-
-/** Criterion (4) for one particle: the acoustic bound cfl 2 h / (c_max + |u|) and, when mu > 0,
- *  the viscous bound cfl_visc 2 h^2 rho / mu [s]. integrate_time_step takes its minimum over the
- *  particles; the case's resource budget (budget.c) estimates the number of steps with it. */
-static inline double integrate_particle_dt(double cfl, double cfl_visc, double h, double c_max, double speed,
-                                           double rho, double mu)
-{
-    double d = cfl * 2.0 * h / (c_max + speed);
-    if (mu > 0.0) {
-        const double dv = cfl_visc * 2.0 * h * h * rho / mu;
-        if (dv < d) d = dv;
-    }
-    return d;
-}
 
 /** Pressure from the equation of state and the fields derived from the density and the medium
  *  (1/rho, volume m/rho, artificial-viscosity coefficient) of every non-wall particle. */

@@ -1,10 +1,8 @@
 /* viscous.c - see viscous.h.
  *
- * Unknowns: the mobile particles and, with numerics.held_grains "solved", the grains held fixed
- * (they take forces and kicks as in the explicit scheme, they are only not drifted) among the
- * active ones. Held grains are prescribed at rest when "rigid" (then judged on the velocity one
- * explicit step of their forces gives them, held_grain_kicks below) and in a hold_fixed medium (no
- * forces); the wall particles follow the unknowns through
+ * Unknowns: the particles the caller names (the implicit scheme: the mobile ones and the grains
+ * held fixed that take their forces, by the paper law's rule, mixture_paper.h); the others keep
+ * their velocities; the wall particles follow the unknowns through
  * the mirror of walls.h, u_g = c_g + s_g sum_k a_gk u_k (with the wall's velocity at the end of
  * the step, so the boundary condition is implicit like the rest). With u = u_U + u_B, u_B the
  * prescribed values with the walls' mirror of them,
@@ -134,7 +132,8 @@ struct solve_ctx {
     const struct wall_mirror *M; /* NULL: the wall rows keep P->uvx, P->uvz */
     double dt;                   /* the stage's kappa */
     size_t n;
-    int rigid;                   /* grains held fixed are prescribed at rest (numerics.held_grains) */
+    const unsigned char *unknown; /* per particle: its velocity is solved for (else prescribed); NULL:
+                                   * every mobile and held particle (viscous_solve) */
 };
 
 /* Fill the wall rows of (vx, vz) from their unknown rows (with_constant: the whole mirror map,
@@ -241,10 +240,8 @@ static int setup(const struct solve_ctx *c)
     const double dt = c->dt;
 #pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
     for (size_t i = 0; i < c->n; i++) {
-        /* grains held fixed take their forces like mobile ones (they are only not drifted), unless
-         * they are rigid or of a hold_fixed medium */
-        mob[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
-                 (P->state[i] == MIXSPH_STATE_FIXED && !c->rigid && !c->S->media[P->medium[i]].hold_fixed);
+        /* the caller says which velocities are unknowns (the rest, walls aside, stay as they are) */
+        mob[i] = c->unknown ? c->unknown[i] : P->state[i] <= MIXSPH_STATE_FIXED;
         v[MASS][i] = P->m[i];
         v[U0X][i] = mob[i] ? 0.0 : P->vx[i];
         v[U0Z][i] = mob[i] ? 0.0 : P->vz[i];
@@ -505,36 +502,29 @@ int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct
  * lid-driven closed channel grew without bound with either from t = 0.03 s. */
 #define SDIRK_GAMMA 1.7071067811865475 /* 1 + 1/sqrt 2 */
 
-/* With rigid held grains: the velocity of every held grain (not of a hold_fixed medium) after one
- * explicit step of judge_dt, as the explicit scheme gives it to the grain it judges (mixture.c):
- * its acceleration by the other forces (P->ax, P->az of the last momentum pass) plus the viscous
- * one from the solved velocities around it, -(L u)_i / m_i with u_i = 0 (v[UX], v[UZ] hold the
- * whole field after store). One operator pass. */
-static int held_grain_kicks(const struct solve_ctx *c, double judge_dt)
+int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
+                              const double **lx, const double **lz)
 {
-    struct particles *P = c->S->P;
-    double **v = c->V->v;
-    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], NULL) != 0) return -1;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || c->S->media[P->medium[i]].hold_fixed) continue;
-        P->vx[i] = judge_dt * (P->ax[i] - v[RX][i] / P->m[i]);
-        P->vz[i] = judge_dt * (P->az[i] - v[RZ][i] / P->m[i]);
-    }
+    double **v = V->v;
+    if (forces_viscous_apply(F, S, v[UX], v[UZ], v[RX], v[RZ], NULL) != 0) return -1;
+    *lx = v[RX];
+    *lz = v[RZ];
     return 0;
 }
 
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
-                 double judge_dt, double tolerance, int max_iterations, struct viscous_report *report)
+                 const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report)
 {
     const size_t n = S->C->start[S->C->ncell];
     *report = (struct viscous_report){.converged = 1};
     if (reserve(V, n) != 0) return -1;
-    V->preconditioner = cfg->viscous_preconditioner;
+    V->preconditioner = vp->preconditioner;
     V->coarse_built = 0;
     const double g = SDIRK_GAMMA;
-    const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = g * dt, .n = n, .rigid = cfg->held_grains_rigid};
+    const double tolerance = vp->tolerance;
+    const int max_iterations = vp->max_iterations;
+    const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = g * dt, .n = n, .unknown = unknown};
     const struct particles *P = S->P;
     double **v = V->v;
     const int threads = S->n_threads;
@@ -575,6 +565,5 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     walls_mirror_at(M, cfg, ws, P, t, dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     store(&c);
-    if (c.rigid && judge_dt > 0.0 && held_grain_kicks(&c, judge_dt) != 0) return -1;
     return 0;
 }

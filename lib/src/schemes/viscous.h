@@ -4,8 +4,9 @@
  * whose stages are backward-Euler-like solves
  *     m_i u_i + kappa sum_j w_ij (u_i - u_j) = m_i w_i        for the unknown particles i,
  * w_ij >= 0 the couplings of the momentum pass (forces.h). Wall particles follow the unknowns
- * through the mirror of walls.h (their wall's velocity at the stage's time); grains held fixed
- * are prescribed at rest when numerics.held_grains is "rigid" or their medium hold_fixed. The
+ * through the mirror of walls.h (their wall's velocity at the stage's time); which other
+ * particles are unknowns the caller says (the scheme, by the material laws' rules): the rest
+ * keep their velocities. The solver knows no physical rule. The
  * system is solved matrix-free by BiCGSTAB with a Jacobi or a two-level (Jacobi plus the coarse
  * correction of viscous_coarse.h) preconditioner, each stage warm-started from its increments of
  * the last two steps (kept per particle). Dot products are summed in fixed blocks, so results do not depend on the
@@ -29,26 +30,37 @@ struct viscous_report {
     int converged;     /* residual <= tolerance */
 };
 
+/* The solver's numerical parameters (numerics.viscous_*), fixed for a run. */
+struct viscous_params {
+    int preconditioner;  /* enum viscous_preconditioner */
+    double tolerance;    /* relative residual at which a stage's solve stops [-] */
+    int max_iterations;  /* iteration budget of one solve */
+};
+
 struct viscous_solver *viscous_create(void);
 void viscous_free(struct viscous_solver *V);
 
 /** The implicit viscous step over dt from t (walls not yet moved): the two-stage SDIRK of
  *  docs/numerics.md, each stage a solve (m + gamma dt L) U = m w - gamma dt L u_B with the
- *  walls' mirror (M, rebuilt here at the current positions) at the stage's time, warm-started
- *  from its increments of the last two steps. Updates P->vx, P->vz, the increments
- *  (visc_dv*, visc_d1* and those of the step before) and the wall particles' uvx, uvz. The
- *  report sums the two stages' iterations and keeps the larger residual. Stops a stage at
- *  ||r|| <= tolerance ||b|| or after max_iterations. With rigid held grains (cfg->held_grains_rigid)
- *  these are prescribed at rest and then, if judge_dt > 0, get the velocity one explicit step of
- *  judge_dt of their forces gives them (the other forces' P->ax, P->az and the viscous force of the
- *  solved field), on which the regime decision judges them. Returns -1 when out of memory, 0
- *  otherwise (convergence is in the report). */
+ *  walls' mirror (M, rebuilt here at the current positions; the case's walls `cfg` at `ws`) at
+ *  the stage's time, warm-started from its increments of the last two steps. unknown[i] != 0:
+ *  particle i's velocity is solved for; the others (walls aside) are prescribed at theirs.
+ *  Updates P->vx, P->vz of the unknowns, the increments (visc_dv*, visc_d1* and those of the step
+ *  before) and the wall particles' uvx, uvz. The report sums the two stages' iterations and keeps
+ *  the larger residual; a stage stops at ||r|| <= tolerance ||b|| or after max_iterations (vp).
+ *  Returns -1 when out of memory, 0 otherwise (convergence is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
-                 double judge_dt, double tolerance, int max_iterations, struct viscous_report *report);
+                 const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report);
 
-/** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the mobile particles'
- *  velocities (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
+/** The viscous operator applied to the last step's solved velocity field (its wall rows as the
+ *  mirror made them): *lx, *lz point at sum_j w_ij (u_i - u_j) per particle, in the solver's
+ *  scratch, valid until its next use. Returns -1 without a stored operator. */
+int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
+                              const double **lx, const double **lz);
+
+/** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the velocities of the
+ *  particles mobile or held (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
  *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
  *  built and timed by the caller (NULL: the walls keep uvx, uvz) and the preconditioner of enum
  *  viscous_preconditioner; tests of the solver. */

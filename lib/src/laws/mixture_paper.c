@@ -36,18 +36,116 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "mixture.h"
+#include "mixture_paper.h"
+
+#include <string.h>
 
 #include "eos.h"
+#include "geometry.h"
 #include "mixsph.h"
 #include "rheology.h"
+#include "status.h"
 
-#define MIXTURE_DET_MIN 0.05 /* below this det L the correction is not applied */
+/* ---- its case keys: media.<name> of type granular ------------------------------------------- */
+
+static const struct case_choice granular_type[] = {{"granular", LAW_MIXTURE_PAPER}, {NULL, 0}};
+
+static const struct case_key granular_keys[] = {
+    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_type,
+     .field = CASE_FIELD(medium, law), .meaning = "\"granular\": a mixture at the packing limit"},
+    {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices,
+     SCHEMA_DEF(LAW_MIXTURE_PAPER), .field = CASE_FIELD(medium, law),
+     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next)"},
+    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
+     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
+    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
+     .unit = "Pa", .field = CASE_FIELD(medium, bulk_modulus), .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s)"},
+    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e5, 0),
+     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
+    {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 0.95, 0), .unit = "-",
+     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n = ε_f at the packing limit"},
+    {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 89, 0), .unit = "deg",
+     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
+    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
+     .meaning = "pores filled with the pore fluid (else dry)"},
+    {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
+     .meaning = "name of a fluid medium defined before this one"},
+    {.key = "mu_thr", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "unless mu1", SCHEMA_RANGE(0, 1, 1e12, 0),
+     .unit = "Pa s", .field = CASE_FIELD(medium, mu_thr),
+     .meaning = "threshold viscosity μ_thr: a grain with μ_app ≥ μ_thr is held fixed"},
+    {.key = "mu0", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 1e12, 0), SCHEMA_DEF(INFINITY), .def_text = "+∞ (no limit)",
+     .unit = "Pa s", .field = CASE_FIELD(medium, mu0),
+     .meaning = "limiting viscosity μ0: μ_app between μ0 and μ_thr is replaced by μ0; μ0 ≥ μ_thr: no limit"},
+    {.key = "mu1", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 1e12, 0), .unit = "Pa s",
+     .meaning = "instead of mu_thr and mu0: the rheology of Run 7, μ_thr = μ1 without a limit"},
+    {.key = "tension_cutoff", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, tension_cutoff),
+     .meaning = "no tensile pressure: p below the background pressure is raised to it (below)"},
+    {.key = "hold_fixed", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, hold_fixed),
+     .meaning = "a grain held fixed gets no acceleration (below)"},
+    {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0), .unit = "-",
+     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M of the grains"},
+};
+
+static const struct case_refused granular_refused[] = {
+    {"d50", "not used by the model: the packing-limit law of the mixture has no grain size (docs/model.md "
+            "sections 5-6); remove the key"},
+    {NULL, NULL}};
+
+static const struct case_section granular_section = {
+    SCHEMA_SECTION("media.granular", "media.<name> of type granular", granular_keys), .refused = granular_refused};
+
+#define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
+
+/* The rules between its keys and what it derives: the sound speed of the grains, sin(phi), the
+ * pore fluid, the mixture density (5), eps_f mu_f and the mu1 rheology of Run 7. */
+static mixsph_status granular_finish(struct medium *md, const struct law_finish_ctx *ctx)
+{
+    if (ctx->given(ctx->entry, "K")) md->c = sqrt(md->bulk_modulus / md->rho_grain);
+    md->sin_phi = sin(md->phi_deg * GEOM_PI / 180.0);
+    md->pore_fluid = -1;
+    const char *fluid = ctx->text(ctx->entry, "pore_fluid");
+    if (fluid) {
+        for (size_t k = 0; k + 1 < ctx->n_media; k++)
+            if (strcmp(ctx->media[k].name, fluid) == 0) md->pore_fluid = (int)k;
+        if (md->pore_fluid < 0 || ctx->media[md->pore_fluid].law != LAW_NEWTONIAN)
+            return FAIL(ctx, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", ctx->origin,
+                        ctx->path, fluid);
+    }
+    if (md->saturated && md->pore_fluid < 0)
+        return FAIL(ctx, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", ctx->origin,
+                    ctx->path);
+    const double n = md->porosity;
+    if (md->saturated) {
+        const struct medium *f = &ctx->media[md->pore_fluid];
+        md->rho_f = f->rho0;
+        md->eps_f_mu_f = n * f->mu;
+        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
+    } else {
+        md->rho_f = 0.0;
+        md->eps_f_mu_f = 0.0;
+        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
+    }
+    if (ctx->given(ctx->entry, "mu1")) {
+        if (ctx->given(ctx->entry, "mu_thr") || ctx->given(ctx->entry, "mu0"))
+            return FAIL(ctx, "%s: %s.mu1: the mu1 rheology (Run 7) replaces mu_thr and mu0: give mu1 alone", ctx->origin,
+                        ctx->path);
+        md->mu_thr = ctx->number(ctx->entry, "mu1"); /* mu0 keeps its default: no limit */
+        md->mu1_mode = 1;
+    } else if (!ctx->given(ctx->entry, "mu_thr")) {
+        return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1)", ctx->origin, ctx->path);
+    }
+    md->mu = 0.0; /* set by the rheology */
+    return MIXSPH_OK;
+}
+
+static double granular_wave_speed(const struct medium *m) { return m->c; }
+
+/* ---- its state: the pore pressure's and the fixed bed's columns ---------------------------- */
 
 struct mixture {
-    const struct case_def *cfg;
+    const struct medium *media;
+    double g, p_background, fixed_bed_speed;
     double x_min, dx, h;
-    struct velocity_gradient grad; /* per particle, filled by the pair loops within a step */
     /* pore pressure: per column dx wide, the top of the saturated granular column [m] */
     double *ztop;
     size_t nbins;
@@ -58,43 +156,41 @@ struct mixture {
     size_t nbed;
 };
 
-struct mixture *mixture_create(const struct case_def *cfg, size_t cap, double x_min, double x_max, double dx, double h)
+static void mixture_free(void *state);
+
+static void *mixture_create(const struct law_setup *setup)
 {
     struct mixture *M = calloc(1, sizeof *M);
     if (!M) return NULL;
-    M->cfg = cfg;
+    M->media = setup->media;
+    M->g = setup->g;
+    M->p_background = setup->p_background;
+    M->fixed_bed_speed = setup->fixed_bed_speed;
+    const double x_min = setup->x_min, x_max = setup->x_max, dx = setup->dx, h = setup->h;
     M->x_min = x_min;
     M->dx = dx;
     M->h = h;
-    struct velocity_gradient *G = &M->grad;
-    double **f[7] = {&G->dudx, &G->dudz, &G->dwdx, &G->dwdz, &G->lxx, &G->lxz, &G->lzz};
-    int ok = 1;
-    for (int k = 0; k < 7; k++) ok &= (*f[k] = calloc(cap + 1, sizeof(double))) != NULL;
     M->nbins = (size_t)ceil((x_max - x_min) / dx) + 1;
     M->ztop = calloc(M->nbins, sizeof(double));
     M->nbed = (size_t)ceil((x_max - x_min) / (2.0 * h)) + 1;
     M->bed_z = calloc(M->nbed, sizeof(double));
     M->bed_ref = calloc(M->nbed, sizeof(long));
-    if (!ok || !M->ztop || !M->bed_z || !M->bed_ref) {
+    if (!M->ztop || !M->bed_z || !M->bed_ref) {
         mixture_free(M);
         return NULL;
     }
     return M;
 }
 
-void mixture_free(struct mixture *M)
+static void mixture_free(void *state)
 {
+    struct mixture *M = state;
     if (!M) return;
-    struct velocity_gradient *G = &M->grad;
-    double *f[7] = {G->dudx, G->dudz, G->dwdx, G->dwdz, G->lxx, G->lxz, G->lzz};
-    for (int k = 0; k < 7; k++) free(f[k]);
     free(M->ztop);
     free(M->bed_z);
     free(M->bed_ref);
     free(M);
 }
-
-struct velocity_gradient *mixture_gradient(struct mixture *M) { return &M->grad; }
 
 /* Column of x among n columns of the given width from the domain's x_min (clamped to the ends). */
 static size_t column_of(const struct mixture *M, double x, double width, size_t n)
@@ -117,8 +213,8 @@ static void saturated_tops(struct mixture *M, const struct particles *P)
     for (size_t b = 0; b < M->nbins; b++) M->ztop[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const struct medium *m = &M->cfg->media[P->medium[i]];
-        if (m->kind != MEDIUM_GRANULAR || !m->saturated) continue;
+        const struct medium *m = &M->media[P->medium[i]];
+        if (m->law != LAW_MIXTURE_PAPER || !m->saturated) continue;
         const size_t b = bin_of(M, P->x[i]);
         const double top = P->z[i] + 0.5 * M->dx;
         if (top > M->ztop[b]) M->ztop[b] = top;
@@ -136,14 +232,13 @@ static size_t bed_column(const struct mixture *M, double x)
  * in memory order, so the choice does not depend on the threads. */
 static void fixed_bed_tops(struct mixture *M, const struct particles *P, size_t n)
 {
-    const struct case_def *cfg = M->cfg;
-    const double v2 = cfg->fixed_bed_speed * cfg->fixed_bed_speed;
+    const double v2 = M->fixed_bed_speed * M->fixed_bed_speed;
     for (size_t b = 0; b < M->nbed; b++) {
         M->bed_z[b] = -INFINITY;
         M->bed_ref[b] = -1;
     }
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || cfg->media[P->medium[i]].kind != MEDIUM_GRANULAR) continue;
+        if (P->state[i] > MIXSPH_STATE_FIXED || M->media[P->medium[i]].law != LAW_MIXTURE_PAPER) continue;
         if (P->state[i] == MIXSPH_STATE_MOBILE && P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i] > v2) continue;
         const size_t b = bed_column(M, P->x[i]);
         if (P->z[i] > M->bed_z[b]) {
@@ -170,42 +265,36 @@ static double pore_pressure(const struct mixture *M, const struct medium *m, dou
     if (br > bl && isfinite(M->ztop[bl]) && isfinite(M->ztop[br]))
         slope = (M->ztop[br] - M->ztop[bl]) / ((double)(br - bl) * M->dx);
     const double cos2 = 1.0 / (1.0 + slope * slope);
-    return m->rho_f * M->cfg->g * (top - z) * cos2;
+    return m->rho_f * M->g * (top - z) * cos2;
 }
 
-long mixture_update(struct mixture *M, const struct kernel *KW, const struct gather *G, struct particles *P, size_t n,
-                    int n_threads)
+static long mixture_update(void *state, const struct law_step *step)
 {
-    const struct case_def *cfg = M->cfg;
-    const struct velocity_gradient *K = &M->grad;
+    struct mixture *M = state;
+    const struct kernel *KW = step->K;
+    const struct gather *G = step->G;
+    struct particles *P = step->P;
+    const size_t n = step->n;
+    const struct medium *media = M->media;
     saturated_tops(M, P);
-    const int fixed_bed = cfg->fixed_bed_speed >= 0.0;
+    const int fixed_bed = M->fixed_bed_speed >= 0.0;
     if (fixed_bed) fixed_bed_tops(M, P, n);
     long fixed = 0;
-    const double g = cfg->g, pb = cfg->p_background;
+    const double g = M->g, pb = M->p_background;
     /* one parallel region for the three loops (each waits for the one before: the second reads the
      * regimes of the first, the third the pressures of the second) */
-#pragma omp parallel num_threads(n_threads)
+#pragma omp parallel num_threads(step->n_threads)
     {
 #pragma omp for schedule(static) reduction(+ : fixed)
         for (size_t i = 0; i < n; i++) {
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
-            const struct medium *m = &cfg->media[P->medium[i]];
-            if (m->kind != MEDIUM_GRANULAR) continue;
-            double dudx = K->dudx[i], dudz = K->dudz[i], dwdx = K->dwdx[i], dwdz = K->dwdz[i];
-            const double det = K->lxx[i] * K->lzz[i] - K->lxz[i] * K->lxz[i];
-            if (det > MIXTURE_DET_MIN) {
-                const double a = K->lzz[i] / det, b = -K->lxz[i] / det, d = K->lxx[i] / det; /* L^-1 = [a b; b d] */
-                const double ux = dudx * a + dudz * b, uz = dudx * b + dudz * d;
-                const double wx = dwdx * a + dwdz * b, wz = dwdx * b + dwdz * d;
-                dudx = ux;
-                dudz = uz;
-                dwdx = wx;
-                dwdz = wz;
-            }
-            const double sii = rheology_sqrt_ii(dudx, dudz, dwdx, dwdz);
+            const struct medium *m = &media[P->medium[i]];
+            if (m->law != LAW_MIXTURE_PAPER) continue;
+            double grad[4];
+            velocity_gradient_corrected(step->grad, i, grad);
+            const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
             const double pw = m->saturated ? pore_pressure(M, m, P->x[i], P->z[i]) : 0.0;
-            const double sigma = rheology_effective_stress(P->p[i] - cfg->p_background, pw);
+            const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
             const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
             double mu;
             int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
@@ -231,7 +320,7 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
                 double sw = 0.0, sp = 0.0;
                 for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
                     for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
-                    if (P->state[j] != MIXSPH_STATE_MOBILE || cfg->media[P->medium[j]].kind != MEDIUM_GRANULAR) continue;
+                    if (P->state[j] != MIXSPH_STATE_MOBILE || media[P->medium[j]].law != LAW_MIXTURE_PAPER) continue;
                     const double rx = xi - P->x[j], rz = zi - P->z[j];
                     const double r2 = rx * rx + rz * rz;
                     if (r2 >= KW->r2max) continue;
@@ -241,7 +330,7 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
                 }
                 if (sw > 0.0) {
                     const double p = sp / sw;
-                    P->p[i] = cfg->media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
+                    P->p[i] = media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
                 }
             }
             if (fixed_bed) {
@@ -251,8 +340,8 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
                 for (size_t i = 0; i < n; i++) {
                     if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
                     const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
-                    const struct medium *m = &cfg->media[P->medium[i]];
-                    double p = P->p[top] + cfg->media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+                    const struct medium *m = &media[P->medium[i]];
+                    double p = P->p[top] + media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
                     if (m->tension_cutoff && p < pb) p = pb;
                     P->p[i] = p;
                     P->rho[i] = eos_density(p - pb, m->rho0, m->c);
@@ -264,3 +353,16 @@ long mixture_update(struct mixture *M, const struct kernel *KW, const struct gat
     }
     return fixed;
 }
+
+const struct material_law law_mixture_paper = {
+    .type = "granular",
+    .name = "paper",
+    .keys = &granular_section,
+    .features = LAW_USES_GRADIENT,
+    .finish = granular_finish,
+    .wave_speed = granular_wave_speed,
+    .viscosity_bound = mixture_paper_held_viscosity,
+    .create = mixture_create,
+    .destroy = mixture_free,
+    .update = mixture_update,
+};

@@ -1,0 +1,132 @@
+/* elastic_plastic.c - the elastic-perfectly-plastic granular law (media of type "granular" with
+ * law "elastic_plastic"; docs/model.md section 10): inside the Drucker-Prager cone the grains are
+ * an elastic solid, on it they flow with the Coulomb stress, so a heap stands and a deposit stops
+ * with no hold rule, no mu_thr and no mu0, at the acoustic time step. Per grain and step:
+ *   s <- Jaumann step of s with G over dt (elasticity.h),
+ *   p' = p - p_b (dry grains; the effective pressure),
+ *   (s, p') <- the return mapping onto the cone with the tension cut-off at its apex
+ *              (drucker_prager.h); at the apex the pressure is set to p' + p_b,
+ * the pressure coming from the equation of state of the grains' sound speed (K = rho0 c^2, the
+ * mixture density rho0 of (5)), the shear modulus from Poisson's ratio, G = 3 K (1 - 2 nu) /
+ * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by the medium's artificial viscosity.
+ * Not yet: saturated media (the pore pressure of docs/model.md [PW] is the paper law's module's),
+ * a wall friction angle (walls carry no deviatoric stress, laws/law.h). Experimental: the bundled
+ * cases keep the paper's law. */
+#include <math.h>
+
+#include "drucker_prager.h"
+#include "elasticity.h"
+#include "geometry.h"
+#include "law.h"
+#include "status.h"
+
+static const struct case_choice granular_ep_type[] = {{"granular", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
+
+static const struct case_key elastic_plastic_keys[] = {
+    {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_ep_type,
+     .field = CASE_FIELD(medium, law), .meaning = "\"granular\""},
+    {.key = "law", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = law_granular_choices,
+     .field = CASE_FIELD(medium, law), .meaning = "\"elastic_plastic\" (this table): Drucker-Prager, experimental"},
+    {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
+     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
+    {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
+     .unit = "Pa", .field = CASE_FIELD(medium, bulk_modulus),
+     .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s); the law's bulk modulus is ρ0 c²"},
+    {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e5, 0),
+     .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
+    {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 0.95, 0), .unit = "-",
+     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n: the mixture density (5)"},
+    {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 89, 0), .unit = "deg",
+     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
+    {.key = "cohesion", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 1e9, 0), SCHEMA_DEF(0), .unit = "Pa",
+     .field = CASE_FIELD(medium, cohesion), .meaning = "cohesion c of the cone"},
+    {.key = "dilatancy", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 0, 0), SCHEMA_DEF(0), .unit = "deg",
+     .field = CASE_FIELD(medium, dilatancy_deg),
+     .meaning = "dilatancy angle ψ (0 only: a dilating return changes the pressure, which the equation of state "
+                "would undo)"},
+    {.key = "nu", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 0.49, 0), SCHEMA_DEF(0.3), .unit = "-",
+     .field = CASE_FIELD(medium, poisson), .meaning = "Poisson's ratio: G = 3K(1−2ν)/(2(1+ν))"},
+    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
+     .meaning = "must be false: saturated media are the paper law's for now"},
+    {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0.2), .unit = "-",
+     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M (damps the waves)"},
+};
+
+static const struct case_section elastic_plastic_section = {
+    SCHEMA_SECTION("media.granular.elastic_plastic", "media.<name> of type granular, law elastic_plastic",
+                   elastic_plastic_keys)};
+
+#define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
+
+static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_finish_ctx *ctx)
+{
+    if (m->saturated)
+        return FAIL(ctx, "%s: %s.saturated: the elastic_plastic law takes dry grains only for now (the pore pressure "
+                         "is the paper law's); use law \"paper\"", ctx->origin, ctx->path);
+    if (ctx->given(ctx->entry, "K")) m->c = sqrt(m->bulk_modulus / m->rho_grain);
+    m->rho0 = (1.0 - m->porosity) * m->rho_grain; /* (5), dry */
+    m->bulk_modulus = m->rho0 * m->c * m->c;      /* the equation of state's */
+    const char *why = elasticity_shear_from_bulk(m->bulk_modulus, m->poisson, &m->shear_modulus);
+    if (!why)
+        why = drucker_prager_matching(m->phi_deg * GEOM_PI / 180.0, m->cohesion, m->dilatancy_deg * GEOM_PI / 180.0,
+                                      &m->alpha_phi, &m->k_c, &m->alpha_psi);
+    if (why) return FAIL(ctx, "%s: %s: %s", ctx->origin, ctx->path, why);
+    m->sin_phi = sin(m->phi_deg * GEOM_PI / 180.0);
+    m->mu = 0.0;
+    return MIXSPH_OK;
+}
+
+static double elastic_plastic_wave_speed(const struct medium *m)
+{
+    return elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0);
+}
+
+static double elastic_plastic_viscosity_bound(const struct medium *m)
+{
+    (void)m;
+    return 0.0;
+}
+
+/* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
+static long elastic_plastic_update(void *state, const struct law_step *step)
+{
+    (void)state;
+    struct particles *P = step->P;
+    const struct medium *media = step->media;
+    const double dt = step->dt, pb = step->p_background;
+    if (!(dt > 0.0)) return 0;
+    long plastic = 0;
+#pragma omp parallel for schedule(static) reduction(+ : plastic) num_threads(step->n_threads)
+    for (size_t i = 0; i < step->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        const struct medium *m = &media[P->medium[i]];
+        if (m->law != LAW_ELASTIC_PLASTIC) continue;
+        double g[4];
+        velocity_gradient_corrected(step->grad, i, g);
+        struct deviatoric_stress s = {.xx = P->sxx[i], .zz = P->szz[i], .xz = P->sxz[i], .yy = P->syy[i]};
+        elasticity_jaumann_step(&s, g[0], g[1], g[2], g[3], m->shear_modulus, dt);
+        const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->shear_modulus,
+                                                   .alpha_phi = m->alpha_phi, .k_c = m->k_c,
+                                                   .alpha_psi = m->alpha_psi};
+        double p_eff = P->p[i] - pb;
+        const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
+        if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb; /* the tension cut-off */
+        plastic += out != DRUCKER_PRAGER_ELASTIC;
+        P->sxx[i] = s.xx;
+        P->sxz[i] = s.xz;
+        P->szz[i] = s.zz;
+        P->syy[i] = s.yy;
+    }
+    return plastic;
+}
+
+const struct material_law law_elastic_plastic = {
+    .type = "granular",
+    .name = "elastic_plastic",
+    .keys = &elastic_plastic_section,
+    .features = LAW_USES_GRADIENT | LAW_HAS_STRESS,
+    .finish = elastic_plastic_finish,
+    .wave_speed = elastic_plastic_wave_speed,
+    .viscosity_bound = elastic_plastic_viscosity_bound,
+    .update = elastic_plastic_update,
+};

@@ -1,0 +1,59 @@
+/* medium.h - a medium's parameters as a material law reads them: the case reader fills them
+ * from media.<name> (the rows of the law's key table, laws/law.h) and the law derives the rest
+ * once (law->finish). The law of a medium is its `law` (enum law_id, chosen by the medium's
+ * "type"); what it hands the pair loops is the per-particle viscosity P->mu and, for a law with
+ * a stress state, the deviatoric stress of its particles (docs/model.md). */
+#ifndef MIXSPH_MEDIUM_H
+#define MIXSPH_MEDIUM_H
+
+#define MEDIUM_NAME_LEN 48
+
+/* The material laws (laws/law_registry.c holds one entry per law, in this order). */
+enum law_id {
+    LAW_NEWTONIAN = 0,     /* "fluid": Newtonian viscosity (laws/newtonian.c) */
+    LAW_MIXTURE_PAPER = 1, /* "granular": the paper's KTGF mixture with mu_thr / mu0 (laws/mixture_paper.c) */
+    LAW_ELASTIC_SOLID = 2, /* "elastic": a linear-elastic solid, Jaumann rate (laws/elastic_solid.c) */
+    LAW_ELASTIC_PLASTIC = 3, /* "granular" with law "elastic_plastic": Drucker-Prager (laws/elastic_plastic.c) */
+    LAW_COUNT
+};
+
+/* What a law asks of the step (bits of struct medium's `features`, copied from its law). */
+enum law_feature {
+    LAW_USES_GRADIENT = 1u, /* the velocity gradient of its particles is gathered every step */
+    LAW_HAS_STRESS = 2u     /* its particles carry a deviatoric stress (P->sxx, sxz, szz, syy) */
+};
+
+struct medium {
+    char name[MEDIUM_NAME_LEN];
+    int law;           /* enum law_id */
+    unsigned features; /* enum law_feature bits of its law */
+    double rho0;       /* reference density [kg/m3]; granular: the mixture density (5) */
+    double c;          /* sound speed of the equation of state [m/s]; granular: sqrt(K_s / rho_s) */
+    double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
+    double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (granular: 0 unless given) */
+    /* the paper's granular mixture (docs/model.md sections 5-6) */
+    double rho_grain;  /* density of the grains rho_s [kg/m3] */
+    double porosity;   /* n = eps_f at the packing limit [-] */
+    double phi_deg;    /* angle of internal friction [deg] */
+    double sin_phi;
+    int saturated;     /* pores filled with the pore fluid (else dry) */
+    int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
+    double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */
+    double eps_f_mu_f; /* eps_f mu_f [Pa s] (0 if dry) */
+    double mu_thr;     /* threshold viscosity [Pa s] */
+    double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
+    int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
+    int hold_fixed;     /* granular: a fixed grain gets no acceleration (SPHERA's implementation) */
+    int tension_cutoff; /* granular: no tensile pressure, p >= background pressure (off: the paper's model) */
+    /* the linear-elastic solid */
+    double youngs_modulus; /* E [Pa] */
+    double poisson;        /* nu [-] */
+    double shear_modulus;  /* G = E / (2 (1 + nu)) [Pa] */
+    double bulk_modulus;   /* K = E / (3 (1 - 2 nu)) [Pa]: the equation of state's, c = sqrt(K / rho0) */
+    /* the elastic-perfectly-plastic granular law (also phi_deg, porosity, rho_grain, poisson) */
+    double cohesion;       /* c [Pa] */
+    double dilatancy_deg;  /* psi [deg] */
+    double alpha_phi, k_c, alpha_psi; /* the plane-strain matched Drucker-Prager cone (drucker_prager.h) */
+};
+
+#endif
