@@ -40,15 +40,8 @@ import numpy as np
 import pandas as pd
 
 from . import emulator as E
-
-
-class UsageError(Exception):
-    pass
-
-
-def _default_fmu():
-    from .__main__ import default_fmu
-    return default_fmu()
+from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_sets,
+                  parse_value, resolve_run, save_json)
 
 
 def _parse_box(items):
@@ -73,7 +66,7 @@ def _dists(items):
 
 
 def _load(args):
-    fmu = args.fmu or _default_fmu()
+    fmu = args.fmu or default_fmu()
     return E.load(args.emulator, fmu, check_fmu=not args.no_fmu_check)
 
 
@@ -85,7 +78,6 @@ def _fmu_args(p):
 
 
 def build_parser():
-    from .__main__ import common_cluster_args, common_run_args
     ap = argparse.ArgumentParser(prog="python -m tools.dss emulate", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -286,7 +278,7 @@ def fit_folder(folder, outputs=None, inputs=None, box=None, fmu=None, mode="auto
     if os.path.isfile(sp):
         with open(sp) as f:
             settings = json.load(f)
-    fmu = fmu or settings.get("fmu") or _default_fmu()
+    fmu = fmu or settings.get("fmu") or default_fmu()
     if not os.path.isfile(fmu):
         raise UsageError(f"the FMU {fmu} of these runs is not there: give --fmu")
     ident = E.fmu_identity(fmu)
@@ -448,7 +440,6 @@ def cmd_risk(args):
         else:
             raise UsageError(f"no emulator of {output!r} ({', '.join(em.models)})")
     dists = _dists(args.dist)
-    from .__main__ import parse_sets
     fixed = parse_sets(args.set)
     if not dists:
         raise UsageError("give the inputs' distributions with --dist NAME=SPEC")
@@ -558,7 +549,6 @@ def cmd_curve(args):
 
 def cmd_plot(args):
     from . import emulate_plots as P
-    from .__main__ import parse_sets
     em = _load(args)
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.emulator)),
                                    f"surface_{args.output}.png")
@@ -569,7 +559,6 @@ def cmd_plot(args):
 
 def cmd_design(args):
     from . import design as D, runner
-    from .__main__ import _save_json, resolve_run
     from .scenarios import Distribution, split_assignment
     saved = {}
     sp = os.path.join(args.out, "sweep.json")
@@ -598,7 +587,7 @@ def cmd_design(args):
     os.makedirs(args.out, exist_ok=True)
     settings = {"fmu": os.path.abspath(fmu), "stop_time": opts["stop_time"], "step": opts["step"],
                 "dx": fixed.get("dx", dx), "fixed": fixed, "threads": opts["threads"]}
-    _save_json(sp, settings)
+    save_json(sp, settings)
     quiet = args.quiet
     with runner.sigterm_as_interrupt(), \
             runner.dask_client(args.scheduler, args.workers, quiet=quiet,
@@ -659,7 +648,7 @@ def jitter_scenarios(points: list[dict], perturb: dict, n: int, seed: int) -> li
 def cmd_jitter(args):
     """Run the jitter scan (through the sweep machinery: resumable) and estimate the noise."""
     import itertools
-    from .__main__ import cmd_sweep, parse_value, resolve_run
+    from .sweep import cmd_sweep
     from .scenarios import split_assignment
     from .store import open_store
     fmu, fixed, opts, md, var, dx = resolve_run(args, {})
