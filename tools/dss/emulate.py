@@ -17,6 +17,9 @@
                      syntax), with its band from joint posterior draws, and Sobol indices
   plot EMU           the response surface over reservoir_level and phi with its uncertainty
   curve DESIGN HOLD  the hold-out error of emulators of a design's first n runs, against n
+  mf-design, mf-fit, mf-predict, mf-validate, mf-risk, study
+                     the multi-fidelity emulator over a ladder of spacings dx, with the
+                     dx -> 0 extrapolation and its error (emulate_mf.py)
   jitter OUT         measure the FMU's discretisation noise: runs at a box point with the
                      reservoir level moved by up to half a particle spacing; writes
                      OUT/jitter.json, which fit and design take as the noise term's lower bound
@@ -224,6 +227,9 @@ def build_parser():
     j.add_argument("--no-plots", action="store_true")
     common_run_args(j)
     common_cluster_args(j)
+
+    from . import emulate_mf
+    emulate_mf.add_parsers(sub)
 
     q = sub.add_parser("plot", help="the response surface over two inputs")
     q.add_argument("emulator")
@@ -732,7 +738,10 @@ def main(argv=None):
     ap = build_parser()
     args = ap.parse_args(argv)
     os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+    from .emulate_mf import COMMANDS as MF_COMMANDS
     try:
+        if args.cmd in MF_COMMANDS:
+            return MF_COMMANDS[args.cmd](args)
         return {"fit": cmd_fit, "predict": cmd_predict, "validate": cmd_validate,
                 "risk": cmd_risk, "plot": cmd_plot, "design": cmd_design,
                 "curve": cmd_curve, "jitter": cmd_jitter}[args.cmd](args)
