@@ -107,6 +107,8 @@ def add_parsers(sub):
     v.add_argument("holdout", nargs="+", help="folder(s) of hold-out runs")
     v.add_argument("--output", default="max_run_up")
     _level_arg(v, "finest")
+    v.epilog = ("A dx below the ladder's finest as --level is the extrapolation to that dx: "
+                "the check of the extrapolation against runs one level finer than the ladder.")
     v.add_argument("--holdout-dx", type=float,
                    help="use the hold-out runs at this dx (default: the level's; for the "
                         "extrapolation the finest dx of the hold-out runs)")
@@ -370,24 +372,24 @@ def cmd_mf_validate(args):
     em = _load(args)
     li = em.level_index(args.level)
     df = _runs(args.holdout)
+    extrap = li == M.EXTRAPOLATED or isinstance(li, tuple)
     if args.holdout_dx is not None:
         dx = args.holdout_dx
     elif li == M.EXTRAPOLATED:
         dx = float(df["dx"].astype(float).min())
     else:
-        dx = em.dxs[li]
+        dx = li[1] if extrap else em.dxs[li]
     h = df[np.isclose(df["dx"].astype(float), dx)]
     if h.empty:
         raise UsageError(f"no hold-out runs at dx = {dx:g}")
     X = h[em.inputs].astype(float).to_numpy()
     y = h[args.output].astype(float).to_numpy()
-    mu, sd = em.predict(X, args.output, args.level)
+    res = em.predict(X, args.output, args.level, with_terms=True)
+    mu, sd = res[:2]
     met = E.metrics(y, mu, sd, y_range=args.range)
     extra = {}
-    if li == M.EXTRAPOLATED:
-        _, v, vg, vo = em.models[args.output].predict_extrapolated(em.unit(X), with_terms=True)
-        extra = {"sd_gp_mean": float(np.mean(np.sqrt(vg))),
-                 "sd_order_mean": float(np.mean(np.sqrt(vo)))}
+    if extrap:
+        extra = {"sd_gp_mean": float(np.mean(res[2])), "sd_order_mean": float(np.mean(res[3]))}
         fin, fsd = em.predict(X, args.output, "finest")
         extra["finest_level_as_prediction"] = E.metrics(y, fin, fsd, y_range=args.range)
     z = (y - mu) / sd

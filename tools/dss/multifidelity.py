@@ -176,9 +176,10 @@ def observed_order(fa, fb, fc, dxa, dxb, dxc):
     return p
 
 
-def richardson_c(p, dxb, dxc):
-    """c of f_0 = (1 + c) f_c - c f_b for the order p (the two finest spacings dxb > dxc)."""
-    return dxc ** p / (dxb ** p - dxc ** p)
+def richardson_c(p, dxb, dxc, dx=0.0):
+    """c of f(dx) = (1 + c) f_c - c f_b for the order p (the two finest spacings dxb > dxc; dx
+    below them, default 0: the limit)."""
+    return (dxc ** p - dx ** p) / (dxb ** p - dxc ** p)
 
 
 # ---- the emulator --------------------------------------------------------------------------------------
@@ -302,10 +303,10 @@ class OutputMF:
             return m, v
         return m, (v + self.levels[li].noise_var()) * self.scale[li] ** 2
 
-    def extrapolation_coeffs(self, p):
-        """(a, b) of f_0 = a f_{L-1} + b delta_L for the order p."""
+    def extrapolation_coeffs(self, p, dx=0.0):
+        """(a, b) of f(dx) = a f_{L-1} + b delta_L for the order p (dx below the ladder)."""
         dxb, dxc = self.dxs[-2], self.dxs[-1]
-        c = richardson_c(p, dxb, dxc)
+        c = richardson_c(p, dxb, dxc, dx)
         return (1 + c) * self.levels[-1].rho - c, 1 + c
 
     def estimate_order(self, seed=0, order=None):
@@ -340,23 +341,24 @@ class OutputMF:
                                       if ok.any() else None)}
         return self.order
 
-    def predict_extrapolated(self, U, with_terms=False):
-        """Mean and predictive variance of the dx -> 0 value (module doc)."""
+    def predict_extrapolated(self, U, with_terms=False, dx=0.0):
+        """Mean and predictive variance of the value extrapolated to dx (default 0, the
+        limit; a dx below the ladder's finest checks the extrapolation against runs there)
+        (module doc); with_terms also the GP's and the order's variance terms."""
         if not self.order:
             raise MFError(f"{self.name}: no extrapolation: it needs three levels or a given "
                           f"order (--order)")
         mb, vb = self.predict_level(U, len(self.levels) - 2, latent=True)
         md, vd = self.levels[-1].predict(U)
         mc = self.levels[-1].rho * mb + md
-        p = self.order["p"]
-        a, b = self.extrapolation_coeffs(p)
+        a, b = self.extrapolation_coeffs(self.order["p"], dx)
         mean = a * mb + b * md
         v_gp = (a ** 2 * vb + b ** 2 * vd + self.levels[-1].noise_var()) * self.scale[-1] ** 2
 
-        def f0(pp):
-            c = richardson_c(pp, self.dxs[-2], self.dxs[-1])
+        def f_at(pp):
+            c = richardson_c(pp, self.dxs[-2], self.dxs[-1], dx)
             return (1 + c) * mc - c * mb
-        v_order = ((f0(self.order["p_lo"]) - f0(self.order["p_hi"])) / (2 * Z95)) ** 2
+        v_order = ((f_at(self.order["p_lo"]) - f_at(self.order["p_hi"])) / (2 * Z95)) ** 2
         if with_terms:
             return mean, v_gp + v_order, v_gp, v_order
         return mean, v_gp + v_order
@@ -440,17 +442,23 @@ class MFEmulator:
         return np.array([",".join(names[r]) for r in bad], dtype=object)
 
     def level_index(self, level) -> int | str:
-        """A level given as its dx (a number), 'finest', or 'extrapolated'."""
-        if level in (EXTRAPOLATED, "dx0", "0"):
+        """A level given as its dx (a number), 'finest', or 'extrapolated' (the limit); a dx
+        below the finest level's is the extrapolation to that dx: ('extrapolated', dx)."""
+        if level in (EXTRAPOLATED, "dx0", "0", 0, 0.0):
             return EXTRAPOLATED
         if level in (None, "finest"):
             return len(self.dxs) - 1
-        dx = float(level)
+        try:
+            dx = float(level)
+        except (TypeError, ValueError):
+            dx = math.nan
         for i, d in enumerate(self.dxs):
             if math.isclose(d, dx, rel_tol=1e-9):
                 return i
-        raise MFError(f"no level dx = {dx:g} (the levels: {', '.join(f'{d:g}' for d in self.dxs)}"
-                      f", finest, {EXTRAPOLATED})")
+        if 0 < dx < self.dxs[-1]:
+            return (EXTRAPOLATED, dx)
+        raise MFError(f"no level {level} (the levels: {', '.join(f'{d:g}' for d in self.dxs)}, "
+                      f"finest, {EXTRAPOLATED}, or a dx below {self.dxs[-1]:g})")
 
     def fit_output(self, name, restarts=2, seed=0, noise=None, order=None, thetas=None,
                    rhos=None):
@@ -466,12 +474,18 @@ class MFEmulator:
         self.models[name] = m
         return m
 
-    def predict(self, X, output, level="finest"):
-        """(mean, sd) of the output at a level (dx, 'finest' or 'extrapolated') for raw inputs X."""
+    def predict(self, X, output, level="finest", with_terms=False):
+        """(mean, sd) of the output at a level (a dx of the ladder, 'finest', 'extrapolated' or
+        a dx below the ladder) for raw inputs X; with_terms, at an extrapolated level, also the
+        sd of the GP's and of the order's terms."""
         m = self._model(output)
         U = self.unit(np.atleast_2d(X))
         li = self.level_index(level)
-        mu, v = m.predict_extrapolated(U) if li == EXTRAPOLATED else m.predict_level(U, li)
+        if li == EXTRAPOLATED or isinstance(li, tuple):
+            dx = 0.0 if li == EXTRAPOLATED else li[1]
+            mu, v, vg, vo = m.predict_extrapolated(U, with_terms=True, dx=dx)
+            return (mu, np.sqrt(v), np.sqrt(vg), np.sqrt(vo)) if with_terms else (mu, np.sqrt(v))
+        mu, v = m.predict_level(U, li)
         return mu, np.sqrt(v)
 
     def _model(self, output):
@@ -585,6 +599,8 @@ def exceedance(em: MFEmulator, output, dists: dict, fixed: dict, crest, level=EX
     from scipy.stats import norm
     m = em._model(output)
     li = em.level_index(level)
+    if isinstance(li, tuple):
+        raise MFError("the risk is of a level of the ladder or of the limit (extrapolated)")
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
     X = _inputs(em, dists, fixed, np.clip(rng.random((n, len(dists))), 1e-12, 1 - 1e-12))
