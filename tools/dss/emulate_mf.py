@@ -90,6 +90,9 @@ def add_parsers(sub):
                                    "are two levels (with three or more it is observed)")
     f.add_argument("--restarts", type=int, default=3)
     f.add_argument("--seed", type=int, default=0)
+    f.add_argument("--no-jitter-floor", action="store_true",
+                   help="no lower bound on the finer levels' noise (default: the coarsest "
+                        "level's fitted noise variance times (dx / dx_coarsest)^2)")
     f.add_argument("-o", "--out", required=True, help="the emulator file")
     f.add_argument("--fmu", help="the FMU of the runs (default: the first folder's sweep.json)")
 
@@ -151,6 +154,8 @@ def _design_args(d):
                    help="another output of the final emulator (default max_run_up_Z)")
     d.add_argument("--restarts", type=int, default=3, help="restarts of the final fit")
     d.add_argument("--seed", type=int, default=0)
+    d.add_argument("--no-jitter-floor", action="store_true",
+                   help="no lower bound on the finer levels' noise (see mf-fit)")
     common_run_args(d)
     common_cluster_args(d)
 
@@ -203,7 +208,7 @@ def cmd_mf_design(args, quiet_summary=False):
             des = MD.MFDesign(args.out, dists, fixed, opts["stop_time"], levels, args.budget_cpu,
                               output=args.output, init=init, seed=args.seed, n_workers=nw,
                               target=args.target, fmu=ident, settings=settings,
-                              progress=not args.quiet)
+                              progress=not args.quiet, jitter_floor=not args.no_jitter_floor)
             res = des.run(evaluate)
         except DesignError as e:
             print(f"emulate mf-design: {e}", file=sys.stderr)
@@ -316,7 +321,8 @@ def cmd_mf_fit(args):
                         settings={"sources": [os.path.abspath(x) for x in args.folders]})
     t0 = time.perf_counter()
     for o in outs:
-        em.fit_output(o, restarts=args.restarts, seed=args.seed, order=_order(args.order))
+        em.fit_output(o, restarts=args.restarts, seed=args.seed, order=_order(args.order),
+                      jitter_floor=not args.no_jitter_floor)
     em.save(args.out)
     print(f"emulate mf-fit: {sum(len(x) for x in em.X)} runs at dx "
           + ", ".join(f"{d:g}" for d in em.dxs) + f", fitted in {time.perf_counter() - t0:.1f} s")

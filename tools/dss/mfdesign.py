@@ -146,7 +146,8 @@ class MFDesign:
 
     def __init__(self, out, dists, fixed, stop_time, levels, budget_cpu, output="max_run_up",
                  init=None, seed=0, n_workers=2, restarts=0, target="finest", fmu=None,
-                 settings=None, progress=True, stream=None, n_candidates=N_CAND):
+                 settings=None, progress=True, stream=None, n_candidates=N_CAND,
+                 jitter_floor=True):
         self.out = out
         self.dists = list(dists)
         self.names = [d.name for d in self.dists]
@@ -171,6 +172,7 @@ class MFDesign:
             raise DesignError(f"--init has {len(self.init)} counts for {L} levels")
         self.box = {dd.name: box_of(dd) for dd in self.dists}
         self.n_cand = int(n_candidates)
+        self.jitter_floor = bool(jitter_floor)
         self.fmu = dict(fmu or {})
         self.settings = dict(settings or {})
         self.progress, self.stream = progress, stream or sys.stderr
@@ -187,7 +189,8 @@ class MFDesign:
     def _spec(self):
         return {"dists": {d.name: _dist_spec(d) for d in self.dists}, "fixed": self.fixed,
                 "stop_time": self.stop_time, "levels": self.levels, "output": self.output,
-                "seed": self.seed, "init": self.init, "target": self.target}
+                "seed": self.seed, "init": self.init, "target": self.target,
+                "jitter_floor": self.jitter_floor}
 
     def _load_state(self):
         now = json.loads(json.dumps(self._spec()))
@@ -277,7 +280,8 @@ class MFDesign:
         for o in outputs or [self.output]:
             warm = self._warm if o == self.output else None
             m = em.fit_output(o, restarts=self.restarts if restarts is None else restarts,
-                              seed=self.seed, thetas=warm and warm[0], rhos=warm and warm[1])
+                              seed=self.seed, thetas=warm and warm[0], rhos=warm and warm[1],
+                              jitter_floor=self.jitter_floor)
             if o == self.output:
                 self._warm = ([g.theta for g in m.levels], [g.rho for g in m.levels])
         return em

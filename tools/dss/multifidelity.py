@@ -16,6 +16,17 @@ mean). The recursion is exact for nested designs (the runs of a level a subset o
 level below, which the design makes; Le Gratiet 2013, Stat. Comput.). Prediction at level l: mean rho_l m_{l-1} + m_delta_l, latent variance
 rho_l^2 v_{l-1} + v_delta_l, plus the level's fitted noise for the interval of a new run.
 
+The noise: every level's WhiteKernel takes the FMU's lattice jitter (the lattice is anchored
+at the reservoir level, so the run-up jitters by a fraction of a particle spacing over the
+box). The coarsest level has the most runs and its noise is fitted well; a finer level's few
+runs cannot tell jitter from response, and its delta GP would interpolate the jitter with
+length scales of a few % of the box. So the noise of level l has a lower bound (a floor, the
+likelihood may raise it): the coarsest level's fitted noise variance times (dx_l / dx_1)^2,
+i.e. a jitter sd proportional to the spacing (measured: 7.1 mm fitted at dx = 0.04 in the
+campaign of docs/dss.md, 2.81 mm by the jitter scan at dx = 0.015 of the earlier campaign:
+178 and 187 mm per m of dx). A measured floor per dx (noise=) replaces it;
+jitter_floor=False switches it off.
+
 The dx -> 0 value: Richardson extrapolation of the three finest levels a > b > c (dx), with
 f(dx) = f_0 + C dx^p. The observed order p(x) solves
 (f_a - f_b) / (f_b - f_c) = (dx_a^p - dx_b^p) / (dx_b^p - dx_c^p) at each of N_ORDER random
@@ -187,7 +198,7 @@ def richardson_c(p, dxb, dxc, dx=0.0):
 class OutputMF:
     """The recursive model of one output over the levels (coarse to fine)."""
 
-    def __init__(self, name, dxs, d, noise=None):
+    def __init__(self, name, dxs, d, noise=None, jitter_floor=True):
         self.name = name
         self.dxs = list(dxs)
         self.d = d
@@ -195,6 +206,9 @@ class OutputMF:
         self.U: list[np.ndarray] = []         # unit-box training inputs per level
         self.y: list[np.ndarray] = []
         self.noise = noise or {}              # dx -> measured noise variance (floor)
+        # without a measured one, the floor of level l's noise is the coarsest level's fitted
+        # noise scaled by (dx_l / dx_1)^2 (module doc, "The noise")
+        self.jitter_floor = bool(jitter_floor)
         self.scale = [1.0] * len(self.dxs)    # the applied variance scale (sd factor) per level
         self.calibration: list[dict] = []
         self.order: dict = {}
@@ -210,7 +224,10 @@ class OutputMF:
             if len(y) < 3:
                 raise MFError(f"{self.name}: level dx = {self.dxs[li]:g} has {len(y)} runs; at "
                               f"least 3 are needed")
-            g = DeltaGP(self.d, self.noise.get(self.dxs[li]))
+            floor = self.noise.get(self.dxs[li])
+            if floor is None and li > 0 and self.jitter_floor:
+                floor = self.levels[0].noise_var() * (self.dxs[li] / self.dxs[0]) ** 2
+            g = DeltaGP(self.d, floor)
             th = thetas[li] if thetas and li < len(thetas) else None
             if li == 0:
                 g.fit(U, y, restarts, seed, th)
@@ -398,7 +415,8 @@ class OutputMF:
     def to_json(self):
         return {"levels": [{"dx": dx, **g.to_json(), "n": int(len(y))}
                            for dx, g, y in zip(self.dxs, self.levels, self.y)],
-                "calibration": self.calibration, "scale": self.scale, "order": self.order}
+                "calibration": self.calibration, "scale": self.scale, "order": self.order,
+                "jitter_floor": self.jitter_floor}
 
 
 def _mvn(C, n, rng):
@@ -461,14 +479,14 @@ class MFEmulator:
                       f"finest, {EXTRAPOLATED}, or a dx below {self.dxs[-1]:g})")
 
     def fit_output(self, name, restarts=2, seed=0, noise=None, order=None, thetas=None,
-                   rhos=None):
+                   rhos=None, jitter_floor=True):
         U, y = [], []
         for li in range(len(self.dxs)):
             yy = self.Y[li][name]
             ok = np.isfinite(yy)
             U.append(self.unit(self.X[li][ok]))
             y.append(yy[ok])
-        m = OutputMF(name, self.dxs, len(self.inputs), noise)
+        m = OutputMF(name, self.dxs, len(self.inputs), noise, jitter_floor)
         m.fit(U, y, restarts=restarts, seed=seed, thetas=thetas, rhos=rhos)
         m.estimate_order(seed=seed, order=order)
         self.models[name] = m
@@ -540,7 +558,7 @@ class MFEmulator:
                 ok = np.isfinite(yy)
                 U.append(em.unit(em.X[li][ok]))
                 y.append(yy[ok])
-            m = OutputMF(name, em.dxs, len(em.inputs))
+            m = OutputMF(name, em.dxs, len(em.inputs), jitter_floor=o.get("jitter_floor", True))
             m.rebuild(U, y, o["levels"])
             m.calibration, m.scale, m.order = o["calibration"], o["scale"], o["order"]
             em.models[name] = m
