@@ -18,8 +18,13 @@ import argparse
 import os
 import sys
 
-from .cli import UsageError, common_cluster_args, common_run_args, resolve_run
-from .sweep import cmd_sweep, print_report
+# the emulators' linear algebra (GP predictions, the joint draws' Cholesky factors) in one BLAS
+# thread unless told otherwise: on cores the FMU runs share, a second BLAS thread slowed the
+# risk of 1e5 samples from 0.6 s to 2-4.5 s (tools/dss/bench_mf.py, load 3.5, docs/dss.md)
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+from .cli import UsageError, common_cluster_args, common_run_args, resolve_run  # noqa: E402
+from .sweep import cmd_sweep, print_report  # noqa: E402
 
 
 def build_parser():

@@ -12,10 +12,12 @@ import argparse
 import os
 import time
 
-import numpy as np
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")     # as python -m tools.dss (its __main__)
 
-from . import multifidelity as M
-from .scenarios import Distribution
+import numpy as np  # noqa: E402
+
+from . import multifidelity as M  # noqa: E402
+from .scenarios import Distribution  # noqa: E402
 
 
 def main(argv=None):
