@@ -27,5 +27,6 @@ $RUN $PY -m tools.dss sweep $OUT/sf02 --fmu $FMU $BOX -n 5 --seed 12 --dx 0.02 -
 $RUN $PY -m tools.dss sweep $OUT/check015 --fmu $FMU $BOX -n 3 --seed 102 --dx 0.015 --workers 2 --no-report --quiet
 # 5. the nested Latin hypercube of the same compute (the start only: --budget-cpu 1)
 $RUN $PY -m tools.dss emulate mf-design $OUT/mflhs --fmu $FMU $BOX --levels $LEVELS --budget-cpu 1 --init 28,12,6 --seed 11 --workers 2
-# 6. the study again with the current model
+# 6. the study again with the current model (as run: its start's 21 of 28 runs copied from step 2's
+#    results, the same scenarios: the runs are deterministic)
 $RUN $PY -m tools.dss emulate study $OUT/study2 --fmu $FMU $BOX --levels $LEVELS --budget-cpu 350 --seed 1 --crest 850 --workers 2
