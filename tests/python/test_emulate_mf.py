@@ -11,7 +11,7 @@ import functools
 import json
 import os
 import pathlib
-import shutil
+import re
 import signal
 import subprocess
 import sys
@@ -19,7 +19,6 @@ import time
 import zipfile
 
 import numpy as np
-import pandas as pd
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -162,7 +161,6 @@ def _fake_fmu(path, guid):
     """A zip with the repository's modelDescription.xml under another GUID: what
     emulator.fmu_identity reads (no binary needed)."""
     md = (ROOT / "modelDescription.xml").read_text()
-    import re
     md = re.sub(r'guid="[^"]*"', f'guid="{guid}"', md, count=1)
     with zipfile.ZipFile(path, "w") as z:
         z.writestr("modelDescription.xml", md)

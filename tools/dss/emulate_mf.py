@@ -305,7 +305,9 @@ def cmd_mf_fit(args):
     fmu = args.fmu
     if not fmu:
         sp = os.path.join(args.folders[0], "sweep.json")
-        fmu = json.load(open(sp)).get("fmu") if os.path.isfile(sp) else None
+        if os.path.isfile(sp):
+            with open(sp) as fh:
+                fmu = json.load(fh).get("fmu")
     fmu = fmu or default_fmu()
     if not os.path.isfile(fmu):
         raise UsageError(f"the FMU {fmu} of these runs is not there: give --fmu")
