@@ -24,7 +24,7 @@ import time
 
 import pandas as pd
 
-from . import __main__ as cli
+from . import cli
 from .store import ResultStore
 
 

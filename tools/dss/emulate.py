@@ -17,6 +17,9 @@
                      syntax), with its band from joint posterior draws, and Sobol indices
   plot EMU           the response surface over reservoir_level and phi with its uncertainty
   curve DESIGN HOLD  the hold-out error of emulators of a design's first n runs, against n
+  mf-design, mf-fit, mf-predict, mf-validate, mf-risk, study
+                     the multi-fidelity emulator over a ladder of spacings dx, with the
+                     dx -> 0 extrapolation and its error (emulate_mf.py)
   jitter OUT         measure the FMU's discretisation noise: runs at a box point with the
                      reservoir level moved by up to half a particle spacing; writes
                      OUT/jitter.json, which fit and design take as the noise term's lower bound
@@ -40,15 +43,8 @@ import numpy as np
 import pandas as pd
 
 from . import emulator as E
-
-
-class UsageError(Exception):
-    pass
-
-
-def _default_fmu():
-    from .__main__ import default_fmu
-    return default_fmu()
+from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_sets,
+                  parse_value, resolve_run, save_json)
 
 
 def _parse_box(items):
@@ -73,7 +69,7 @@ def _dists(items):
 
 
 def _load(args):
-    fmu = args.fmu or _default_fmu()
+    fmu = args.fmu or default_fmu()
     return E.load(args.emulator, fmu, check_fmu=not args.no_fmu_check)
 
 
@@ -85,7 +81,6 @@ def _fmu_args(p):
 
 
 def build_parser():
-    from .__main__ import common_cluster_args, common_run_args
     ap = argparse.ArgumentParser(prog="python -m tools.dss emulate", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -233,6 +228,9 @@ def build_parser():
     common_run_args(j)
     common_cluster_args(j)
 
+    from . import emulate_mf
+    emulate_mf.add_parsers(sub)
+
     q = sub.add_parser("plot", help="the response surface over two inputs")
     q.add_argument("emulator")
     q.add_argument("--output", default="max_run_up")
@@ -286,7 +284,7 @@ def fit_folder(folder, outputs=None, inputs=None, box=None, fmu=None, mode="auto
     if os.path.isfile(sp):
         with open(sp) as f:
             settings = json.load(f)
-    fmu = fmu or settings.get("fmu") or _default_fmu()
+    fmu = fmu or settings.get("fmu") or default_fmu()
     if not os.path.isfile(fmu):
         raise UsageError(f"the FMU {fmu} of these runs is not there: give --fmu")
     ident = E.fmu_identity(fmu)
@@ -448,7 +446,6 @@ def cmd_risk(args):
         else:
             raise UsageError(f"no emulator of {output!r} ({', '.join(em.models)})")
     dists = _dists(args.dist)
-    from .__main__ import parse_sets
     fixed = parse_sets(args.set)
     if not dists:
         raise UsageError("give the inputs' distributions with --dist NAME=SPEC")
@@ -558,7 +555,6 @@ def cmd_curve(args):
 
 def cmd_plot(args):
     from . import emulate_plots as P
-    from .__main__ import parse_sets
     em = _load(args)
     out = args.out or os.path.join(os.path.dirname(os.path.abspath(args.emulator)),
                                    f"surface_{args.output}.png")
@@ -569,7 +565,6 @@ def cmd_plot(args):
 
 def cmd_design(args):
     from . import design as D, runner
-    from .__main__ import _save_json, resolve_run
     from .scenarios import Distribution, split_assignment
     saved = {}
     sp = os.path.join(args.out, "sweep.json")
@@ -598,7 +593,7 @@ def cmd_design(args):
     os.makedirs(args.out, exist_ok=True)
     settings = {"fmu": os.path.abspath(fmu), "stop_time": opts["stop_time"], "step": opts["step"],
                 "dx": fixed.get("dx", dx), "fixed": fixed, "threads": opts["threads"]}
-    _save_json(sp, settings)
+    save_json(sp, settings)
     quiet = args.quiet
     with runner.sigterm_as_interrupt(), \
             runner.dask_client(args.scheduler, args.workers, quiet=quiet,
@@ -659,7 +654,7 @@ def jitter_scenarios(points: list[dict], perturb: dict, n: int, seed: int) -> li
 def cmd_jitter(args):
     """Run the jitter scan (through the sweep machinery: resumable) and estimate the noise."""
     import itertools
-    from .__main__ import cmd_sweep, parse_value, resolve_run
+    from .sweep import cmd_sweep
     from .scenarios import split_assignment
     from .store import open_store
     fmu, fixed, opts, md, var, dx = resolve_run(args, {})
@@ -743,7 +738,10 @@ def main(argv=None):
     ap = build_parser()
     args = ap.parse_args(argv)
     os.environ.setdefault("OMP_WAIT_POLICY", "passive")
+    from .emulate_mf import COMMANDS as MF_COMMANDS
     try:
+        if args.cmd in MF_COMMANDS:
+            return MF_COMMANDS[args.cmd](args)
         return {"fit": cmd_fit, "predict": cmd_predict, "validate": cmd_validate,
                 "risk": cmd_risk, "plot": cmd_plot, "design": cmd_design,
                 "curve": cmd_curve, "jitter": cmd_jitter}[args.cmd](args)

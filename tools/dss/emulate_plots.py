@@ -236,3 +236,78 @@ def jitter_plot(doc: dict, output: str, path: str):
     fig.savefig(path, dpi=110)
     plt.close(fig)
     return path
+
+
+def mf_validation_plot(doc: dict, output: str, path: str):
+    """Predicted (with the 95 % intervals) against simulated hold-out runs at one level."""
+    plt = _plt()
+    y, mu, sd = (np.asarray(doc[k], float) for k in ("y", "mean", "sd"))
+    met = doc["metrics"]
+    fig, ax = plt.subplots(figsize=(5, 4.6))
+    inside = np.abs(mu - y) <= E.Z95 * sd
+    ax.errorbar(y[inside], mu[inside], yerr=E.Z95 * sd[inside], fmt="o", ms=4, color="C0",
+                capsize=2, label="inside its 95 % interval")
+    if (~inside).any():
+        ax.errorbar(y[~inside], mu[~inside], yerr=E.Z95 * sd[~inside], fmt="s", ms=4,
+                    color="C3", capsize=2, label="outside")
+    lo = min(y.min(), (mu - E.Z95 * sd).min())
+    hi = max(y.max(), (mu + E.Z95 * sd).max())
+    ax.plot([lo, hi], [lo, hi], "k-", lw=0.7)
+    ax.set_xlabel(f"{output}, FMU at dx = {doc['holdout_dx']:g}")
+    ax.set_ylabel(f"emulator, level {doc['level']}")
+    ax.set_title(f"RMSE {met['rmse']:.3g} ({met['rmse_pct']:.1f} % of range), "
+                 f"{100 * met['coverage95']:.0f} % inside", fontsize=9)
+    ax.legend(fontsize=7)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def mf_design_history(state: dict, path: str):
+    """The multi-fidelity design: the CPU spent and the runs per level against the batches,
+    and the finest level's leave-one-out RMSE."""
+    plt = _plt()
+    h = state["history"]
+    levels = state["spec"]["levels"]
+    cpu = [x["cpu_spent_s"] for x in h]
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.8))
+    runs = np.array([x["runs_per_level"] for x in h])
+    for j, dx in enumerate(levels):
+        a1.plot(cpu, runs[:, j], "o-", ms=3, label=f"dx {dx:g}")
+    a1.set_xlabel("CPU seconds spent")
+    a1.set_ylabel("runs")
+    a1.legend(fontsize=7)
+    a1.grid(alpha=0.3)
+    a2.plot(cpu, [x["loo_rmse_finest"] for x in h], "o-", ms=3, color="C3")
+    a2.set_xlabel("CPU seconds spent")
+    a2.set_ylabel(f"LOO RMSE at dx {levels[-1]:g}")
+    a2.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def level_costs(df, levels, path: str):
+    """The CPU time of every ok run per level (the costs the design divides by)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(4.6, 3.6))
+    ok = df[df["status"] == "ok"]
+    for j, dx in enumerate(levels):
+        c = ok.loc[np.isclose(ok["dx"].astype(float), dx), "cpu_time_s"].astype(float)
+        ax.plot(np.full(len(c), j) + np.linspace(-0.15, 0.15, max(len(c), 1))[:len(c)], c, "o",
+                ms=3, alpha=0.6, color=f"C{j}")
+        if len(c):
+            ax.plot([j - 0.25, j + 0.25], [np.median(c)] * 2, "k-", lw=1.5)
+            ax.annotate(f"{np.median(c):.1f} s", (j + 0.27, np.median(c)), fontsize=7,
+                        va="center")
+    ax.set_xticks(range(len(levels)), [f"dx {dx:g}" for dx in levels])
+    ax.set_yscale("log")
+    ax.set_ylabel("CPU seconds per run (median: line)")
+    ax.grid(alpha=0.3, axis="y")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
