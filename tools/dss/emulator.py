@@ -69,6 +69,15 @@ NOISE_BOUNDS = (1e-8, 1.0)
 Z95 = 1.959963984540054
 
 
+
+def file_header(schema: str, version: int) -> dict:
+    """The first keys of an emulator file: its schema and version, when it was made (UTC) and
+    the versions of the libraries that fitted it."""
+    import sklearn
+    return {"schema": schema, "schema_version": version,
+            "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "library": {"scikit-learn": sklearn.__version__, "numpy": np.__version__}}
+
 class EmulatorError(ValueError):
     pass
 
@@ -455,11 +464,8 @@ class Emulator:
     # ---- save / load ------------------------------------------------------------------------
 
     def to_json(self) -> dict:
-        import sklearn
         return {
-            "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
-            "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "library": {"scikit-learn": sklearn.__version__, "numpy": np.__version__},
+            **file_header(SCHEMA, SCHEMA_VERSION),
             "fmu": self.fmu, "sweep": self.sweep,
             "inputs": [{"name": n, "kind": k, "lo": float(b[0]), "hi": float(b[1])}
                        for n, k, b in zip(self.inputs, self.kinds, self.box)],

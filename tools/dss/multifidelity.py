@@ -55,7 +55,6 @@ rebuilds every GP with optimizer=None (the same predictions) and refuses an FMU 
 
 from __future__ import annotations
 
-import datetime as _dt
 import json
 import math
 import os
@@ -514,11 +513,8 @@ class MFEmulator:
     # ---- save / load --------------------------------------------------------------------------
 
     def to_json(self) -> dict:
-        import sklearn
         return {
-            "schema": SCHEMA, "schema_version": SCHEMA_VERSION,
-            "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ"),
-            "library": {"scikit-learn": sklearn.__version__, "numpy": np.__version__},
+            **E.file_header(SCHEMA, SCHEMA_VERSION),
             "fmu": self.fmu, "settings": self.settings,
             "model": "recursive autoregressive co-kriging (Kennedy & O'Hagan 2000; Le Gratiet & "
                      "Garnier 2014); delta GPs ConstantKernel*Matern(nu=2.5, anisotropic)"
