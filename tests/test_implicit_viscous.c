@@ -165,8 +165,8 @@ static struct viscous_report box_solve(mixsph_sim *s, double factor, int precond
     const double dt = factor * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0;
     struct wall_mirror *M = walls_mirror_create();
     assert_non_null(M);
-    assert_int_equal(walls_mirror_build(M, &s->cfg, &s->K, &s->G, &s->P, n, 1), 0);
-    walls_mirror_at(M, &s->cfg, s->walls, &s->P, s->t, dt, 1);
+    assert_int_equal(walls_mirror_build(M, &s->walls, &s->K, &s->G, &s->P, n, 1), 0);
+    walls_mirror_at(M, &s->walls, &s->P, s->t, dt, 1);
     assert_int_equal(viscous_solve(V, s->forces, &S, M, dt, preconditioner, 1e-10, 1000, &rep), 0);
     viscous_free(V);
     walls_mirror_free(M);

@@ -274,10 +274,10 @@ static void test_moving_plate(void **state)
         /* the plate follows its law: reference, the integral of the law; tolerance 1e-6 m (the
          * mid-step velocity is exact on the linear pieces; a step across a kink of the law errs
          * by about |jump of acceleration| dt^2 / 8, < 1e-8 m here, at 6 kinks) */
-        const double e = fabs(s->walls[plate].ox - X);
+        const double e = fabs(s->walls.state[plate].ox - X);
         err_max = fmax(err_max, e);
         assert_true(e < 1e-6);
-        assert_true(fabs(s->walls[plate].oz) < 1e-15);
+        assert_true(fabs(s->walls.state[plate].oz) < 1e-15);
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
@@ -298,7 +298,7 @@ static void test_moving_plate(void **state)
     const long clips = mixsph_sim_output_find(s, "wall_corrections");
     print_message("plate stroke %.4f m (law %.4f m, largest deviation %.2e m); closest particle %.4f dx in front "
                   "of it at t = %.4f s; highest particle z = %.3f m; %.0f wall corrections; %llu steps\n",
-                  s->walls[plate].ox, law_displacement(t_end), err_max, gap_min / s->dx, t_gap, z_max,
+                  s->walls.state[plate].ox, law_displacement(t_end), err_max, gap_min / s->dx, t_gap, z_max,
                   mixsph_sim_output_value(s, (size_t)clips), (unsigned long long)mixsph_sim_steps(s));
     /* the stroke of the law: about 0.34 m at speed scale 1 (cases/vajont_padua.json), checked on the table */
     assert_true(fabs(law_displacement(t_end) / PLATE_SPEED_SCALE - 0.34) < 0.01);

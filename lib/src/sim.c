@@ -54,7 +54,7 @@ static int site_blocked(const mixsph_sim *s, double x, double z)
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         int at_end = 0;
         double d;
-        walls_signed_distance(&s->cfg, s->walls, w, x, z, &d, &at_end);
+        walls_signed_distance(&s->walls, w, x, z, &d, &at_end);
         if (!at_end && d < 0.5 * s->dx * (1.0 - 1e-9)) return 1;
     }
     return 0;
@@ -186,7 +186,7 @@ static void set_domain(mixsph_sim *s)
         const double dt = s->cfg.t_end / nsub;
         for (int k = 0; k < nsub; k++) {
             double vx, vz;
-            case_motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
+            motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
             ox += vx * dt;
             oz += vz * dt;
             oxmin = fmin(oxmin, ox);
@@ -237,9 +237,11 @@ static mixsph_status sim_init(mixsph_sim *s)
     s->h = s->cfg.h_over_dx * s->dx;
     s->K = kernel_make_type(s->h, s->cfg.kernel);
     s->c_max = law_max_wave_speed(s->cfg.media, s->cfg.n_media);
-    walls_start(&s->cfg, s->walls);
+    /* a wall particle with no fluid around it takes the first medium's density */
+    walls_init(&s->walls, s->cfg.walls, s->cfg.n_walls, s->cfg.motions, s->cfg.wall_layers, s->cfg.wall_placement,
+               s->cfg.lattice_z0, s->cfg.g, s->cfg.media[0].rho0);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
-    const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->interrupt, &s->P);
+    const long n_wall = walls_generate(&s->walls, s->dx, &s->interrupt, &s->P);
     if (n_wall == WALLS_INTERRUPTED)
         return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while placing the wall particles", s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
@@ -582,10 +584,10 @@ mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, doub
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s: external velocity (%g, %g) m/s is not finite", wall, vx, vz);
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
-    s->walls[w].ext = 1;
-    s->walls[w].ext_vx = vx;
-    s->walls[w].ext_vz = vz;
-    walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, 0.0, 0.0, &s->P);
+    s->walls.state[w].ext = 1;
+    s->walls.state[w].ext_vx = vx;
+    s->walls.state[w].ext_vz = vz;
+    walls_change_velocity(&s->walls, (size_t)w, vx, vz, 0.0, 0.0, &s->P);
     return MIXSPH_OK;
 }
 
@@ -595,14 +597,14 @@ mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall)
     if (!wall) return SIM_FAIL(s, MIXSPH_ERR_ARG, "release_wall_velocity: no wall name");
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
-    if (s->walls[w].ext) {
+    if (s->walls.state[w].ext) {
         const struct motion *law = &s->cfg.motions[s->cfg.walls[w].motion];
         double vx, vz, ax, az;
-        case_motion_velocity(law, s->t, &vx, &vz);
-        case_motion_acceleration(law, s->t, &ax, &az);
-        walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, ax, az, &s->P);
+        motion_velocity(law, s->t, &vx, &vz);
+        motion_acceleration(law, s->t, &ax, &az);
+        walls_change_velocity(&s->walls, (size_t)w, vx, vz, ax, az, &s->P);
     }
-    s->walls[w].ext = 0;
+    s->walls.state[w].ext = 0;
     return MIXSPH_OK;
 }
 size_t mixsph_sim_output_count(const mixsph_sim *s) { return s->n_out; }

@@ -58,7 +58,7 @@ struct mixsph_sim {
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
     double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
-    struct wall_state walls[CASE_MAX_WALLS];
+    struct walls walls;           /* the walls' definitions and moving states */
     void *law_state[LAW_COUNT];   /* each material law's state (laws/law.h); NULL: stateless or unused */
     unsigned law_features;        /* the union of the media's law features (enum law_feature) */
     struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */

@@ -97,7 +97,7 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
             if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P->x[i], P->z[i])) continue;
             double d;
             int at_end;
-            walls_signed_distance(&s->cfg, s->walls, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
+            walls_signed_distance(&s->walls, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
             if (d < -s->dx) continue; /* first layer only */
             if (isnan(best) || P->p[i] > best) best = P->p[i];
         }

@@ -163,7 +163,7 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
     put(w, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
     put_u64(w, s->cfg.n_walls);
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
-        const struct wall_state *ws = &s->walls[k];
+        const struct wall_state *ws = &s->walls.state[k];
         const double v[8] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz};
         put(w, v, sizeof v);
         put_u64(w, (uint64_t)ws->ext);
@@ -306,7 +306,7 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
     get(r, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
     if (get_u64(r) != s->cfg.n_walls) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: wall count differs from the case's");
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
-        struct wall_state *ws = &s->walls[k];
+        struct wall_state *ws = &s->walls.state[k];
         double v[8];
         get(r, v, sizeof v);
         ws->ox = v[0];

@@ -131,10 +131,10 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     for (size_t i = 0; i < n; i++) {
         int close = 0;
         if (P->state[i] != MIXSPH_STATE_WALL)
-            for (size_t w = 0; w < s->cfg.n_walls && !close; w++) {
+            for (size_t w = 0; w < s->walls.n && !close; w++) {
                 double d;
                 int at_end;
-                walls_signed_distance(&s->cfg, s->walls, w, P->x[i], P->z[i], &d, &at_end);
+                walls_signed_distance(&s->walls, w, P->x[i], P->z[i], &d, &at_end);
                 close = !(fabs(d) > reach); /* NaN counts as close */
             }
         near[i] = (uint8_t)close;
@@ -201,7 +201,7 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
 {
     if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
     integrate_update_laws(s, law_dt);
-    walls_extrapolate_fluid(&s->cfg, s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
+    walls_extrapolate_fluid(&s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
     return 0;
 }
 
@@ -317,7 +317,7 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
                                       .tolerance = s->cfg.viscous_tolerance,
                                       .max_iterations = s->cfg.viscous_max_iterations};
     const double t0 = clock_monotonic_s();
-    int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->cfg, s->walls, s->t, dt,
+    int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->walls, s->t, dt,
                               s->viscous_unknown, &vp, rep);
     if (!failed && rigid && judge_dt > 0.0) failed = held_grain_kicks(s, &S, judge_dt);
     s->viscous_wall_s += clock_monotonic_s() - t0;
@@ -367,12 +367,12 @@ static mixsph_status check_time_step(mixsph_sim *s)
 static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
 {
     struct particles *P = &s->P;
-    double ox_old[CASE_MAX_WALLS], oz_old[CASE_MAX_WALLS];
-    for (size_t w = 0; w < s->cfg.n_walls; w++) {
-        ox_old[w] = s->walls[w].ox;
-        oz_old[w] = s->walls[w].oz;
+    double ox_old[WALLS_MAX], oz_old[WALLS_MAX];
+    for (size_t w = 0; w < s->walls.n; w++) {
+        ox_old[w] = s->walls.state[w].ox;
+        oz_old[w] = s->walls.state[w].oz;
     }
-    walls_move(&s->cfg, s->walls, P, s->t, dt);
+    walls_move(&s->walls, P, s->t, dt);
     const double gap = INTEGRATE_CLIP_GAP * s->dx;
     long clips = 0;
     /* with the drift, in the same loop, the largest squared displacement of an active particle
@@ -398,7 +398,7 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
                 const double x0 = P->x[i], z0 = P->z[i];
                 double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
                 if (s->near_wall[i])
-                    walls_clip(&s->cfg, s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
+                    walls_clip(&s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
                 P->x[i] = x1;
                 P->z[i] = z1;
             }
