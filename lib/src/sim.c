@@ -230,6 +230,34 @@ static mixsph_status create_laws(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
+/* The time schemes' parameters from the case and the laws' features (after create_laws). */
+static void set_scheme_params(mixsph_sim *s)
+{
+    const struct case_def *c = &s->cfg;
+    s->scheme = (struct scheme_params){
+        .media = c->media,
+        .n_media = c->n_media,
+        .implicit = c->viscosity_implicit,
+        .held_grains_rigid = c->held_grains_rigid,
+        .cfl = c->cfl,
+        .cfl_visc = c->cfl_visc,
+        .p_background = c->p_background,
+        .pressure_smoothing = c->pressure_smoothing,
+        .pair = {.K = s->K,
+                 .eta2 = 0.01 * s->h * s->h,
+                 .g = c->g,
+                 .av_wall = c->av_wall,
+                 .av_mixed = c->av_mixed,
+                 .av_separating = c->av_separating,
+                 .implicit_viscosity = c->viscosity_implicit,
+                 .arithmetic_mean = c->viscosity_arithmetic,
+                 .stress = (s->law_features & LAW_HAS_STRESS) != 0},
+        .viscous = {.preconditioner = c->viscous_preconditioner,
+                    .tolerance = c->viscous_tolerance,
+                    .max_iterations = c->viscous_max_iterations},
+    };
+}
+
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
@@ -248,6 +276,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     s->n_wall = (size_t)n_wall;
     set_domain(s);
     if ((st = create_laws(s)) != MIXSPH_OK) return st;
+    set_scheme_params(s);
     if (!(s->forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
     for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */

@@ -17,6 +17,7 @@
 #include "law.h"
 #include "neighbours.h"
 #include "particles.h"
+#include "scheme_params.h"
 #include "viscous.h"
 #include "walls.h"
 
@@ -35,7 +36,8 @@
 #define SIM_MAX_OUTPUTS (10 + CASE_MAX_MONITORS)
 
 struct mixsph_sim {
-    struct case_def cfg;
+    struct case_def cfg;          /* read when the simulation is created and by the outputs, not by a step */
+    struct scheme_params scheme;  /* what a step reads, set once from cfg */
     /* what the simulation was created from (kept for state save/restore and metadata) */
     char *case_text, *case_origin;
     size_t n_ov;

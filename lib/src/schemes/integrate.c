@@ -52,14 +52,14 @@ static inline double particle_time_step(const mixsph_sim *s, size_t i, int impli
     const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
     double mu = implicit ? 0.0 : P->mu[i];
     if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) /* the viscosity it will have once mobilised */
-        mu = mixture_paper_held_viscosity(&s->cfg.media[P->medium[i]]);
-    return time_step_bound(s->cfg.cfl, s->cfg.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
+        mu = mixture_paper_held_viscosity(&s->scheme.media[P->medium[i]]);
+    return time_step_bound(s->scheme.cfl, s->scheme.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
 }
 
 double integrate_time_step(const mixsph_sim *s)
 {
     const struct particles *P = &s->P;
-    const int implicit = s->cfg.viscosity_implicit; /* no viscous bound: the viscous step is implicit */
+    const int implicit = s->scheme.implicit; /* no viscous bound: the viscous step is implicit */
     double dt = INFINITY;
 #pragma omp parallel for schedule(static) reduction(min : dt) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
@@ -74,8 +74,8 @@ double integrate_time_step(const mixsph_sim *s)
 static inline void particle_pressure(mixsph_sim *s, size_t i)
 {
     struct particles *P = &s->P;
-    const struct medium *m = &s->cfg.media[P->medium[i]];
-    const double pb = s->cfg.p_background;
+    const struct medium *m = &s->scheme.media[P->medium[i]];
+    const double pb = s->scheme.p_background;
     double p = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
     if (m->tension_cutoff && p < pb) p = pb; /* a cohesionless medium carries no tension */
     P->p[i] = p;
@@ -113,7 +113,7 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     if (neighbours_gather_reserve(&s->G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     for (size_t i = 0; i < n; i++) {
         uint8_t mode = NEIGHBOURS_GATHER_NONE;
-        if (P->state[i] == MIXSPH_STATE_WALL || (s->cfg.media[P->medium[i]].features & LAW_USES_GRADIENT))
+        if (P->state[i] == MIXSPH_STATE_WALL || (s->scheme.media[P->medium[i]].features & LAW_USES_GRADIENT))
             mode = NEIGHBOURS_GATHER_ALL;
         s->G.mode[i] = mode;
     }
@@ -149,16 +149,8 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.C = &s->C;
     S.NB = &s->NB;
     S.G = &s->G;
-    S.media = s->cfg.media;
-    S.params.K = s->K;
-    S.params.eta2 = 0.01 * s->h * s->h;
-    S.params.g = s->cfg.g;
-    S.params.av_wall = s->cfg.av_wall;
-    S.params.av_mixed = s->cfg.av_mixed;
-    S.params.av_separating = s->cfg.av_separating;
-    S.params.implicit_viscosity = s->cfg.viscosity_implicit;
-    S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
-    S.params.stress = (s->law_features & LAW_HAS_STRESS) != 0;
+    S.media = s->scheme.media;
+    S.params = s->scheme.pair;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
@@ -168,8 +160,8 @@ static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.nce
 /* Whether a medium of the case uses law `id`. */
 static int law_in_use(const mixsph_sim *s, int id)
 {
-    for (size_t k = 0; k < s->cfg.n_media; k++)
-        if (s->cfg.media[k].law == id) return 1;
+    for (size_t k = 0; k < s->scheme.n_media; k++)
+        if (s->scheme.media[k].law == id) return 1;
     return 0;
 }
 
@@ -183,9 +175,9 @@ int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
  * their ids; the paper's law reports the grains it holds fixed. */
 void integrate_update_laws(mixsph_sim *s, double law_dt)
 {
-    const struct law_step step = {.P = &s->P, .n = active_particles(s), .media = s->cfg.media, .grad = &s->grad,
+    const struct law_step step = {.P = &s->P, .n = active_particles(s), .media = s->scheme.media, .grad = &s->grad,
                                   .G = &s->G, .K = &s->K, .dt = law_dt,
-                                  .p_background = s->cfg.p_background, .n_threads = SIM_THREADS(s)};
+                                  .p_background = s->scheme.p_background, .n_threads = SIM_THREADS(s)};
     for (int id = 0; id < LAW_COUNT; id++) {
         const struct material_law *law = law_get(id);
         if (!law->update || !law_in_use(s, id)) continue;
@@ -199,7 +191,7 @@ void integrate_update_laws(mixsph_sim *s, double law_dt)
  * when out of memory. */
 static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth, double law_dt)
 {
-    if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
+    if (smooth && forces_smooth_pressure(s->forces, S, s->scheme.pressure_smoothing * s->dt / s->h) != 0) return -1;
     integrate_update_laws(s, law_dt);
     walls_extrapolate_fluid(&s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
     return 0;
@@ -210,11 +202,11 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
 static void kick_velocities(mixsph_sim *s, double dt)
 {
     struct particles *P = &s->P;
-    const int rigid = s->cfg.viscosity_implicit && s->cfg.held_grains_rigid;
+    const int rigid = s->scheme.implicit && s->scheme.held_grains_rigid;
 #pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], rigid))
+        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid))
             continue;
         P->vx[i] += dt * P->ax[i];
         P->vz[i] += dt * P->az[i];
@@ -261,7 +253,7 @@ static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double j
     const size_t n = active_particles(s);
 #pragma omp parallel for schedule(static) num_threads(S->n_threads)
     for (size_t i = 0; i < n; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0))
+        if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))
             continue;
         P->vx[i] = judge_dt * (P->ax[i] - lx[i] / P->m[i]);
         P->vz[i] = judge_dt * (P->az[i] - lz[i] / P->m[i]);
@@ -304,7 +296,7 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     struct viscous_report *rep = &s->viscous_last;
     if (!(s->viscous_unknown = realloc_unknowns(s->viscous_unknown, s->P.cap)))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
-    const int rigid = s->cfg.held_grains_rigid;
+    const int rigid = s->scheme.held_grains_rigid;
     struct particles *P = &s->P;
     const size_t n = active_particles(s);
     /* the unknowns: mobile particles, and held grains that take their forces (mixture_paper.h) */
@@ -312,13 +304,11 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     for (size_t i = 0; i < n; i++)
         s->viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
                                 (P->state[i] == MIXSPH_STATE_FIXED &&
-                                 mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], rigid));
-    const struct viscous_params vp = {.preconditioner = s->cfg.viscous_preconditioner,
-                                      .tolerance = s->cfg.viscous_tolerance,
-                                      .max_iterations = s->cfg.viscous_max_iterations};
+                                 mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
+    const struct viscous_params *vp = &s->scheme.viscous;
     const double t0 = clock_monotonic_s();
     int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->walls, s->t, dt,
-                              s->viscous_unknown, &vp, rep);
+                              s->viscous_unknown, vp, rep);
     if (!failed && rigid && judge_dt > 0.0) failed = held_grain_kicks(s, &S, judge_dt);
     s->viscous_wall_s += clock_monotonic_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
@@ -327,7 +317,7 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
         return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                         "implicit viscous step: relative residual %.3g after %d iterations (tolerance %g, "
                         "numerics.viscous_max_iterations %d) at t = %.6g s (step %llu)",
-                        rep->residual, rep->iterations, s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, s->t,
+                        rep->residual, rep->iterations, vp->tolerance, vp->max_iterations, s->t,
                         (unsigned long long)s->step);
     return MIXSPH_OK;
 }
@@ -390,7 +380,7 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
         const int st = P->state[i];
         if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
             const double kick =
-                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0) ? 0.0
+                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0) ? 0.0
                                                                                                            : half_kick;
             double vx = P->vx[i] + kick * P->ax[i];
             double vz = P->vz[i] + kick * P->az[i];
@@ -438,7 +428,7 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
         bad_rho |= !(P->rho[i] > 0.0);
         particle_pressure(s, i);
     }
-    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
+    if (pressures_and_regimes(s, &S, s->scheme.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -461,7 +451,7 @@ static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implici
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         if (last_kick > 0.0 &&
-            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0))) {
+            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))) {
             P->vx[i] += last_kick * P->ax[i];
             P->vz[i] += last_kick * P->az[i];
         }
@@ -496,7 +486,7 @@ static mixsph_status implicit_step(mixsph_sim *s)
     if (st != MIXSPH_OK) return st;
     const double dt = s->dt;
     /* from the state before the kick, as the explicit scheme's step would be; 0: none held */
-    const double judge_dt = s->cfg.held_grains_rigid && s->n_fixed > 0 ? held_grain_judge_dt(s, dt) : 0.0;
+    const double judge_dt = s->scheme.held_grains_rigid && s->n_fixed > 0 ? held_grain_judge_dt(s, dt) : 0.0;
     kick_velocities(s, dt);
     if ((st = implicit_viscous_step(s, dt, judge_dt)) != MIXSPH_OK) return st;
     if ((st = move_particles(s, dt, 0.0)) != MIXSPH_OK) return st;
@@ -507,5 +497,5 @@ static mixsph_status implicit_step(mixsph_sim *s)
 
 mixsph_status integrate_step(mixsph_sim *s)
 {
-    return s->cfg.viscosity_implicit ? implicit_step(s) : explicit_step(s);
+    return s->scheme.implicit ? implicit_step(s) : explicit_step(s);
 }
