@@ -470,6 +470,27 @@ static mixsph_status read_full_scale(const struct case_reader *r, const cJSON *r
     return MIXSPH_OK;
 }
 
+mixsph_status case_number(const struct case_def *c, const char *key, double *value, char *err, size_t err_len)
+{
+    static const char *const own[] = {"numerics", "output"}; /* sections stored in struct case_def */
+    const char *dot = strchr(key, '.');
+    const struct case_section *sec = NULL;
+    const char *name = key;
+    if (!dot) {
+        sec = case_schema_find("case");
+    } else {
+        for (size_t k = 0; k < sizeof own / sizeof own[0]; k++)
+            if ((size_t)(dot - key) == strlen(own[k]) && strncmp(key, own[k], strlen(own[k])) == 0)
+                sec = case_schema_find(own[k]);
+        name = dot + 1;
+    }
+    const struct case_key *k = sec ? case_schema_key(sec, name) : NULL;
+    if (!k || case_schema_stored_number(k, c, value) != 0)
+        return status_set(err, err_len, MIXSPH_ERR_ARG,
+                          "%s: not a numeric key of the case's top level, numerics or output", key);
+    return MIXSPH_OK;
+}
+
 double case_profile_bin_count(const struct monitor_def *md)
 {
     return fmax(1.0, ceil((md->x_max - md->x_min) / md->bin));

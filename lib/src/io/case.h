@@ -129,6 +129,11 @@ mixsph_status case_read_file(const char *path, char **text, char *err, size_t er
 
 void case_free(struct case_def *c);
 
+/** The value a case gives a numeric key of its top level, `numerics` or `output` ("numerics.cfl",
+ *  "t_end"...: the file's, an override's or the default; a choice as its value). MIXSPH_ERR_ARG,
+ *  with a message, for any other key. */
+mixsph_status case_number(const struct case_def *c, const char *key, double *value, char *err, size_t err_len);
+
 /** Full-scale elevation of a lab elevation z [m] (the case's full_scale map; z itself without one). */
 double case_full_scale_z(const struct case_def *c, double z);
 /** The error (13) [%] of a full-scale elevation Z against the case's reference (NAN without one). */

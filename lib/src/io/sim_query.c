@@ -12,6 +12,13 @@
 #include "sim.h"
 #include "status.h"
 
+mixsph_status mixsph_sim_case_number(const mixsph_sim *s, const char *key, double *value)
+{
+    if (!s || !key || !value) return MIXSPH_ERR_ARG;
+    char unused[160]; /* s is the host's to read: it keeps no message of a query */
+    return case_number(&s->cfg, key, value, unused, sizeof unused);
+}
+
 size_t mixsph_sim_wall_count(const mixsph_sim *s)
 {
     return s ? s->cfg.n_walls : 0;
