@@ -28,7 +28,7 @@ static inline void sim_mixture_update(mixsph_sim *s) { integrate_update_laws(s, 
 static inline void sim_smooth_pressure(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
-    forces_smooth_pressure(s->work.forces, &S, s->cfg.pressure_smoothing * s->phys.dt / s->phys.h);
+    forces_smooth_pressure(s->work.forces, &S, s->scheme.pressure_smoothing * s->phys.dt / s->phys.h);
 }
 
 /* The acceleration (without gravity) and density rate particle j gives i. */

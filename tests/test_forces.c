@@ -379,8 +379,8 @@ static void test_monaghan_switches(void **state)
     size_t on[4] = {0}, off[4] = {0};
     for (int mode = 0; mode < 4; mode++) {
         const int mixed = mode & 1, separating = (mode >> 1) & 1;
-        s->cfg.av_mixed = mixed;
-        s->cfg.av_separating = separating;
+        s->scheme.pair.av_mixed = mixed;
+        s->scheme.pair.av_separating = separating;
         for (size_t i = 0; i < n; i++) {
             for (size_t j = 0; j < n; j++) {
                 struct pair_geom g;
@@ -405,8 +405,8 @@ static void test_monaghan_switches(void **state)
             }
         }
     }
-    s->cfg.av_mixed = 0;
-    s->cfg.av_separating = 0;
+    s->scheme.pair.av_mixed = 0;
+    s->scheme.pair.av_separating = 0;
     select_terms(s, TERM_PRESSURE | TERM_MONAGHAN | TERM_MORRIS_MIXED, alpha, mu);
     free(mu);
     /* every mode met pairs where the term acts, and all but the all-pairs mode pairs where it
@@ -444,7 +444,7 @@ static void test_monaghan_at_walls(void **state)
     }
     integrate_pressure_and_derived(s);
     for (int av_wall = 1; av_wall >= 0; av_wall--) {
-        s->cfg.av_wall = av_wall;
+        s->scheme.pair.av_wall = av_wall;
         double drag = 0.0, mass = 0.0;
         size_t pairs = 0;
         for (size_t i = 0; i < P->n; i++) {
