@@ -8,7 +8,8 @@
  *              (drucker_prager.h); at the apex the pressure is set to p' + p_b,
  * the pressure coming from the equation of state of the grains' sound speed (K = rho0 c^2, the
  * mixture density rho0 of (5)), the shear modulus from Poisson's ratio, G = 3 K (1 - 2 nu) /
- * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by the medium's artificial viscosity.
+ * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by Monaghan's artificial viscosity
+ * with alpha_M c = c_p (fixed, below).
  * Not yet: saturated media (the pore pressure of docs/model.md [PW] is the paper law's module's),
  * a wall friction angle (walls carry no deviatoric stress, laws/law.h). Experimental: the bundled
  * cases keep the paper's law. */
@@ -48,8 +49,6 @@ static const struct case_key elastic_plastic_keys[] = {
      .field = CASE_FIELD(medium, poisson), .meaning = "Poisson's ratio: G = 3K(1−2ν)/(2(1+ν))"},
     {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
      .meaning = "must be false: saturated media are the paper law's for now"},
-    {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0.2), .unit = "-",
-     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M (damps the waves)"},
 };
 
 static const struct case_section elastic_plastic_section = {
@@ -73,6 +72,10 @@ static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_f
     if (why) return FAIL(ctx, "%s: %s: %s", ctx->origin, ctx->path, why);
     m->sin_phi = sin(m->phi_deg * GEOM_PI / 180.0);
     m->mu = 0.0;
+    /* The grains' dissipation (docs/model.md [DP-AV]): Monaghan's term with alpha_M c = c_p, the
+     * acoustic impedance rho c_p of the P wave on the approach speed of a pair, as a linearised
+     * Riemann solver has it; a fixed numerical parameter, not a case key. */
+    m->alpha_m = elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0) / m->c;
     return MIXSPH_OK;
 }
 
