@@ -6,7 +6,11 @@
  * 0.1 dx of where it started over 2 s. Measured (12-06, one thread): 0.055 dx, the largest
  * displacement near the apex. It stands by its elastic stress and the dissipation of
  * docs/model.md [DP-AV]; without that dissipation (alpha_M = 0) a heap of 25-degree slopes
- * spreads by 4 dx in 2 s. */
+ * spreads by 4 dx in 2 s.
+ *
+ * Grains against walls: a block on a 30-degree incline of wall friction angle 15 degrees slides
+ * with the Coulomb block's acceleration (asserted); that it stays a block is not met yet (a
+ * known failure with today's band, below). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -18,6 +22,7 @@
 
 #include <cmocka.h>
 
+#include "known_failure.h"
 #include "sim.h"
 
 #define DX 0.01
@@ -97,11 +102,94 @@ static void test_heap_below_phi(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* A block of the same sand (0.2 m long, 0.05 m thick along the slope) released from rest on a
+ * 30-degree incline (aligned wall particles) whose friction angle is delta = 15 degrees. */
+#define INCLINE_DEG 30.0
+#define DELTA_DEG 15.0
+
+static const char *block_json(void)
+{
+    static char buf[2048];
+    const double a = INCLINE_DEG * GEOM_PI / 180.0, tx = cos(a), tz = -sin(a), nx = sin(a), nz = cos(a);
+    const double s0 = 0.1, s1 = 0.3, h = 0.05, len = 1.2;
+#define PT(s, d) (s) * tx + (d) * nx, (s) * tz + (d) * nz
+    snprintf(buf, sizeof buf,
+             "{ \"name\": \"block_ep\", \"gravity\": 9.81,"
+             "  \"numerics\": { \"dx\": 0.01, \"t_end\": 0.5, \"wall_placement\": \"aligned\" },"
+             "  \"media\": { \"sand\": { \"type\": \"granular\", \"law\": \"elastic_plastic\", \"rho\": 2650.0,"
+             "    \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0 } },"
+             "  \"bodies\": { \"block\": { \"medium\": \"sand\", \"polygon\": [[%.9g, %.9g], [%.9g, %.9g], [%.9g, %.9g],"
+             "    [%.9g, %.9g]] } },"
+             "  \"walls\": { \"incline\": { \"polyline\": [[%.9g, %.9g], [%.9g, %.9g]], \"fluid_side\": \"left\","
+             "    \"friction\": %g } },"
+             "  \"domain\": { \"x_min\": -0.2, \"x_max\": 1.25, \"z_min\": -0.8, \"z_max\": 0.3 } }",
+             PT(s0, 0.0), PT(s1, 0.0), PT(s1, h), PT(s0, h), PT(-0.05, 0.0), PT(len, 0.0), DELTA_DEG);
+#undef PT
+    return buf;
+}
+
+/* The block's mean velocity along the slope and its thickness (extent normal to the slope). */
+static void block_state(const struct particles *P, double *u, double *thick)
+{
+    const double a = INCLINE_DEG * GEOM_PI / 180.0;
+    double su = 0.0, lo = INFINITY, hi = -INFINITY;
+    size_t n = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] == MIXSPH_STATE_WALL) continue;
+        su += P->vx[i] * cos(a) - P->vz[i] * sin(a);
+        const double d = P->x[i] * sin(a) + P->z[i] * cos(a);
+        lo = fmin(lo, d);
+        hi = fmax(hi, d);
+        n++;
+    }
+    *u = su / (double)n;
+    *thick = hi - lo;
+}
+
+static void test_block_on_incline(void **state)
+{
+    (void)state;
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    assert_int_equal(mixsph_sim_create_from_text(block_json(), "block", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    double u, thick0, thick;
+    block_state(&s->P, &u, &thick0);
+    /* the centroid velocity sampled every 0.05 s from 0.1 to 0.5 s, after the start's elastic
+     * transient, and its least-squares slope */
+    double st = 0.0, su = 0.0, stt = 0.0, stu = 0.0;
+    int k = 0;
+    for (double t = 0.1; t <= 0.5 + 1e-9; t += 0.05, k++) {
+        assert_int_equal(mixsph_sim_advance_to(s, t), MIXSPH_OK);
+        block_state(&s->P, &u, &thick);
+        st += t;
+        su += u;
+        stt += t * t;
+        stu += t * u;
+    }
+    const double acc = (k * stu - st * su) / (k * stt - st * st);
+    const double a = INCLINE_DEG * GEOM_PI / 180.0, delta = DELTA_DEG * GEOM_PI / 180.0;
+    const double ref = 9.81 * (sin(a) - cos(a) * tan(delta)); /* a Coulomb block: 2.629 m/s2 */
+    print_message("block on %g-degree incline, delta %g: acceleration %.4f m/s2, reference %.4f (%.2f %%); thickness "
+                  "%.4f -> %.4f m\n",
+                  INCLINE_DEG, DELTA_DEG, acc, ref, 100.0 * (acc / ref - 1.0), thick0, thick);
+    /* criterion (the issue): the Coulomb block's acceleration g (sin a - cos a tan delta) within 5 %;
+     * measured (12-06) +1.2 % */
+    assert_true(fabs(acc / ref - 1.0) <= 0.05);
+    /* ... "while it stays a block": its thickness within 10 % of the start's. NOT MET: a cohesionless
+     * block's end faces (steeper than phi) slump and it spreads along the slope; measured (12-06) 0.55
+     * of its thickness at 0.5 s; band +-20 % */
+    known_failure_check("elastic-plastic block on an incline, thickness ratio at 0.5 s", thick / thick0 >= 0.9,
+                        thick / thick0, 0.44, 0.66);
+    mixsph_sim_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_keys),
         cmocka_unit_test(test_heap_below_phi),
+        cmocka_unit_test(test_block_on_incline),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -222,9 +222,12 @@ static mixsph_status create_laws(mixsph_sim *s)
                             s->cfg.media[k].name);
     }
     if (s->law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
-        for (size_t i = 0; i < s->P.n; i++)
-            s->P.wall_rough[i] = s->P.state[i] == MIXSPH_STATE_WALL &&
-                                 s->cfg.walls[particles_wall_index(&s->P, i)].slip == WALL_NO_SLIP;
+        for (size_t i = 0; i < s->P.n; i++) {
+            const int wall = s->P.state[i] == MIXSPH_STATE_WALL;
+            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(&s->P, i)] : NULL;
+            s->P.wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
+            s->P.wall_friction[i] = !wall ? 0.0 : isnan(w->friction_deg) ? -1.0 : tan(w->friction_deg * GEOM_PI / 180.0);
+        }
     if ((s->law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->grad, s->P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
     return MIXSPH_OK;
