@@ -769,9 +769,12 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
 
 /* The wall friction of an elastic-plastic grain i (docs/model.md [DP-W]): the tangential part F_t
  * of the force F_w its no-slip walls exert on it (their pressure, artificial viscosity and the
- * grain's own stress) is bounded by mu max(N', 0), N' = F_w . n/|n| - 2 p_b V_i |n| its normal
- * part without the background pressure's, mu the walls' tan(delta) weighted by q (the grain's
- * tan(phi) where a wall takes it). Adds the change to the force (fx, fz). */
+ * grain's own stress) is bounded by mu N', N' = F_w . n/|n| - 2 p_b V_i |n| its normal part
+ * without the background pressure's, mu the walls' tan(delta) weighted by q (the grain's tan(phi)
+ * where a wall takes it). Where N' < 0 (a cohesive grain's tension mirrored by the wall) the
+ * contact is unilateral: the walls' effective force on the grain is removed altogether, so the
+ * walls' normal forces on a body sum to its load and their friction to tan(delta) times it. Adds
+ * the change to the force (fx, fz). */
 static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, double vol_i, double tan_phi,
                                 double p_background, double *fx, double *fz)
 {
@@ -784,7 +787,12 @@ static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, dou
     const double fn = fwx * ex + fwz * ez;
     const double tx = fwx - fn * ex, tz = fwz - fn * ez, ft = hypot(tx, tz);
     const double n_eff = fn - 2.0 * p_background * vol_i * nn;
-    const double bound = mu * (n_eff > 0.0 ? n_eff : 0.0);
+    if (n_eff < 0.0) { /* a wall pushes a grain, never pulls it (no adhesion), and then has no shear on it */
+        *fx -= tx + n_eff * ex;
+        *fz -= tz + n_eff * ez;
+        return;
+    }
+    const double bound = mu * n_eff;
     if (ft <= bound) return;
     const double cut = (ft - bound) / ft;
     *fx -= cut * tx;
