@@ -21,24 +21,28 @@
 
 #include <cmocka.h>
 
+#include "known_failure.h"
 #include "sim.h"
 
 #define DX 0.01
 
-/* The heap: base 0.4 m, slopes of 30 degrees (apex 0.2 tan 30 = 0.1154701 m high). */
-static const char *heap_json(const char *extra)
+/* A heap: base 0.4 m, slopes of `slope_deg` on a no-slip floor; `extra` is added to the sand. */
+static const char *heap_json_slope(const char *extra, double slope_deg)
 {
     static char buf[2048];
     snprintf(buf, sizeof buf,
              "{ \"name\": \"heap_ep\", \"gravity\": 9.81, \"numerics\": { \"dx\": 0.01, \"t_end\": 2.0 },"
              "  \"media\": { \"sand\": { \"type\": \"granular\", \"law\": \"elastic_plastic\", \"rho\": 2650.0,"
              "    \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0 %s } },"
-             "  \"bodies\": { \"heap\": { \"medium\": \"sand\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.2, 0.1154701]] } },"
+             "  \"bodies\": { \"heap\": { \"medium\": \"sand\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.2, %.9g]] } },"
              "  \"walls\": { \"floor\": { \"polyline\": [[-0.05, 0.0], [0.45, 0.0]], \"fluid_side\": \"left\" } },"
              "  \"domain\": { \"x_min\": -0.15, \"x_max\": 0.55, \"z_min\": -0.05, \"z_max\": 0.25 } }",
-             extra);
+             extra, 0.2 * tan(slope_deg * GEOM_PI / 180.0));
     return buf;
 }
+
+/* The heap of the tests below phi: slopes of 30 degrees (5 degrees below phi). */
+static const char *heap_json(const char *extra) { return heap_json_slope(extra, 30.0); }
 
 static void test_keys(void **state)
 {
@@ -229,8 +233,84 @@ static void test_block_on_incline(void **state)
     mixsph_sim_destroy(s);
 }
 
-int main(void)
+/* The mean slope [deg] of a heap's two flanks: the top grain of every column dx wide, and a
+ * least-squares line through the tops between 20 % and 80 % of the heap's height on each side of
+ * its highest column. */
+static double heap_flank_angle(const struct particles *P)
 {
+    enum { NB = 80 };
+    const double x0 = -0.15;
+    double top[NB];
+    for (int b = 0; b < NB; b++) top[b] = -INFINITY;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] == MIXSPH_STATE_WALL) continue;
+        const int b = (int)floor((P->x[i] - x0) / DX);
+        if (b >= 0 && b < NB && P->z[i] > top[b]) top[b] = P->z[i];
+    }
+    int apex = 0;
+    for (int b = 1; b < NB; b++)
+        if (top[b] > top[apex]) apex = b;
+    const double H = top[apex];
+    double sum = 0.0;
+    for (int side = -1; side <= 1; side += 2) {
+        double n = 0.0, sx = 0.0, sz = 0.0, sxx = 0.0, sxz = 0.0;
+        for (int b = 0; b < NB; b++) {
+            if ((b - apex) * side <= 0 || !(top[b] > 0.2 * H && top[b] < 0.8 * H)) continue;
+            const double x = x0 + (b + 0.5) * DX;
+            n += 1.0;
+            sx += x;
+            sz += top[b];
+            sxx += x * x;
+            sxz += x * top[b];
+        }
+        assert_true(n >= 2.0);
+        sum += atan(fabs((n * sxz - sx * sz) / (n * sxx - sx * sx))) * 180.0 / GEOM_PI;
+    }
+    return 0.5 * sum;
+}
+
+/* A heap of 45-degree slopes, 10 degrees steeper than phi, fails; the criterion (the issue): it
+ * comes to rest at its repose angle, phi = 35 degrees in plane strain (docs/model.md section 10),
+ * within 3 degrees. NOT MET (12-06): after 3 s its flanks stand at 26.5 degrees and 31 % of its
+ * grains are faster than 1 mm/s. Kept as a known failure with today's band. */
+static void test_repose_after_failure(void **state)
+{
+    (void)state;
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    assert_int_equal(mixsph_sim_create_from_text(heap_json_slope("", 45.0), "heap", NULL, 0, &s, err, sizeof err),
+                     MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    const double start = heap_flank_angle(&s->P);
+    assert_int_equal(mixsph_sim_advance_to(s, 3.0), MIXSPH_OK);
+    const double angle = heap_flank_angle(&s->P);
+    size_t moving = 0, n = 0;
+    for (size_t i = 0; i < s->P.n; i++) {
+        if (s->P.state[i] == MIXSPH_STATE_WALL) continue;
+        n++;
+        moving += hypot(s->P.vx[i], s->P.vz[i]) > 1e-3;
+    }
+    print_message("heap of 45-degree slopes (%.1f on the lattice): flanks at %.2f degrees after 3 s, %.1f %% of "
+                  "the grains faster than 1 mm/s\n", start, angle, 100.0 * (double)moving / (double)n);
+    const int met = fabs(angle - 35.0) <= 3.0 && (double)moving <= 0.05 * (double)n;
+    /* today's band: 26.5 degrees +- 4 */
+    known_failure_check("elastic-plastic heap 10 degrees steeper than phi, flank angle after 3 s [deg]", met, angle,
+                        22.5, 30.5);
+    mixsph_sim_destroy(s);
+}
+
+/* `test_elastic_plastic` runs the tests the law meets; `test_elastic_plastic known_failure repose`
+ * the criterion it does not meet yet (a slow test of its own in CTest). */
+int main(int argc, char **argv)
+{
+    if (argc > 2 && strcmp(argv[1], "known_failure") == 0) {
+        if (strcmp(argv[2], "repose") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_repose_after_failure)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
+        fprintf(stderr, "test_elastic_plastic: unknown known_failure '%s' (repose)\n", argv[2]);
+        return 2;
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_keys),
         cmocka_unit_test(test_heap_below_phi),
