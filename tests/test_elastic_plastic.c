@@ -88,7 +88,7 @@ static void heap_displacements(const char *json, double t_end, double *largest, 
     char err[512] = "";
     assert_int_equal(mixsph_sim_create_from_text(json, "heap", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
     assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const size_t n = P->n;
     double *x0 = calloc(n, sizeof *x0), *z0 = calloc(n, sizeof *z0), *d = calloc(n, sizeof *d);
     assert_true(x0 && z0 && d);
@@ -203,14 +203,14 @@ static void test_block_on_incline(void **state)
     assert_int_equal(mixsph_sim_create_from_text(block_json(), "block", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
     assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
     double u, u_std, len0, len;
-    block_state(&s->P, &u, &u_std, &len0);
+    block_state(&s->phys.P, &u, &u_std, &len0);
     /* the centroid velocity sampled every 0.05 s from 0.1 to 0.5 s, after the start's elastic
      * transient, and its least-squares slope */
     double st = 0.0, su = 0.0, stt = 0.0, stu = 0.0;
     int k = 0;
     for (double t = 0.1; t <= 0.5 + 1e-9; t += 0.05, k++) {
         assert_int_equal(mixsph_sim_advance_to(s, t), MIXSPH_OK);
-        block_state(&s->P, &u, &u_std, &len);
+        block_state(&s->phys.P, &u, &u_std, &len);
         st += t;
         su += u;
         stt += t * t;
@@ -281,14 +281,14 @@ static void test_repose_after_failure(void **state)
     assert_int_equal(mixsph_sim_create_from_text(heap_json_slope("", 45.0), "heap", NULL, 0, &s, err, sizeof err),
                      MIXSPH_OK);
     assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
-    const double start = heap_flank_angle(&s->P);
+    const double start = heap_flank_angle(&s->phys.P);
     assert_int_equal(mixsph_sim_advance_to(s, 3.0), MIXSPH_OK);
-    const double angle = heap_flank_angle(&s->P);
+    const double angle = heap_flank_angle(&s->phys.P);
     size_t moving = 0, n = 0;
-    for (size_t i = 0; i < s->P.n; i++) {
-        if (s->P.state[i] == MIXSPH_STATE_WALL) continue;
+    for (size_t i = 0; i < s->phys.P.n; i++) {
+        if (s->phys.P.state[i] == MIXSPH_STATE_WALL) continue;
         n++;
-        moving += hypot(s->P.vx[i], s->P.vz[i]) > 1e-3;
+        moving += hypot(s->phys.P.vx[i], s->phys.P.vz[i]) > 1e-3;
     }
     print_message("heap of 45-degree slopes (%.1f on the lattice): flanks at %.2f degrees after 3 s, %.1f %% of "
                   "the grains faster than 1 mm/s\n", start, angle, 100.0 * (double)moving / (double)n);

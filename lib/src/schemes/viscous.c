@@ -513,7 +513,7 @@ int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, 
 }
 
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                 struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
+                 struct wall_mirror *M, const struct walls *W, double t, double dt,
                  const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report)
 {
     const size_t n = S->C->start[S->C->ncell];
@@ -528,7 +528,7 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     const struct particles *P = S->P;
     double **v = V->v;
     const int threads = S->n_threads;
-    if (walls_mirror_build(M, cfg, &S->params.K, S->G, P, n, threads) != 0) return -1;
+    if (walls_mirror_build(M, W, &S->params.K, S->G, P, n, threads) != 0) return -1;
     load_velocities(&c);
     /* stage 1: w = u*, first guess u* + the first-stage increment extrapolated linearly from
      * the last two steps (closer than the last increment alone where the flow changes smoothly;
@@ -540,7 +540,7 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
         v[GX][i] = v[USX][i] + 2.0 * P->visc_d1x[i] - P->visc_d1px[i];
         v[GZ][i] = v[USZ][i] + 2.0 * P->visc_d1z[i] - P->visc_d1pz[i];
     }
-    walls_mirror_at(M, cfg, ws, P, t, g * dt, threads);
+    walls_mirror_at(M, W, P, t, g * dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess U1 + the second stage's own
      * change (U2 - U1 = dv - d1) extrapolated linearly from the last two steps; the increments
@@ -562,7 +562,7 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
             Pw->visc_d1z[i] = v[UZ][i] - v[USZ][i];
         }
     }
-    walls_mirror_at(M, cfg, ws, P, t, dt, threads);
+    walls_mirror_at(M, W, P, t, dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     store(&c);
     return 0;
