@@ -222,9 +222,13 @@ static mixsph_status create_laws(mixsph_sim *s)
                             s->cfg.media[k].name);
     }
     if (s->phys.law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
-        for (size_t i = 0; i < s->phys.P.n; i++)
-            s->phys.P.wall_rough[i] = s->phys.P.state[i] == MIXSPH_STATE_WALL &&
-                                 s->cfg.walls[particles_wall_index(&s->phys.P, i)].slip == WALL_NO_SLIP;
+        for (size_t i = 0; i < s->phys.P.n; i++) {
+            struct particles *P = &s->phys.P;
+            const int wall = P->state[i] == MIXSPH_STATE_WALL;
+            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
+            P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
+            P->wall_friction[i] = !wall ? 0.0 : isnan(w->friction_deg) ? -1.0 : tan(w->friction_deg * GEOM_PI / 180.0);
+        }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
     return MIXSPH_OK;
@@ -251,7 +255,8 @@ static void set_scheme_params(mixsph_sim *s)
                  .av_separating = c->av_separating,
                  .implicit_viscosity = c->viscosity_implicit,
                  .arithmetic_mean = c->viscosity_arithmetic,
-                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0},
+                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0,
+                 .p_background = c->p_background},
         .viscous = {.preconditioner = c->viscous_preconditioner,
                     .tolerance = c->viscous_tolerance,
                     .max_iterations = c->viscous_max_iterations},

@@ -85,6 +85,9 @@ const struct particle_field particle_fields[] = {
     {.name = "wall_rough", COMPONENTS1(wall_rough), .unit = "1",
      .description = "a wall particle that takes the stress of the solid it meets (no-slip wall)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+    {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
+     .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi))",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
     {.name = "syy", COMPONENTS1(syy), .unit = "Pa", .description = "deviatoric stress, yy (out of plane)",
      .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
 };

@@ -38,6 +38,9 @@ struct particles {
     double *syy;          /* its out-of-plane component (plane strain) [Pa] */
     double *wall_rough;   /* wall particles: 1 where the wall takes the stress of the solid it meets (a
                            * no-slip wall), 0 where it takes none (free-slip); 0 for the others [-] */
+    double *wall_friction; /* wall particles: tan(delta) of their wall's friction angle, or -1 where
+                            * the wall takes the friction angle of the grains it meets; 0 for the
+                            * others [-] (docs/model.md [DP-W]) */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index
                            * (read it through particles_wall_index) */
     uint8_t *state;       /* MIXSPH_STATE_* */

@@ -347,6 +347,7 @@ static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, 
         struct wall *wl = &c->walls[c->n_walls < CASE_MAX_WALLS ? c->n_walls : 0];
         TRY(entry(r, it, "walls", c->n_walls, CASE_MAX_WALLS, path, sizeof path, wl->name));
         c->n_walls++;
+        wl->friction_deg = NAN; /* not given: the grains' own phi */
         TRY(case_schema_read(r, it, path, section("walls"), 0, wl));
         wl->motion = -1;
         const cJSON *motion = item(it, "motion");

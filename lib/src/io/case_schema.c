@@ -176,6 +176,10 @@ static const struct case_key wall_keys[] = {
      .field = CASE_FIELD(wall, side), .meaning = "the side of the fluid, seen along the polyline's direction of travel"},
     {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .numeric_choice = 1,
      .field = CASE_FIELD(wall, slip), .meaning = "the condition on the tangential velocity"},
+    {.key = "friction", .type = CASE_NUMBER, RANGE(0, 0, 89, 0), .def_text = "φ of the grains", .unit = "deg",
+     .field = CASE_FIELD(wall, friction_deg),
+     .meaning = "wall friction angle δ on elastic-plastic grains at a no-slip wall: its shear on a grain is at most "
+                "tan δ times the effective normal force (0: smooth)"},
     {.key = "motion", .type = CASE_NAME, .def_text = "fixed", .meaning = "name of one of the motions"},
 };
 

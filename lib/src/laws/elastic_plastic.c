@@ -3,21 +3,23 @@
  * an elastic solid, on it they flow with the Coulomb stress, so a heap stands and a deposit stops
  * with no hold rule, no mu_thr and no mu0, at the acoustic time step. Per grain and step:
  *   s <- Jaumann step of s with G over dt (elasticity.h),
- *   p' = p - p_b (dry grains; the effective pressure),
+ *   p' = p - p_b - max(p_w, 0) (the effective pressure; p_w the pore pressure [PW] of a
+ *        saturated medium, pore_pressure.h, 0 when dry),
  *   (s, p') <- the return mapping onto the cone with the tension cut-off at its apex
- *              (drucker_prager.h); at the apex the pressure is set to p' + p_b,
+ *              (drucker_prager.h); at the apex the pressure is set to p' + p_b + max(p_w, 0),
  * the pressure coming from the equation of state of the grains' sound speed (K = rho0 c^2, the
  * mixture density rho0 of (5)), the shear modulus from Poisson's ratio, G = 3 K (1 - 2 nu) /
- * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by the medium's artificial viscosity.
- * Not yet: saturated media (the pore pressure of docs/model.md [PW] is the paper law's module's),
- * a wall friction angle (walls carry no deviatoric stress, laws/law.h). Experimental: the bundled
- * cases keep the paper's law. */
+ * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by Monaghan's artificial viscosity
+ * with alpha_M c = c_p (fixed, below).
+ * Walls: the rough walls' stress and their friction are the momentum pass's (docs/model.md
+ * [DP-W]). Experimental: the bundled cases keep the paper's law. */
 #include <math.h>
 
 #include "drucker_prager.h"
 #include "elasticity.h"
 #include "geometry.h"
 #include "law.h"
+#include "pore_pressure.h"
 #include "status.h"
 
 static const struct case_choice granular_ep_type[] = {{"granular", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
@@ -47,9 +49,9 @@ static const struct case_key elastic_plastic_keys[] = {
     {.key = "nu", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 0.49, 0), SCHEMA_DEF(0.3), .unit = "-",
      .field = CASE_FIELD(medium, poisson), .meaning = "Poisson's ratio: G = 3K(1−2ν)/(2(1+ν))"},
     {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
-     .meaning = "must be false: saturated media are the paper law's for now"},
-    {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0.2), .unit = "-",
-     .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M (damps the waves)"},
+     .meaning = "pores filled with the pore fluid (else dry): yield on the effective stress of the pore pressure [PW]"},
+    {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
+     .meaning = "name of a fluid medium defined before this one"},
 };
 
 static const struct case_section elastic_plastic_section = {
@@ -60,11 +62,9 @@ static const struct case_section elastic_plastic_section = {
 
 static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_finish_ctx *ctx)
 {
-    if (m->saturated)
-        return FAIL(ctx, "%s: %s.saturated: the elastic_plastic law takes dry grains only for now (the pore pressure "
-                         "is the paper law's); use law \"paper\"", ctx->origin, ctx->path);
     if (ctx->given(ctx->entry, "K")) m->c = sqrt(m->bulk_modulus / m->rho_grain);
-    m->rho0 = (1.0 - m->porosity) * m->rho_grain; /* (5), dry */
+    const mixsph_status st = pore_fluid_finish(m, ctx); /* the pore fluid, rho_f and the mixture density (5) */
+    if (st != MIXSPH_OK) return st;
     m->bulk_modulus = m->rho0 * m->c * m->c;      /* the equation of state's */
     const char *why = elasticity_shear_from_bulk(m->bulk_modulus, m->poisson, &m->shear_modulus);
     if (!why)
@@ -73,6 +73,10 @@ static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_f
     if (why) return FAIL(ctx, "%s: %s: %s", ctx->origin, ctx->path, why);
     m->sin_phi = sin(m->phi_deg * GEOM_PI / 180.0);
     m->mu = 0.0;
+    /* The grains' dissipation (docs/model.md [DP-AV]): Monaghan's term with alpha_M c = c_p, the
+     * acoustic impedance rho c_p of the P wave on the approach speed of a pair, as a linearised
+     * Riemann solver has it; a fixed numerical parameter, not a case key. */
+    m->alpha_m = elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0) / m->c;
     return MIXSPH_OK;
 }
 
@@ -87,14 +91,20 @@ static double elastic_plastic_viscosity_bound(const struct medium *m)
     return 0.0;
 }
 
+/* Its state: the tops of the saturated columns (the pore pressure). */
+static void *elastic_plastic_create(const struct law_setup *setup) { return pore_columns_create(setup); }
+
+static void elastic_plastic_destroy(void *state) { pore_columns_free(state); }
+
 /* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
 static long elastic_plastic_update(void *state, const struct law_step *step)
 {
-    (void)state;
+    struct pore_columns *pore = state;
     struct particles *P = step->P;
     const struct medium *media = step->media;
     const double dt = step->dt, pb = step->p_background;
     if (!(dt > 0.0)) return 0;
+    pore_columns_tops(pore, P, media); /* (of the saturated media, of any granular law) */
     long plastic = 0;
 #pragma omp parallel for schedule(static) reduction(+ : plastic) num_threads(step->n_threads)
     for (size_t i = 0; i < step->n; i++) {
@@ -108,9 +118,10 @@ static long elastic_plastic_update(void *state, const struct law_step *step)
         const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->shear_modulus,
                                                    .alpha_phi = m->alpha_phi, .k_c = m->k_c,
                                                    .alpha_psi = m->alpha_psi};
-        double p_eff = P->p[i] - pb;
+        const double pw = m->saturated ? fmax(pore_pressure(pore, m, P->x[i], P->z[i]), 0.0) : 0.0;
+        double p_eff = P->p[i] - pb - pw;
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
-        if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb; /* the tension cut-off */
+        if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb + pw; /* the tension cut-off */
         plastic += out != DRUCKER_PRAGER_ELASTIC;
         P->sxx[i] = s.xx;
         P->sxz[i] = s.xz;
@@ -128,5 +139,7 @@ const struct material_law law_elastic_plastic = {
     .finish = elastic_plastic_finish,
     .wave_speed = elastic_plastic_wave_speed,
     .viscosity_bound = elastic_plastic_viscosity_bound,
+    .create = elastic_plastic_create,
+    .destroy = elastic_plastic_destroy,
     .update = elastic_plastic_update,
 };

@@ -43,6 +43,7 @@
 #include "eos.h"
 #include "geometry.h"
 #include "mixsph.h"
+#include "pore_pressure.h"
 #include "rheology.h"
 #include "status.h"
 
@@ -102,29 +103,9 @@ static mixsph_status granular_finish(struct medium *md, const struct law_finish_
 {
     if (ctx->given(ctx->entry, "K")) md->c = sqrt(md->bulk_modulus / md->rho_grain);
     md->sin_phi = sin(md->phi_deg * GEOM_PI / 180.0);
-    md->pore_fluid = -1;
-    const char *fluid = ctx->text(ctx->entry, "pore_fluid");
-    if (fluid) {
-        for (size_t k = 0; k + 1 < ctx->n_media; k++)
-            if (strcmp(ctx->media[k].name, fluid) == 0) md->pore_fluid = (int)k;
-        if (md->pore_fluid < 0 || ctx->media[md->pore_fluid].law != LAW_NEWTONIAN)
-            return FAIL(ctx, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", ctx->origin,
-                        ctx->path, fluid);
-    }
-    if (md->saturated && md->pore_fluid < 0)
-        return FAIL(ctx, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", ctx->origin,
-                    ctx->path);
-    const double n = md->porosity;
-    if (md->saturated) {
-        const struct medium *f = &ctx->media[md->pore_fluid];
-        md->rho_f = f->rho0;
-        md->eps_f_mu_f = n * f->mu;
-        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
-    } else {
-        md->rho_f = 0.0;
-        md->eps_f_mu_f = 0.0;
-        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
-    }
+    const mixsph_status st = pore_fluid_finish(md, ctx); /* the pore fluid, rho_f and (5) */
+    if (st != MIXSPH_OK) return st;
+    md->eps_f_mu_f = md->saturated ? md->porosity * ctx->media[md->pore_fluid].mu : 0.0;
     if (ctx->given(ctx->entry, "mu1")) {
         if (ctx->given(ctx->entry, "mu_thr") || ctx->given(ctx->entry, "mu0"))
             return FAIL(ctx, "%s: %s.mu1: the mu1 rheology (Run 7) replaces mu_thr and mu0: give mu1 alone", ctx->origin,
@@ -146,9 +127,7 @@ struct mixture {
     const struct medium *media;
     double g, p_background, fixed_bed_speed;
     double x_min, dx, h;
-    /* pore pressure: per column dx wide, the top of the saturated granular column [m] */
-    double *ztop;
-    size_t nbins;
+    struct pore_columns *pore; /* the tops of the saturated granular columns */
     /* numerics.fixed_bed_speed >= 0 (SPHERA's fixed bed): per column 2h wide, the highest
      * granular particle no faster than that speed (bed_ref, -1 for none) and its z [m] */
     double *bed_z;
@@ -170,12 +149,11 @@ static void *mixture_create(const struct law_setup *setup)
     M->x_min = x_min;
     M->dx = dx;
     M->h = h;
-    M->nbins = (size_t)ceil((x_max - x_min) / dx) + 1;
-    M->ztop = calloc(M->nbins, sizeof(double));
+    M->pore = pore_columns_create(setup);
     M->nbed = (size_t)ceil((x_max - x_min) / (2.0 * h)) + 1;
     M->bed_z = calloc(M->nbed, sizeof(double));
     M->bed_ref = calloc(M->nbed, sizeof(long));
-    if (!M->ztop || !M->bed_z || !M->bed_ref) {
+    if (!M->pore || !M->bed_z || !M->bed_ref) {
         mixture_free(M);
         return NULL;
     }
@@ -186,7 +164,7 @@ static void mixture_free(void *state)
 {
     struct mixture *M = state;
     if (!M) return;
-    free(M->ztop);
+    pore_columns_free(M->pore);
     free(M->bed_z);
     free(M->bed_ref);
     free(M);
@@ -199,26 +177,6 @@ static size_t column_of(const struct mixture *M, double x, double width, size_t 
     if (b < 0) b = 0;
     if (b > (double)(n - 1)) b = (double)(n - 1);
     return (size_t)b;
-}
-
-/* Pore-pressure bin of x: columns dx wide. */
-static size_t bin_of(const struct mixture *M, double x)
-{
-    return column_of(M, x, M->dx, M->nbins);
-}
-
-/* Top of the saturated granular column in every bin. */
-static void saturated_tops(struct mixture *M, const struct particles *P)
-{
-    for (size_t b = 0; b < M->nbins; b++) M->ztop[b] = -INFINITY;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const struct medium *m = &M->media[P->medium[i]];
-        if (m->law != LAW_MIXTURE_PAPER || !m->saturated) continue;
-        const size_t b = bin_of(M, P->x[i]);
-        const double top = P->z[i] + 0.5 * M->dx;
-        if (top > M->ztop[b]) M->ztop[b] = top;
-    }
 }
 
 /* Fixed-bed column of x: columns 2h wide. */
@@ -254,20 +212,6 @@ static int frozen(const struct mixture *M, const struct particles *P, size_t i)
     return P->z[i] < M->bed_z[bed_column(M, P->x[i])] - 2.0 * M->h;
 }
 
-/* Pore pressure of a saturated grain at (x, z). */
-static double pore_pressure(const struct mixture *M, const struct medium *m, double x, double z)
-{
-    const size_t b = bin_of(M, x);
-    const double top = M->ztop[b];
-    if (!(top > z)) return 0.0;
-    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < M->nbins ? b + 2 : M->nbins - 1;
-    double slope = 0.0;
-    if (br > bl && isfinite(M->ztop[bl]) && isfinite(M->ztop[br]))
-        slope = (M->ztop[br] - M->ztop[bl]) / ((double)(br - bl) * M->dx);
-    const double cos2 = 1.0 / (1.0 + slope * slope);
-    return m->rho_f * M->g * (top - z) * cos2;
-}
-
 static long mixture_update(void *state, const struct law_step *step)
 {
     struct mixture *M = state;
@@ -276,7 +220,7 @@ static long mixture_update(void *state, const struct law_step *step)
     struct particles *P = step->P;
     const size_t n = step->n;
     const struct medium *media = M->media;
-    saturated_tops(M, P);
+    pore_columns_tops(M->pore, P, media);
     const int fixed_bed = M->fixed_bed_speed >= 0.0;
     if (fixed_bed) fixed_bed_tops(M, P, n);
     long fixed = 0;
@@ -293,7 +237,7 @@ static long mixture_update(void *state, const struct law_step *step)
             double grad[4];
             velocity_gradient_corrected(step->grad, i, grad);
             const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
-            const double pw = m->saturated ? pore_pressure(M, m, P->x[i], P->z[i]) : 0.0;
+            const double pw = m->saturated ? pore_pressure(M->pore, m, P->x[i], P->z[i]) : 0.0;
             const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
             const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
             double mu;

@@ -80,6 +80,12 @@ static void *aligned_block(size_t bytes) { return aligned_alloc(64, bytes); }
 static void aligned_block_free(void *p) { free(p); }
 #endif
 
+/* The sums over its wall neighbours j that a particle's wall friction needs (momentum pass with
+ * stress, no-slip walls): the walls' force on it, the wall normal n = -sum_j V_j F_ij x_ij (out of
+ * the walls), the weight q = -sum_j V_j F_ij of the walls with a given friction coefficient, that
+ * weight times their coefficient, and the weight of the walls that take the grain's own. */
+enum { WALL_FX, WALL_FZ, WALL_NX, WALL_NZ, WALL_Q_GIVEN, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS };
+
 struct forces {
     double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
     size_t *fk_off;           /* particle i's lanes start at fk + fk_off[i] */
@@ -89,6 +95,7 @@ struct forces {
     double *nbr_count;        /* density pass: same-medium neighbours within 2h */
     double *smooth_sum;       /* smoothing: sum_j B_ij W_ij V_j */
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
+    double *wall_sum[WALL_SUMS]; /* momentum pass with stress: each particle's wall sums (above) */
     size_t scratch_cap;
     /* implicit viscosity: the viscous coupling w_ij >= 0 of every lane (layout of fk), stored by
      * the momentum pass, so that m_i du_i/dt = -sum_j w_ij (u_i - u_j) */
@@ -107,6 +114,7 @@ struct pair_ctx {
     int wendland;
     int arithmetic_mean;  /* implicit viscosity with the pair viscosity (mu_i + mu_j) / 2 */
     int stress;           /* the particles' deviatoric stresses enter the momentum pass */
+    double *wall_sum[WALL_SUMS]; /* with stress: the wall sums (struct forces) */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -132,6 +140,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
     X->arithmetic_mean = fp->arithmetic_mean;
     X->stress = fp->stress;
+    for (int q = 0; q < WALL_SUMS; q++) X->wall_sum[q] = NULL;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -306,12 +315,14 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict avc = P->avc;
     const double *restrict sxx = P->sxx, *restrict sxz = P->sxz, *restrict szz = P->szz;
     const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
-    const double *restrict wall_rough = P->wall_rough;
-    const double roughi = stress ? wall_rough[i] : 0.0;
+    const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
+    const double roughi = stress ? wall_rough[i] : 0.0, mu_wi = stress ? wall_mu[i] : 0.0;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
+    double ws[WALL_SUMS][FORCES_CHUNK] = {{0}};            /* i's wall sums (stress), per lane */
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, n) {
         double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
+        double wj[WALL_SUMS][FORCES_CHUNK]; /* what j's wall sums receive from wall particle i */
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
@@ -361,6 +372,25 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 const double tzz = vv * (ci * szzi + cj * szz[j]);
                 fx += F * (txx * rx + txz * rz);
                 fz += F * (txz * rx + tzz * rz);
+                /* the wall sums of the wall friction: i's from a rough wall particle j, j's from
+                 * a rough wall particle i (its force on j is -f, its normal at j -V_i F x_ji) */
+                const double to_i = wall_rough[j] * (1.0 - walli), to_j = roughi * (1.0 - wallj);
+                const double mu_gj = wall_mu[j] >= 0.0 ? 1.0 : 0.0, mu_gi = mu_wi >= 0.0 ? 1.0 : 0.0;
+                const double qi = -vol[j] * F * to_i, qj = -voli * F * to_j;
+                ws[WALL_FX][k] += to_i * fx;
+                ws[WALL_FZ][k] += to_i * fz;
+                ws[WALL_NX][k] += qi * rx;
+                ws[WALL_NZ][k] += qi * rz;
+                ws[WALL_Q_GIVEN][k] += qi * mu_gj;
+                ws[WALL_QMU_GIVEN][k] += qi * mu_gj * wall_mu[j];
+                ws[WALL_Q_OWN][k] += qi * (1.0 - mu_gj);
+                wj[WALL_FX][k] = -to_j * fx;
+                wj[WALL_FZ][k] = -to_j * fz;
+                wj[WALL_NX][k] = -qj * rx;
+                wj[WALL_NZ][k] = -qj * rz;
+                wj[WALL_Q_GIVEN][k] = qj * mu_gi;
+                wj[WALL_QMU_GIVEN][k] = qj * mu_gi * mu_wi;
+                wj[WALL_Q_OWN][k] = qj * (1.0 - mu_gi);
             }
             sx[k] += fx;
             sz[k] += fz;
@@ -369,6 +399,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         }
         chunk_add(P->ax, jb, n, ajx);
         chunk_add(P->az, jb, n, ajz);
+        if (stress && roughi != 0.0 && Xl.wall_sum[0])
+            for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], jb, n, wj[q]);
         if (cached) fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
     }
@@ -379,6 +411,12 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     }
     *axi += tx;
     *azi += tz;
+    if (stress && Xl.wall_sum[0])
+        for (int q = 0; q < WALL_SUMS; q++) {
+            double t = 0.0;
+            for (size_t k = 0; k < FORCES_CHUNK; k++) t += ws[q][k];
+            Xl.wall_sum[q][i] += t;
+        }
 }
 
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
@@ -569,6 +607,7 @@ void forces_free(struct forces *F)
     free(F->nbr_count);
     free(F->smooth_sum);
     free(F->smooth_weight);
+    for (int q = 0; q < WALL_SUMS; q++) free(F->wall_sum[q]);
     aligned_block_free(F->visc_w);
     free(F);
 }
@@ -622,8 +661,9 @@ static int scratch_reserve(struct forces *F, size_t n)
 {
     if (F->scratch_cap >= n) return 0;
     const size_t cap = n + n / 4 + 64;
-    double **a[3] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight};
-    for (int k = 0; k < 3; k++) {
+    double **a[3 + WALL_SUMS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight};
+    for (int q = 0; q < WALL_SUMS; q++) a[3 + q] = &F->wall_sum[q];
+    for (int k = 0; k < 3 + WALL_SUMS; k++) {
         double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
         if (!q) return -1;
         memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
@@ -727,6 +767,38 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
             gradient_particle(&X, S->G, P, out, i);
 }
 
+/* The wall friction of an elastic-plastic grain i (docs/model.md [DP-W]): the tangential part F_t
+ * of the force F_w its no-slip walls exert on it (their pressure, artificial viscosity and the
+ * grain's own stress) is bounded by mu N', N' = F_w . n/|n| - 2 p_b V_i |n| its normal part
+ * without the background pressure's, mu the walls' tan(delta) weighted by q (the grain's tan(phi)
+ * where a wall takes it). Where N' < 0 (a cohesive grain's tension mirrored by the wall) the
+ * contact is unilateral: the walls' effective force on the grain is removed altogether, so the
+ * walls' normal forces on a body sum to its load and their friction to tan(delta) times it. Adds
+ * the change to the force (fx, fz). */
+static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, double vol_i, double tan_phi,
+                                double p_background, double *fx, double *fz)
+{
+    const double q = ws[WALL_Q_GIVEN][i] + ws[WALL_Q_OWN][i];
+    const double nx = ws[WALL_NX][i], nz = ws[WALL_NZ][i], nn = hypot(nx, nz);
+    if (!(q > 0.0) || !(nn > 0.0)) return;
+    const double mu = (ws[WALL_QMU_GIVEN][i] + ws[WALL_Q_OWN][i] * tan_phi) / q;
+    const double ex = nx / nn, ez = nz / nn;
+    const double fwx = ws[WALL_FX][i], fwz = ws[WALL_FZ][i];
+    const double fn = fwx * ex + fwz * ez;
+    const double tx = fwx - fn * ex, tz = fwz - fn * ez, ft = hypot(tx, tz);
+    const double n_eff = fn - 2.0 * p_background * vol_i * nn;
+    if (n_eff < 0.0) { /* a wall pushes a grain, never pulls it (no adhesion), and then has no shear on it */
+        *fx -= tx + n_eff * ex;
+        *fz -= tz + n_eff * ez;
+        return;
+    }
+    const double bound = mu * n_eff;
+    if (ft <= bound) return;
+    const double cut = (ft - bound) / ft;
+    *fx -= cut * tx;
+    *fz -= cut * tz;
+}
+
 int forces_momentum(struct forces *F, const struct pair_system *S)
 {
     struct particles *P = S->P;
@@ -754,6 +826,16 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         X.fk_off = F->fk_off;
     }
     F->fk_valid = 0;
+    const int friction = X.stress;
+    if (friction && scratch_reserve(F, n) != 0) return -1;
+    if (friction)
+        for (int q = 0; q < WALL_SUMS; q++) {
+            memset(F->wall_sum[q], 0, n * sizeof(double));
+            X.wall_sum[q] = F->wall_sum[q];
+        }
+    const double *const *ws = (const double *const *)F->wall_sum;
+    const struct medium *M = S->media;
+    const double pb = S->params.p_background;
     const double g = X.g;
     int bad = 0;
 #pragma omp parallel num_threads(S->n_threads)
@@ -761,6 +843,10 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         bands_in_team(S, momentum_band, &X, 0);
 #pragma omp for schedule(static) reduction(| : bad) nowait
         for (size_t i = 0; i < n; i++) {
+            if (friction && P->state[i] != MIXSPH_STATE_WALL && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
+                const double s = M[P->medium[i]].sin_phi;
+                wall_friction_bound(ws, i, P->vol[i], s / sqrt(1.0 - s * s), pb, &P->ax[i], &P->az[i]);
+            }
             P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
             P->az[i] = P->az[i] * P->inv_m[i] - g;
             bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);

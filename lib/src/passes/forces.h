@@ -31,7 +31,10 @@ struct forces_params {
                                couplings for forces_viscous_apply (docs/numerics.md) */
     int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */
     int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
-                               stress (P->sxx, sxz, szz; a law with LAW_HAS_STRESS) */
+                               stress (P->sxx, sxz, szz; a law with LAW_HAS_STRESS) and bounds the
+                               shear of no-slip walls on elastic-plastic grains (wall friction) */
+    double p_background;    /* the equation of state's background pressure [Pa] (not an effective
+                               normal stress: left out of the wall friction's bound) */
 };
 
 /* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */

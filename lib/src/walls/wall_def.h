@@ -18,6 +18,7 @@ struct wall {
     int side;                 /* +1: fluid on the left of the direction of travel, -1: right */
     int motion;               /* index into the case's motions, -1 for a fixed wall */
     int slip;                 /* enum wall_slip */
+    double friction_deg;      /* friction angle delta on grains with a stress [deg]; NaN: the grains' phi */
 };
 
 #endif

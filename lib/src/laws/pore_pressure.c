@@ -1,0 +1,93 @@
+/* pore_pressure.c - see pore_pressure.h. */
+#include "pore_pressure.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "status.h"
+
+struct pore_columns *pore_columns_create(const struct law_setup *setup)
+{
+    struct pore_columns *C = calloc(1, sizeof *C);
+    if (!C) return NULL;
+    C->x_min = setup->x_min;
+    C->dx = setup->dx;
+    C->g = setup->g;
+    C->nbins = (size_t)ceil((setup->x_max - setup->x_min) / setup->dx) + 1;
+    C->ztop = calloc(C->nbins, sizeof(double));
+    if (!C->ztop) {
+        free(C);
+        return NULL;
+    }
+    return C;
+}
+
+void pore_columns_free(struct pore_columns *C)
+{
+    if (!C) return;
+    free(C->ztop);
+    free(C);
+}
+
+/* The column of x (clamped to the ends). */
+static size_t bin_of(const struct pore_columns *C, double x)
+{
+    double b = floor((x - C->x_min) / C->dx);
+    if (b < 0) b = 0;
+    if (b > (double)(C->nbins - 1)) b = (double)(C->nbins - 1);
+    return (size_t)b;
+}
+
+void pore_columns_tops(struct pore_columns *C, const struct particles *P, const struct medium *media)
+{
+    for (size_t b = 0; b < C->nbins; b++) C->ztop[b] = -INFINITY;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        if (!media[P->medium[i]].saturated) continue;
+        const size_t b = bin_of(C, P->x[i]);
+        const double top = P->z[i] + 0.5 * C->dx;
+        if (top > C->ztop[b]) C->ztop[b] = top;
+    }
+}
+
+double pore_pressure(const struct pore_columns *C, const struct medium *m, double x, double z)
+{
+    const size_t b = bin_of(C, x);
+    const double top = C->ztop[b];
+    if (!(top > z)) return 0.0;
+    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < C->nbins ? b + 2 : C->nbins - 1;
+    double slope = 0.0;
+    if (br > bl && isfinite(C->ztop[bl]) && isfinite(C->ztop[br]))
+        slope = (C->ztop[br] - C->ztop[bl]) / ((double)(br - bl) * C->dx);
+    const double cos2 = 1.0 / (1.0 + slope * slope);
+    return m->rho_f * C->g * (top - z) * cos2;
+}
+
+#define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
+
+mixsph_status pore_fluid_finish(struct medium *md, const struct law_finish_ctx *ctx)
+{
+    md->pore_fluid = -1;
+    const char *fluid = ctx->text(ctx->entry, "pore_fluid");
+    if (fluid) {
+        for (size_t k = 0; k + 1 < ctx->n_media; k++)
+            if (strcmp(ctx->media[k].name, fluid) == 0) md->pore_fluid = (int)k;
+        if (md->pore_fluid < 0 || ctx->media[md->pore_fluid].law != LAW_NEWTONIAN)
+            return FAIL(ctx, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", ctx->origin,
+                        ctx->path, fluid);
+    }
+    if (md->saturated && md->pore_fluid < 0)
+        return FAIL(ctx, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", ctx->origin,
+                    ctx->path);
+    const double n = md->porosity;
+    if (md->saturated) {
+        const struct medium *f = &ctx->media[md->pore_fluid];
+        md->rho_f = f->rho0;
+        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
+    } else {
+        md->rho_f = 0.0;
+        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
+    }
+    return MIXSPH_OK;
+}
