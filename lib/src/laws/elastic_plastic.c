@@ -19,6 +19,7 @@
 #include "geometry.h"
 #include "law.h"
 #include "status.h"
+#include "team.h"
 
 static const struct case_choice granular_ep_type[] = {{"granular", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
 
@@ -87,17 +88,20 @@ static double elastic_plastic_viscosity_bound(const struct medium *m)
     return 0.0;
 }
 
-/* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
-static long elastic_plastic_update(void *state, const struct law_step *step)
+struct plastic_loop {
+    const struct law_step *step;
+    long plastic; /* + over the threads */
+};
+
+static void plastic_range(void *arg, size_t b, size_t e)
 {
-    (void)state;
+    struct plastic_loop *L = arg;
+    const struct law_step *step = L->step;
     struct particles *P = step->P;
     const struct medium *media = step->media;
     const double dt = step->dt, pb = step->p_background;
-    if (!(dt > 0.0)) return 0;
     long plastic = 0;
-#pragma omp parallel for schedule(static) reduction(+ : plastic) num_threads(step->n_threads)
-    for (size_t i = 0; i < step->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const struct medium *m = &media[P->medium[i]];
         if (m->law != LAW_ELASTIC_PLASTIC) continue;
@@ -117,7 +121,17 @@ static long elastic_plastic_update(void *state, const struct law_step *step)
         P->szz[i] = s.zz;
         P->syy[i] = s.yy;
     }
-    return plastic;
+    team_add_long(&L->plastic, plastic);
+}
+
+/* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
+static long elastic_plastic_update(void *state, const struct law_step *step)
+{
+    (void)state;
+    if (!(step->dt > 0.0)) return 0;
+    struct plastic_loop L = {.step = step};
+    team_for(step->n_threads, step->n, plastic_range, &L);
+    return L.plastic;
 }
 
 const struct material_law law_elastic_plastic = {
