@@ -48,9 +48,11 @@ struct worker_arg {
     unsigned work; /* the regions handed out before it started */
 };
 
-/* The team a thread belongs to while it runs a region (workers: theirs; the owner: its own,
- * during team_run) and its tid there; NULL outside regions. */
+/* The team a thread belongs to while it runs a region of more than one thread (workers: theirs;
+ * the owner: its own, during team_run); NULL outside them. */
 static _Thread_local struct team *current;
+/* Regions the thread is running (a region of one thread included): nested calls run alone. */
+static _Thread_local int depth;
 /* The team the calling thread owns. */
 static _Thread_local struct team *owned;
 
@@ -123,7 +125,9 @@ static void *worker_main(void *p)
         seen++; /* the owner hands out the next region only after every worker is done */
         if (wa.tid < T->n) {
             current = T;
+            depth = 1;
             T->fn(T->arg, wa.tid, T->n);
+            depth = 0;
             current = NULL;
         }
         if (__atomic_sub_fetch(&T->done, 1, SC) == 0) wake(T);
@@ -168,10 +172,15 @@ static struct team *own_team(int want)
 void team_run(int n, team_fn fn, void *arg)
 {
     if (n > TEAM_MAX_THREADS) n = TEAM_MAX_THREADS;
-    struct team *T = n > 1 && !current ? own_team(n - 1) : NULL;
+    struct team *T = n > 1 && depth == 0 ? own_team(n - 1) : NULL;
     if (T && T->n_workers + 1 < n) n = T->n_workers + 1;
     if (!T || n <= 1) {
+        struct team *outer = current;
+        current = NULL; /* a barrier inside waits for no one */
+        depth++;
         fn(arg, 0, 1);
+        depth--;
+        current = outer;
         return;
     }
     T->fn = fn;
@@ -182,7 +191,9 @@ void team_run(int n, team_fn fn, void *arg)
     __atomic_add_fetch(&T->work, 1, SC);
     wake(T);
     current = T;
+    depth = 1;
     fn(arg, 0, n);
+    depth = 0;
     wait_done(T);
     current = NULL;
 }
