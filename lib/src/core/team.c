@@ -35,6 +35,7 @@ struct team {
     team_fn fn;
     void *arg;
     int n;                  /* threads of the region, the owner included */
+    int stop;               /* the owner has exited: workers return */
     unsigned work;          /* regions handed out */
     int done;               /* workers that have not finished the region yet */
     /* the barrier */
@@ -123,6 +124,7 @@ static void *worker_main(void *p)
     for (;;) {
         wait_change(T, &T->work, seen);
         seen++; /* the owner hands out the next region only after every worker is done */
+        if (__atomic_load_n(&T->stop, SC)) return NULL;
         if (wa.tid < T->n) {
             current = T;
             depth = 1;
@@ -135,12 +137,35 @@ static void *worker_main(void *p)
     return NULL;
 }
 
+/* When a thread that owns a team exits, its workers return and the team is freed. */
+static pthread_key_t owner_key;
+static int owner_key_ok;
+static pthread_once_t owner_key_once = PTHREAD_ONCE_INIT;
+
+static void team_free(void *p)
+{
+    struct team *T = p;
+    __atomic_store_n(&T->stop, 1, SC);
+    __atomic_add_fetch(&T->work, 1, SC);
+    pthread_mutex_lock(&T->mu);
+    pthread_cond_broadcast(&T->cv);
+    pthread_mutex_unlock(&T->mu);
+    for (int k = 0; k < T->n_workers; k++) pthread_join(T->thread[k], NULL);
+    pthread_cond_destroy(&T->cv);
+    pthread_mutex_destroy(&T->mu);
+    free(T);
+}
+
+static void owner_key_create(void) { owner_key_ok = pthread_key_create(&owner_key, team_free) == 0; }
+
 /* The calling thread's team with at least `want` workers started (fewer if threads cannot be
  * started), or NULL. */
 static struct team *own_team(int want)
 {
     struct team *T = owned;
     if (!T) {
+        pthread_once(&owner_key_once, owner_key_create);
+        if (!owner_key_ok) return NULL;
         T = calloc(1, sizeof *T);
         if (!T) return NULL;
         if (pthread_mutex_init(&T->mu, NULL) != 0) {
@@ -148,6 +173,12 @@ static struct team *own_team(int want)
             return NULL;
         }
         if (pthread_cond_init(&T->cv, NULL) != 0) {
+            pthread_mutex_destroy(&T->mu);
+            free(T);
+            return NULL;
+        }
+        if (pthread_setspecific(owner_key, T) != 0) {
+            pthread_cond_destroy(&T->cv);
             pthread_mutex_destroy(&T->mu);
             free(T);
             return NULL;
