@@ -25,6 +25,12 @@
 
 #define SC __ATOMIC_SEQ_CST
 
+/* How long a waiting thread spins before it sleeps [microseconds]: chosen by measurement
+ * (docs/performance.md, "Two threads"); a define so that a benchmark build can set another. */
+#ifndef TEAM_SPIN_US
+#define TEAM_SPIN_US 100
+#endif
+
 struct team {
     pthread_mutex_t mu;
     pthread_cond_t cv;

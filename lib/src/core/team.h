@@ -5,8 +5,8 @@
  * GOMP_SPINCOUNT once, when libgomp loads (about 3 ms by default), so a host that cannot set the
  * environment (the FMU, a Dask worker) gets that policy, and under load a spinning waiter keeps a
  * core busy that the thread it waits for could run on (docs/performance.md, "Two threads").
- * Here a waiting thread spins for at most TEAM_SPIN_US microseconds and then sleeps on a
- * condition variable; the steps' barriers come every 50-200 microseconds on an idle machine, so
+ * Here a waiting thread spins for at most TEAM_SPIN_US (team.c: 100) microseconds and then
+ * sleeps on a condition variable; the steps' barriers come every 50-200 microseconds on an idle machine, so
  * a waiter rarely sleeps there, and under load it gives its core up within that time.
  *
  * Each calling thread has its own team (created at its first parallel call with more than one
@@ -21,9 +21,6 @@
 #define MIXSPH_TEAM_H
 
 #include <stddef.h>
-
-/* How long a waiting thread spins before it sleeps [microseconds]. */
-#define TEAM_SPIN_US 100
 
 /* The most threads of a team (mixsph_sim_set_threads accepts up to 1024; more run as this many). */
 #define TEAM_MAX_THREADS 256
