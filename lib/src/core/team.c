@@ -55,13 +55,22 @@ struct worker_arg {
     unsigned work; /* the regions handed out before it started */
 };
 
-/* The team a thread belongs to while it runs a region of more than one thread (workers: theirs;
- * the owner: its own, during team_run); NULL outside them. */
-static _Thread_local struct team *current;
-/* Regions the thread is running (a region of one thread included): nested calls run alone. */
-static _Thread_local int depth;
-/* The team the calling thread owns. */
-static _Thread_local struct team *owned;
+/* What a thread is doing with teams, kept under a key (not in C11 _Thread_local variables: in
+ * the FMU's shared object those would need the dynamic loader's __tls_get_addr, one more library
+ * its binary needs): the team it owns, the team whose region it runs (a worker's, or its own
+ * during team_run; NULL outside regions of more than one thread) and the regions it is in (a
+ * region of one thread included: nested calls run alone). An owner's state is allocated and
+ * freed, with its team, when the thread exits; a worker's is on its stack. */
+struct thread_state {
+    struct team *owned;
+    struct team *current;
+    int depth;
+    int on_heap;
+};
+
+static pthread_key_t state_key;
+static int state_key_ok;
+static pthread_once_t state_key_once = PTHREAD_ONCE_INIT;
 
 static double now_us(void)
 {
@@ -127,16 +136,18 @@ static void *worker_main(void *p)
     free(p);
     struct team *T = wa.T;
     unsigned seen = wa.work;
+    struct thread_state st = {0};
+    pthread_setspecific(state_key, &st); /* the key exists: the owner made it before its team */
     for (;;) {
         wait_change(T, &T->work, seen);
         seen++; /* the owner hands out the next region only after every worker is done */
         if (__atomic_load_n(&T->stop, SC)) return NULL;
         if (wa.tid < T->n) {
-            current = T;
-            depth = 1;
+            st.current = T;
+            st.depth = 1;
             T->fn(T->arg, wa.tid, T->n);
-            depth = 0;
-            current = NULL;
+            st.depth = 0;
+            st.current = NULL;
         }
         if (__atomic_sub_fetch(&T->done, 1, SC) == 0) wake(T);
     }
@@ -144,13 +155,8 @@ static void *worker_main(void *p)
 }
 
 /* When a thread that owns a team exits, its workers return and the team is freed. */
-static pthread_key_t owner_key;
-static int owner_key_ok;
-static pthread_once_t owner_key_once = PTHREAD_ONCE_INIT;
-
-static void team_free(void *p)
+static void team_free(struct team *T)
 {
-    struct team *T = p;
     __atomic_store_n(&T->stop, 1, SC);
     __atomic_add_fetch(&T->work, 1, SC);
     pthread_mutex_lock(&T->mu);
@@ -162,16 +168,40 @@ static void team_free(void *p)
     free(T);
 }
 
-static void owner_key_create(void) { owner_key_ok = pthread_key_create(&owner_key, team_free) == 0; }
+static void state_free(void *p)
+{
+    struct thread_state *st = p;
+    if (!st->on_heap) return;
+    if (st->owned) team_free(st->owned);
+    free(st);
+}
+
+static void state_key_create(void) { state_key_ok = pthread_key_create(&state_key, state_free) == 0; }
+
+/* The calling thread's state, made at its first call; NULL when it cannot be. */
+static struct thread_state *thread_state(void)
+{
+    pthread_once(&state_key_once, state_key_create);
+    if (!state_key_ok) return NULL;
+    struct thread_state *st = pthread_getspecific(state_key);
+    if (!st) {
+        st = calloc(1, sizeof *st);
+        if (!st) return NULL;
+        st->on_heap = 1;
+        if (pthread_setspecific(state_key, st) != 0) {
+            free(st);
+            return NULL;
+        }
+    }
+    return st;
+}
 
 /* The calling thread's team with at least `want` workers started (fewer if threads cannot be
  * started), or NULL. */
-static struct team *own_team(int want)
+static struct team *own_team(struct thread_state *st, int want)
 {
-    struct team *T = owned;
+    struct team *T = st->owned;
     if (!T) {
-        pthread_once(&owner_key_once, owner_key_create);
-        if (!owner_key_ok) return NULL;
         T = calloc(1, sizeof *T);
         if (!T) return NULL;
         if (pthread_mutex_init(&T->mu, NULL) != 0) {
@@ -183,13 +213,7 @@ static struct team *own_team(int want)
             free(T);
             return NULL;
         }
-        if (pthread_setspecific(owner_key, T) != 0) {
-            pthread_cond_destroy(&T->cv);
-            pthread_mutex_destroy(&T->mu);
-            free(T);
-            return NULL;
-        }
-        owned = T;
+        st->owned = T;
     }
     while (T->n_workers < want) {
         struct worker_arg *wa = malloc(sizeof *wa);
@@ -209,15 +233,20 @@ static struct team *own_team(int want)
 void team_run(int n, team_fn fn, void *arg)
 {
     if (n > TEAM_MAX_THREADS) n = TEAM_MAX_THREADS;
-    struct team *T = n > 1 && depth == 0 ? own_team(n - 1) : NULL;
+    struct thread_state *st = thread_state();
+    if (!st) { /* no state, no team */
+        fn(arg, 0, 1);
+        return;
+    }
+    struct team *T = n > 1 && st->depth == 0 ? own_team(st, n - 1) : NULL;
     if (T && T->n_workers + 1 < n) n = T->n_workers + 1;
     if (!T || n <= 1) {
-        struct team *outer = current;
-        current = NULL; /* a barrier inside waits for no one */
-        depth++;
+        struct team *outer = st->current;
+        st->current = NULL; /* a barrier inside waits for no one */
+        st->depth++;
         fn(arg, 0, 1);
-        depth--;
-        current = outer;
+        st->depth--;
+        st->current = outer;
         return;
     }
     T->fn = fn;
@@ -227,17 +256,18 @@ void team_run(int n, team_fn fn, void *arg)
     __atomic_store_n(&T->done, T->n_workers, SC); /* workers beyond n see it too and skip it */
     __atomic_add_fetch(&T->work, 1, SC);
     wake(T);
-    current = T;
-    depth = 1;
+    st->current = T;
+    st->depth = 1;
     fn(arg, 0, n);
-    depth = 0;
+    st->depth = 0;
     wait_done(T);
-    current = NULL;
+    st->current = NULL;
 }
 
 void team_barrier(void)
 {
-    struct team *T = current;
+    const struct thread_state *st = state_key_ok ? pthread_getspecific(state_key) : NULL;
+    struct team *T = st ? st->current : NULL;
     if (!T || T->n <= 1) return;
     const unsigned c = load_u(&T->cycle);
     if (__atomic_add_fetch(&T->arrived, 1, SC) == T->n) {
