@@ -181,6 +181,18 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
         fprintf(f, ",\n  \"viscous_solve_fraction\": ");
         json_number(f, wall > 0 ? visc_wall / wall : NAN);
     }
+    /* the numerics the run used (the case file's, its overrides' or the defaults) */
+    static const char *const numerics[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "viscosity", "pressure_smoothing"};
+    fprintf(f, ",\n  \"numerics\": {");
+    for (size_t k = 0; k < sizeof numerics / sizeof numerics[0]; k++) {
+        char key[64];
+        double v = NAN;
+        snprintf(key, sizeof key, "numerics.%s", numerics[k]);
+        mixsph_sim_case_number(s, key, &v);
+        fprintf(f, "%s\"%s\": ", k ? ", " : "", numerics[k]);
+        json_number(f, v);
+    }
+    fprintf(f, "}");
     fprintf(f, ",\n  \"outputs\": {\n");
     const size_t n = mixsph_sim_output_count(s);
     for (size_t k = 0; k < n; k++) {

@@ -18,7 +18,7 @@ static inline int sim_density_pass(mixsph_sim *s)
 static inline int sim_momentum_pass(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
-    return forces_momentum(s->forces, &S);
+    return forces_momentum(s->work.forces, &S);
 }
 
 /* Regimes of the grains (the material laws' updates at the current state). */
@@ -28,7 +28,7 @@ static inline void sim_mixture_update(mixsph_sim *s) { integrate_update_laws(s, 
 static inline void sim_smooth_pressure(mixsph_sim *s)
 {
     const struct pair_system S = sim_pair_system(s);
-    forces_smooth_pressure(s->forces, &S, s->cfg.pressure_smoothing * s->dt / s->h);
+    forces_smooth_pressure(s->work.forces, &S, s->scheme.pressure_smoothing * s->phys.dt / s->phys.h);
 }
 
 /* The acceleration (without gravity) and density rate particle j gives i. */

@@ -142,6 +142,36 @@ static void test_good_case(void **state)
     free(j);
 }
 
+/* case_number: the value a case gives a numeric key of its top level, numerics or output (the
+ * file's, an override's or the default), and a clear refusal of any other key. */
+static void test_case_number(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    const mixsph_override ov[] = {{"numerics.cfl", 0.05}, {"numerics.viscosity", 1}};
+    assert_int_equal(case_parse(BASE, ORIGIN, ov, 2, &c, err, sizeof err), MIXSPH_OK);
+    double v = NAN;
+    assert_int_equal(case_number(&c, "numerics.dx", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == 0.02); /* the file's */
+    assert_int_equal(case_number(&c, "numerics.cfl", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == 0.05); /* the override's */
+    assert_int_equal(case_number(&c, "numerics.cfl_visc", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == c.cfl_visc && v > 0.0); /* the default */
+    assert_int_equal(case_number(&c, "numerics.viscosity", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == 1.0); /* a choice: its value ("implicit") */
+    assert_int_equal(case_number(&c, "gravity", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == 9.81);
+    assert_int_equal(case_number(&c, "output.monitor_interval", &v, err, sizeof err), MIXSPH_OK);
+    assert_true(v == c.monitor_interval);
+    const char *refused[] = {"numerics.nope", "media.water.rho", "name", "numerics", "numericsx.cfl"};
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        assert_int_equal(case_number(&c, refused[k], &v, err, sizeof err), MIXSPH_ERR_ARG);
+        assert_non_null(strstr(err, refused[k]));
+    }
+    case_free(&c);
+}
+
 static void test_invalid_json(void **state)
 {
     (void)state;
@@ -723,6 +753,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_good_case),
+        cmocka_unit_test(test_case_number),
         cmocka_unit_test(test_invalid_json),
         cmocka_unit_test(test_missing_key),
         cmocka_unit_test(test_wrong_type),

@@ -80,8 +80,8 @@ static void test_oedometric_state(void **state)
     (void)state;
     mixsph_sim *s = create(NULL, 0);
     assert_int_equal(mixsph_sim_advance_to(s, 0.5), MIXSPH_OK);
-    const struct particles *P = &s->P;
-    const double margin = 3.0 * s->h;
+    const struct particles *P = &s->phys.P;
+    const double margin = 3.0 * s->phys.h;
     double ztop = -INFINITY;
     for (size_t i = 0; i < P->n; i++)
         if (P->state[i] == MIXSPH_STATE_MOBILE) ztop = fmax(ztop, P->z[i]);

@@ -72,7 +72,7 @@ static void test_heap_below_phi(void **state)
     char err[512] = "";
     assert_int_equal(mixsph_sim_create_from_text(heap_json(""), "heap", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
     assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const size_t n = P->n;
     double *x0 = calloc(n, sizeof *x0), *z0 = calloc(n, sizeof *z0);
     assert_true(x0 && z0);

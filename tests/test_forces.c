@@ -61,16 +61,16 @@ static int setup(void **state)
         return -1;
     }
     rng_state = 2024;
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
         const struct medium *m = &s->cfg.media[P->medium[i]];
-        P->x[i] += uniform(-0.3, 0.3) * s->dx;
-        P->z[i] += uniform(-0.3, 0.3) * s->dx;
+        P->x[i] += uniform(-0.3, 0.3) * s->phys.dx;
+        P->z[i] += uniform(-0.3, 0.3) * s->phys.dx;
         P->vx[i] = P->uvx[i] = uniform(-1.0, 1.0);
         P->vz[i] = P->uvz[i] = uniform(-1.0, 1.0);
         P->rho[i] = m->rho0 * (1.0 + uniform(-0.01, 0.01));
-        P->m[i] = m->rho0 * s->dx * s->dx * (1.0 + uniform(-0.2, 0.2));
+        P->m[i] = m->rho0 * s->phys.dx * s->phys.dx * (1.0 + uniform(-0.2, 0.2));
         P->inv_m[i] = 1.0 / P->m[i];
         P->mu[i] = uniform(0.0, 0.1);
     }
@@ -99,7 +99,7 @@ static double dist2(const struct particles *P, size_t i, size_t j)
 static void test_setup_is_wall_free(void **state)
 {
     const mixsph_sim *s = *state;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     size_t n_mob = 0, n_wall = 0, n_oil = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) {
@@ -110,7 +110,7 @@ static void test_setup_is_wall_free(void **state)
         n_mob++;
         n_oil += P->medium[i] == 1;
         for (size_t j = 0; j < P->n; j++)
-            if (P->state[j] == MIXSPH_STATE_WALL) assert_true(dist2(P, i, j) > 4.0 * s->K.r2max);
+            if (P->state[j] == MIXSPH_STATE_WALL) assert_true(dist2(P, i, j) > 4.0 * s->phys.K.r2max);
     }
     assert_int_equal(n_mob, 400); /* (0.2 / 0.01) x (0.2 / 0.01) lattice sites */
     assert_int_equal(n_oil, 200);
@@ -122,7 +122,7 @@ static void test_setup_is_wall_free(void **state)
 static void test_pair_symmetry(void **state)
 {
     mixsph_sim *s = *state;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     size_t pairs = 0, cross = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
@@ -134,7 +134,7 @@ static void test_pair_symmetry(void **state)
             double axij, azij, drij, axji, azji, drji;
             sim_pair_terms(s, i, j, &axij, &azij, &drij);
             sim_pair_terms(s, j, i, &axji, &azji, &drji);
-            if (dist2(P, i, j) >= s->K.r2max) {
+            if (dist2(P, i, j) >= s->phys.K.r2max) {
                 /* outside the support: nothing (reference: compact support of W) */
                 assert_true(axij == 0.0 && azij == 0.0 && drij == 0.0);
                 continue;
@@ -165,13 +165,13 @@ struct pair_geom {
 
 static int pair_geom(const mixsph_sim *s, size_t i, size_t j, struct pair_geom *g)
 {
-    const struct particles *P = &s->P;
-    if (j == i || P->state[i] != MIXSPH_STATE_MOBILE || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= s->K.r2max)
+    const struct particles *P = &s->phys.P;
+    if (j == i || P->state[i] != MIXSPH_STATE_MOBILE || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= s->phys.K.r2max)
         return 0;
     g->rx = P->x[i] - P->x[j];
     g->rz = P->z[i] - P->z[j];
     g->r2 = g->rx * g->rx + g->rz * g->rz;
-    g->F = kernel_f(&s->K, sqrt(g->r2));
+    g->F = kernel_f(&s->phys.K, sqrt(g->r2));
     g->ux = P->vx[i] - P->vx[j];
     g->uz = P->vz[i] - P->vz[j];
     g->vr = g->ux * g->rx + g->uz * g->rz;
@@ -185,7 +185,7 @@ enum { TERM_PRESSURE = 1, TERM_MONAGHAN = 2, TERM_MORRIS = 4, TERM_MORRIS_MIXED 
  * per-particle fields and the pressures from the densities), p and mu of the particles. */
 static void select_terms(mixsph_sim *s, int terms, const double *alpha, const double *mu)
 {
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     for (size_t k = 0; k < s->cfg.n_media; k++) s->cfg.media[k].alpha_m = terms & TERM_MONAGHAN ? alpha[k] : 0.0;
     integrate_pressure_and_derived(s);
     for (size_t i = 0; i < P->n; i++) {
@@ -201,9 +201,9 @@ static void select_terms(mixsph_sim *s, int terms, const double *alpha, const do
  * media's alpha_M (into alpha). */
 static double *save_terms(const mixsph_sim *s, double *alpha)
 {
-    double *mu = malloc(s->P.n * sizeof *mu);
+    double *mu = malloc(s->phys.P.n * sizeof *mu);
     assert_non_null(mu);
-    memcpy(mu, s->P.mu, s->P.n * sizeof *mu);
+    memcpy(mu, s->phys.P.mu, s->phys.P.n * sizeof *mu);
     for (size_t k = 0; k < s->cfg.n_media; k++) alpha[k] = s->cfg.media[k].alpha_m;
     return mu;
 }
@@ -212,9 +212,9 @@ static double *save_terms(const mixsph_sim *s, double *alpha)
 static void test_pair_terms(void **state)
 {
     mixsph_sim *s = *state;
-    struct particles *P = &s->P;
-    const struct kernel *K = &s->K;
-    const double eta2 = 0.01 * s->h * s->h;
+    struct particles *P = &s->phys.P;
+    const struct kernel *K = &s->phys.K;
+    const double eta2 = 0.01 * s->phys.h * s->phys.h;
     const double F0 = kernel_f(K, 0.0); /* the kernel's largest |F| */
     const size_t n = P->n;
     double alpha[CASE_MAX_MEDIA];
@@ -260,7 +260,7 @@ static void test_pair_terms(void **state)
                     const struct medium *md = &s->cfg.media[P->medium[i]];
                     double fa = 0.0;
                     if (vr < 0.0 && P->medium[i] == P->medium[j]) {
-                        const double pi_ij = -md->alpha_m * md->c * s->h * vr / (r2 + eta2) / (0.5 * (rhoi + rhoj));
+                        const double pi_ij = -md->alpha_m * md->c * s->phys.h * vr / (r2 + eta2) / (0.5 * (rhoi + rhoj));
                         fa = -mj * pi_ij * F;
                         approaching++;
                         /* dissipative: the force opposes the approach */
@@ -311,7 +311,7 @@ static void test_pair_terms(void **state)
 static void test_momentum_conservation(void **state)
 {
     mixsph_sim *s = *state;
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     assert_int_equal(sim_density_pass(s), 0);
     assert_int_equal(sim_momentum_pass(s), 0);
     double sx = 0.0, sz = 0.0, sabs = 0.0;
@@ -328,7 +328,7 @@ static void test_momentum_conservation(void **state)
             bd += dr;
             bdabs += fabs(dr);
             nn += j != i && P->state[j] != MIXSPH_STATE_WALL && P->medium[j] == P->medium[i] &&
-                  dist2(P, i, j) < s->K.r2max;
+                  dist2(P, i, j) < s->phys.K.r2max;
         }
         /* reference: brute force over all j; tolerance 1e-12 of the sum of |pair terms| (the
          * sums differ only in order) */
@@ -353,7 +353,7 @@ static void test_momentum_conservation(void **state)
     assert_non_null(az0);
     memcpy(ax0, P->ax, P->n * sizeof *ax0);
     memcpy(az0, P->az, P->n * sizeof *az0);
-    assert_int_equal(forces_cache_pending(s->forces), 0); /* used once */
+    assert_int_equal(forces_cache_pending(s->work.forces), 0); /* used once */
     assert_int_equal(sim_momentum_pass(s), 0);
     assert_memory_equal(ax0, P->ax, P->n * sizeof *ax0);
     assert_memory_equal(az0, P->az, P->n * sizeof *az0);
@@ -368,9 +368,9 @@ static void test_momentum_conservation(void **state)
 static void test_monaghan_switches(void **state)
 {
     mixsph_sim *s = *state;
-    struct particles *P = &s->P;
-    const struct kernel *K = &s->K;
-    const double eta2 = 0.01 * s->h * s->h;
+    struct particles *P = &s->phys.P;
+    const struct kernel *K = &s->phys.K;
+    const double eta2 = 0.01 * s->phys.h * s->phys.h;
     const double F0 = kernel_f(K, 0.0);
     const size_t n = P->n;
     double alpha[CASE_MAX_MEDIA];
@@ -379,8 +379,8 @@ static void test_monaghan_switches(void **state)
     size_t on[4] = {0}, off[4] = {0};
     for (int mode = 0; mode < 4; mode++) {
         const int mixed = mode & 1, separating = (mode >> 1) & 1;
-        s->cfg.av_mixed = mixed;
-        s->cfg.av_separating = separating;
+        s->scheme.pair.av_mixed = mixed;
+        s->scheme.pair.av_separating = separating;
         for (size_t i = 0; i < n; i++) {
             for (size_t j = 0; j < n; j++) {
                 struct pair_geom g;
@@ -388,7 +388,7 @@ static void test_monaghan_switches(void **state)
                 const double rx = g.rx, rz = g.rz, r2 = g.r2, F = g.F, vr = g.vr;
                 const double rhoi = P->rho[i], rhoj = P->rho[j], mj = P->m[j];
                 const struct medium *mdi = &s->cfg.media[P->medium[i]], *mdj = &s->cfg.media[P->medium[j]];
-                const double avc = fmax(mdi->alpha_m * mdi->c, mdj->alpha_m * mdj->c) * s->h;
+                const double avc = fmax(mdi->alpha_m * mdi->c, mdj->alpha_m * mdj->c) * s->phys.h;
                 const int acts = (vr < 0.0 || separating) && (P->medium[i] == P->medium[j] || mixed);
                 double ax, az, dr;
                 sim_pair_terms(s, i, j, &ax, &az, &dr);
@@ -405,8 +405,8 @@ static void test_monaghan_switches(void **state)
             }
         }
     }
-    s->cfg.av_mixed = 0;
-    s->cfg.av_separating = 0;
+    s->scheme.pair.av_mixed = 0;
+    s->scheme.pair.av_separating = 0;
     select_terms(s, TERM_PRESSURE | TERM_MONAGHAN | TERM_MORRIS_MIXED, alpha, mu);
     free(mu);
     /* every mode met pairs where the term acts, and all but the all-pairs mode pairs where it
@@ -435,7 +435,7 @@ static void test_monaghan_at_walls(void **state)
     mixsph_sim *s = NULL;
     char err[512];
     assert_int_equal(mixsph_sim_create_from_text(SLIDE_CASE, "wall_slide.json", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
         P->vx[i] = P->uvx[i] = 1.0; /* sliding along the wall, +x */
@@ -444,13 +444,13 @@ static void test_monaghan_at_walls(void **state)
     }
     integrate_pressure_and_derived(s);
     for (int av_wall = 1; av_wall >= 0; av_wall--) {
-        s->cfg.av_wall = av_wall;
+        s->scheme.pair.av_wall = av_wall;
         double drag = 0.0, mass = 0.0;
         size_t pairs = 0;
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] != MIXSPH_STATE_MOBILE || P->x[i] < 0.05 || P->x[i] > 0.25) continue; /* away from the ends */
             for (size_t j = 0; j < P->n; j++) {
-                if (P->state[j] != MIXSPH_STATE_WALL || dist2(P, i, j) >= s->K.r2max) continue;
+                if (P->state[j] != MIXSPH_STATE_WALL || dist2(P, i, j) >= s->phys.K.r2max) continue;
                 double ax, az, dr;
                 sim_pair_terms(s, i, j, &ax, &az, &dr);
                 if (!av_wall) {

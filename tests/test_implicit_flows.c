@@ -135,7 +135,7 @@ static mixsph_sim *create(const struct flow *f)
 /* The largest bin error / scale at the current time. */
 static double profile_error(const struct flow *f, const mixsph_sim *s)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const double t = mixsph_sim_time(s), frame_vx = -f->frame_accel * t;
     double diff[NBIN] = {0};
     long cnt[NBIN] = {0};
@@ -170,8 +170,8 @@ static double flow_error_between(const struct flow *f, double ratio_min, double 
             const mixsph_status st = mixsph_sim_step(s);
             if (st != MIXSPH_OK) print_error("%s\n", mixsph_sim_last_error(s));
             assert_int_equal(st, MIXSPH_OK);
-            iterations += (uint64_t)s->viscous_last.iterations;
-            if (s->viscous_last.iterations > most) most = s->viscous_last.iterations;
+            iterations += (uint64_t)s->work.viscous_last.iterations;
+            if (s->work.viscous_last.iterations > most) most = s->work.viscous_last.iterations;
         }
         const double e = profile_error(f, s);
         const double in_tau1 = mixsph_sim_time(s) / tau1(f->mu_soft, H);
@@ -181,11 +181,11 @@ static double flow_error_between(const struct flow *f, double ratio_min, double 
         if (counted) worst = fmax(worst, e);
     }
     const double mu_max = fmax(f->mu_soft, f->z_interface < H ? f->mu_stiff : 0.0);
-    const double dt_visc = s->cfg.cfl_visc * 2.0 * s->h * s->h * RHO / mu_max;
-    const double ratio = s->dt / dt_visc;
+    const double dt_visc = s->cfg.cfl_visc * 2.0 * s->phys.h * s->phys.h * RHO / mu_max;
+    const double ratio = s->phys.dt / dt_visc;
     print_message("%s: dt = %.3g s = %.1f x the explicit viscous limit = %.3f tau1, %.1f solver iterations per step "
                   "(at most %d); largest error %.2f%%\n",
-                  f->name, s->dt, ratio, s->dt / tau1(f->mu_soft, H),
+                  f->name, s->phys.dt, ratio, s->phys.dt / tau1(f->mu_soft, H),
                   (double)iterations / (double)mixsph_sim_steps(s), most, 100.0 * worst);
     assert_true(ratio >= ratio_min); /* the time step the test is about */
     mixsph_sim_destroy(s);

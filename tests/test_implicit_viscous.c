@@ -74,14 +74,14 @@ static double channel_error(double mu, double t_end, double *dt_ratio)
         const mixsph_status st = mixsph_sim_step(s);
         if (st != MIXSPH_OK) print_error("%s\n", mixsph_sim_last_error(s));
         assert_int_equal(st, MIXSPH_OK);
-        iterations += (uint64_t)s->viscous_last.iterations;
-        if (s->viscous_last.iterations > most) most = s->viscous_last.iterations;
+        iterations += (uint64_t)s->work.viscous_last.iterations;
+        if (s->work.viscous_last.iterations > most) most = s->work.viscous_last.iterations;
     }
-    const double dt_visc = s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / mu;
-    *dt_ratio = s->dt / dt_visc;
+    const double dt_visc = s->cfg.cfl_visc * 2.0 * s->phys.h * s->phys.h * 1000.0 / mu;
+    *dt_ratio = s->phys.dt / dt_visc;
     double su[NBIN] = {0}, sa[NBIN] = {0};
     long cnt[NBIN] = {0};
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
@@ -100,7 +100,7 @@ static double channel_error(double mu, double t_end, double *dt_ratio)
     }
     print_message("mu = %g Pa s: %llu steps to t = %.3f s, dt = %.3g s = %.1f x the explicit viscous limit, "
                   "%.1f solver iterations per step (at most %d); largest |u - u_exact| = %.2f%% of U\n",
-                  mu, (unsigned long long)mixsph_sim_steps(s), mixsph_sim_time(s), s->dt, *dt_ratio,
+                  mu, (unsigned long long)mixsph_sim_steps(s), mixsph_sim_time(s), s->phys.dt, *dt_ratio,
                   (double)iterations / (double)mixsph_sim_steps(s), most, 100.0 * worst);
     mixsph_sim_destroy(s);
     return worst;
@@ -140,8 +140,8 @@ static const char *const BOX =
 static mixsph_sim *box_with_shear(void)
 {
     mixsph_sim *s = create(BOX, 50.0);
-    struct particles *P = &s->P;
-    const size_t n = s->C.start[s->C.ncell];
+    struct particles *P = &s->phys.P;
+    const size_t n = s->work.C.start[s->work.C.ncell];
     for (size_t i = 0; i < n; i++) /* a shear field that the walls resist */
         if (P->state[i] == MIXSPH_STATE_MOBILE) {
             P->vx[i] = P->uvx[i] = 0.1 * sin(40.0 * P->z[i]);
@@ -157,17 +157,17 @@ static mixsph_sim *box_with_shear(void)
  * walls' mirror; returns the report. */
 static struct viscous_report box_solve(mixsph_sim *s, double factor, int preconditioner)
 {
-    const size_t n = s->C.start[s->C.ncell];
+    const size_t n = s->work.C.start[s->work.C.ncell];
     const struct pair_system S = sim_pair_system(s);
     struct viscous_solver *V = viscous_create();
     assert_non_null(V);
     struct viscous_report rep;
-    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0;
+    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->phys.h * s->phys.h * 1000.0 / 50.0;
     struct wall_mirror *M = walls_mirror_create();
     assert_non_null(M);
-    assert_int_equal(walls_mirror_build(M, &s->cfg, &s->K, &s->G, &s->P, n, 1), 0);
-    walls_mirror_at(M, &s->cfg, s->walls, &s->P, s->t, dt, 1);
-    assert_int_equal(viscous_solve(V, s->forces, &S, M, dt, preconditioner, 1e-10, 1000, &rep), 0);
+    assert_int_equal(walls_mirror_build(M, &s->phys.walls, &s->phys.K, &s->work.G, &s->phys.P, n, 1), 0);
+    walls_mirror_at(M, &s->phys.walls, &s->phys.P, s->phys.t, dt, 1);
+    assert_int_equal(viscous_solve(V, s->work.forces, &S, M, dt, preconditioner, 1e-10, 1000, &rep), 0);
     viscous_free(V);
     walls_mirror_free(M);
     return rep;
@@ -176,8 +176,8 @@ static struct viscous_report box_solve(mixsph_sim *s, double factor, int precond
 static void momentum_only_changed_by_walls(int preconditioner)
 {
     mixsph_sim *s = box_with_shear();
-    struct particles *P = &s->P;
-    const size_t n = s->C.start[s->C.ncell];
+    struct particles *P = &s->phys.P;
+    const size_t n = s->work.C.start[s->work.C.ncell];
     double *ux0 = calloc(n, sizeof(double)), *uz0 = calloc(n, sizeof(double));
     assert_non_null(ux0);
     assert_non_null(uz0);
@@ -187,7 +187,7 @@ static void momentum_only_changed_by_walls(int preconditioner)
     }
     const double factor = 10.0; /* times the explicit viscous limit */
     const struct viscous_report rep = box_solve(s, factor, preconditioner);
-    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->h * s->h * 1000.0 / 50.0;
+    const double dt = factor * s->cfg.cfl_visc * 2.0 * s->phys.h * s->phys.h * 1000.0 / 50.0;
     const struct pair_system S = sim_pair_system(s);
     assert_true(rep.converged);
     /* momentum change of the mobile particles, and the force of the walls from the new field */
@@ -204,7 +204,7 @@ static void momentum_only_changed_by_walls(int preconditioner)
         dpz += P->m[i] * (P->vz[i] - uz0[i]);
         scale += P->m[i] * hypot(ux0[i], uz0[i]);
     }
-    assert_int_equal(forces_viscous_apply(s->forces, &S, ux, uz, lx, lz, NULL), 0);
+    assert_int_equal(forces_viscous_apply(s->work.forces, &S, ux, uz, lx, lz, NULL), 0);
     double fx = 0.0, fz = 0.0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_MOBILE) {
@@ -250,12 +250,12 @@ static void test_two_level_same_solution_fewer_iterations(void **state)
     const struct viscous_report ra = box_solve(a, factor, VISCOUS_JACOBI);
     const struct viscous_report rb = box_solve(b, factor, VISCOUS_TWO_LEVEL);
     assert_true(ra.converged && rb.converged);
-    const size_t n = a->C.start[a->C.ncell];
+    const size_t n = a->work.C.start[a->work.C.ncell];
     double diff = 0.0, scale = 0.0;
     for (size_t i = 0; i < n; i++)
-        if (a->P.state[i] == MIXSPH_STATE_MOBILE) {
-            diff = fmax(diff, hypot(a->P.vx[i] - b->P.vx[i], a->P.vz[i] - b->P.vz[i]));
-            scale = fmax(scale, hypot(a->P.vx[i], a->P.vz[i]));
+        if (a->phys.P.state[i] == MIXSPH_STATE_MOBILE) {
+            diff = fmax(diff, hypot(a->phys.P.vx[i] - b->phys.P.vx[i], a->phys.P.vz[i] - b->phys.P.vz[i]));
+            scale = fmax(scale, hypot(a->phys.P.vx[i], a->phys.P.vz[i]));
         }
     print_message("jacobi %d iterations, two_level %d; largest difference %.2e of the largest speed %.2e\n",
                   ra.iterations, rb.iterations, diff, scale);

@@ -86,7 +86,7 @@ static void expect_error(const char *media, const char *key)
 
 static int is_grain(const mixsph_sim *s, size_t i)
 {
-    return s->P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->P.medium[i]].law == LAW_MIXTURE_PAPER;
+    return s->phys.P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->phys.P.medium[i]].law == LAW_MIXTURE_PAPER;
 }
 
 static void assert_rel(double got, double want, double rel)
@@ -114,10 +114,10 @@ static void test_parse_dry(void **state)
     assert_int_equal(m->mu1_mode, 0);
     /* particles: 40 x 10 grains at the mixture density (hydrostatic p / c^2 <= 1.7 kg/m3 above it) */
     assert_int_equal(mixsph_sim_particles(s), 400);
-    for (size_t i = 0; i < s->P.n; i++) {
+    for (size_t i = 0; i < s->phys.P.n; i++) {
         if (!is_grain(s, i)) continue;
-        assert_true(s->P.rho[i] >= m->rho0 && s->P.rho[i] <= m->rho0 + 1.7);
-        assert_rel(s->P.m[i], s->P.rho[i] * DX * DX, 1e-15);
+        assert_true(s->phys.P.rho[i] >= m->rho0 && s->phys.P.rho[i] <= m->rho0 + 1.7);
+        assert_rel(s->phys.P.m[i], s->phys.P.rho[i] * DX * DX, 1e-15);
     }
     mixsph_sim_destroy(s);
     /* no mu0: no limit (+inf) */
@@ -153,9 +153,9 @@ static void test_parse_mu1(void **state)
     assert_int_equal(m->mu1_mode, 1);
     assert_true(m->mu_thr == 5e3 && isinf(m->mu0));
     /* at rest every grain is held fixed with mu = mu1 */
-    assert_int_equal(s->n_fixed, 400);
-    for (size_t i = 0; i < s->P.n; i++)
-        if (is_grain(s, i)) assert_true(s->P.mu[i] == 5e3);
+    assert_int_equal(s->phys.n_fixed, 400);
+    for (size_t i = 0; i < s->phys.P.n; i++)
+        if (is_grain(s, i)) assert_true(s->phys.P.mu[i] == 5e3);
     mixsph_sim_destroy(s);
     /* with mu_thr or mu0 beside it: refused */
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
@@ -199,7 +199,7 @@ static void test_parse_errors(void **state)
  * and the mixture update, from the pressure of the grains' own density (integrate_pressure_and_derived). */
 static void impose_shear(mixsph_sim *s, double G)
 {
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         P->vx[i] = P->uvx[i] = G * P->z[i];
         P->vz[i] = P->uvz[i] = 0.0;
@@ -221,7 +221,7 @@ struct counts {
  * (p_w given per grain, NULL for dry); p0 is the pressure of every particle before the update. */
 static struct counts check_regimes(const mixsph_sim *s, double G, const double *p0, const double *pw)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     struct counts c = {0, 0, 0};
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
@@ -254,9 +254,9 @@ static struct counts check_regimes(const mixsph_sim *s, double G, const double *
 
 static double *save_p(const mixsph_sim *s)
 {
-    double *p = malloc(s->P.n * sizeof *p);
+    double *p = malloc(s->phys.P.n * sizeof *p);
     assert_non_null(p);
-    memcpy(p, s->P.p, s->P.n * sizeof *p);
+    memcpy(p, s->phys.P.p, s->phys.P.n * sizeof *p);
     return p;
 }
 
@@ -264,7 +264,7 @@ static double *save_p(const mixsph_sim *s)
  * mobile grains j within 2h (brute force over all particles), else the grain's own. */
 static long check_fixed_pressure(const mixsph_sim *s, const double *p0)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     long n_extra = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i) || P->state[i] != MIXSPH_STATE_FIXED) continue;
@@ -272,8 +272,8 @@ static long check_fixed_pressure(const mixsph_sim *s, const double *p0)
         for (size_t j = 0; j < P->n; j++) {
             if (!is_grain(s, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
             const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
-            if (r2 >= s->K.r2max) continue;
-            const double w = kernel_w(&s->K, sqrt(r2));
+            if (r2 >= s->phys.K.r2max) continue;
+            const double w = kernel_w(&s->phys.K, sqrt(r2));
             sw += w;
             sp += (p0[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
         }
@@ -292,12 +292,12 @@ static void test_transitions(void **state)
 {
     (void)state;
     mixsph_sim *s = create_ok(DRY_SAND);
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const long n = 400;
     const size_t out_fixed = (size_t)mixsph_sim_output_find(s, "fixed_particles");
 
     /* at rest after creation: strain rate 0 -> mu_app = mu_thr -> every grain FIXED */
-    assert_int_equal(s->n_fixed, n);
+    assert_int_equal(s->phys.n_fixed, n);
     assert_true(mixsph_sim_output_value(s, out_fixed) == (double)n);
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
@@ -306,11 +306,11 @@ static void test_transitions(void **state)
     }
     /* (4): fixed grains bound dt with min(mu0, mu_thr) = mu0: 0.05 2 h^2 rho / mu0 (5.82e-6 s at
      * h = 0.013 m, rho = 1722.5), below the acoustic 0.1 2h / c = 6.5e-5 s; tolerance: round-off */
-    double dt_ref = 0.1 * 2.0 * s->h / s->c_max;
+    double dt_ref = 0.1 * 2.0 * s->phys.h / s->phys.c_max;
     for (size_t i = 0; i < P->n; i++)
-        if (is_grain(s, i)) dt_ref = fmin(dt_ref, 0.05 * 2.0 * s->h * s->h * P->rho[i] / MU0);
-    print_message("dt at rest: %.6g s (bound of the fixed grains with mu0: %.6g s)\n", s->dt, dt_ref);
-    assert_rel(s->dt, dt_ref, 1e-14);
+        if (is_grain(s, i)) dt_ref = fmin(dt_ref, 0.05 * 2.0 * s->phys.h * s->phys.h * P->rho[i] / MU0);
+    print_message("dt at rest: %.6g s (bound of the fixed grains with mu0: %.6g s)\n", s->phys.dt, dt_ref);
+    assert_rel(s->phys.dt, dt_ref, 1e-14);
 
     /* strong shear G = 0.1 1/s: mu_app = p sin(phi) / G <= 1700 * 0.574 / 0.1 = 9.7e3 < mu_thr:
      * every grain mobile, FRICTIONAL near the top (p < 872 Pa) and LIMITED (mu0) below */
@@ -321,7 +321,7 @@ static void test_transitions(void **state)
     print_message("G = 0.1 1/s:   %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
     assert_int_equal(c.fixed, 0);
     assert_true(c.limited > 0 && c.frictional > 0);
-    assert_int_equal(s->n_fixed, 0);
+    assert_int_equal(s->phys.n_fixed, 0);
     free(p0);
 
     /* back to rest: every grain FIXED again with mu = mu_thr */
@@ -330,7 +330,7 @@ static void test_transitions(void **state)
     update(s);
     c = check_regimes(s, 0.0, p0, NULL);
     assert_int_equal(c.fixed, n);
-    assert_int_equal(s->n_fixed, n);
+    assert_int_equal(s->phys.n_fixed, n);
     free(p0);
 
     /* creeping shear G = 1e-6 1/s (sqrt(II_D) = 5e-7 >= 1e-12): mu_app >= 84 * 0.574 / 1e-6 =
@@ -351,7 +351,7 @@ static void test_transitions(void **state)
     c = check_regimes(s, 0.002, p0, NULL);
     print_message("G = 0.002 1/s: %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
     assert_true(c.fixed > 0 && c.limited > 0);
-    assert_int_equal(s->n_fixed, c.fixed);
+    assert_int_equal(s->phys.n_fixed, c.fixed);
     const long n_extra = check_fixed_pressure(s, p0);
     print_message("  %ld fixed grains took the pressure of mobile neighbours\n", n_extra);
     assert_true(n_extra > 0);
@@ -373,7 +373,7 @@ static void test_pore_pressure(void **state)
 {
     (void)state;
     mixsph_sim *s = create_ok(WATER ", " WET_SAND);
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     impose_shear(s, 0.1);
     double *p0 = save_p(s);
     double *pw = calloc(P->n, sizeof *pw);
@@ -427,7 +427,7 @@ static void test_pore_pressure(void **state)
 static void check_tension(const char *media, int cutoff)
 {
     mixsph_sim *s = create_ok(media);
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const struct medium *m = &s->cfg.media[0];
     assert_int_equal(m->tension_cutoff, cutoff);
     for (size_t i = 0; i < P->n; i++)
@@ -471,9 +471,9 @@ static void test_tension_cutoff(void **state)
 static void check_hold(const char *media, int hold)
 {
     mixsph_sim *s = create_ok(media);
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     assert_int_equal(s->cfg.media[0].hold_fixed, hold);
-    assert_int_equal(s->n_fixed, 400);
+    assert_int_equal(s->phys.n_fixed, 400);
     double *x0 = calloc(P->n, sizeof *x0), *z0 = calloc(P->n, sizeof *z0);
     assert_true(x0 && z0);
     for (size_t i = 0; i < P->n; i++) {
@@ -539,7 +539,7 @@ static mixsph_sim *create_fixed_bed(double v_fb)
  * this field. */
 static void slide_top(mixsph_sim *s)
 {
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         const double u = is_grain(s, i) && P->z[i] >= 0.065 ? 0.05 : 0.0;
         P->vx[i] = P->uvx[i] = u;
@@ -561,7 +561,7 @@ static void test_fixed_bed(void **state)
     mixsph_sim *off = create_ok(DRY_SAND), *on = create_fixed_bed(V_FB);
     assert_true(off->cfg.fixed_bed_speed < 0.0); /* default: off */
     assert_true(on->cfg.fixed_bed_speed == V_FB);
-    struct particles *P = &on->P, *Q = &off->P;
+    struct particles *P = &on->phys.P, *Q = &off->phys.P;
     assert_int_equal(P->n, Q->n);
     const size_t n = P->n;
     /* the same start: the creation's regime decision already froze grains of `on` (all at rest) */
@@ -571,7 +571,7 @@ static void test_fixed_bed(void **state)
     }
     slide_top(off);
     slide_top(on);
-    const double two_h = 2.0 * on->h, x0 = on->domain[0];
+    const double two_h = 2.0 * on->phys.h, x0 = on->phys.domain[0];
     uint8_t *st0 = malloc(n);
     long *top = malloc(n * sizeof *top);
     assert_true(st0 && top);
@@ -616,8 +616,8 @@ static void test_fixed_bed(void **state)
                 for (size_t j = 0; j < n; j++) {
                     if (!is_grain(on, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
                     const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
-                    if (r2 >= on->K.r2max) continue;
-                    const double w = kernel_w(&on->K, sqrt(r2));
+                    if (r2 >= on->phys.K.r2max) continue;
+                    const double w = kernel_w(&on->phys.K, sqrt(r2));
                     sw += w;
                     sp += (P->p[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
                 }

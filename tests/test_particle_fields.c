@@ -164,7 +164,7 @@ static void test_view_shows_the_view_rows(void **state)
     assert_int_equal(mixsph_sim_step(s), MIXSPH_OK);
     size_t rows = 0;
     for (size_t k = 0; k < particle_field_count; k++)
-        rows += (particle_fields[k].where & PF_VIEW) && particle_field_present(&particle_fields[k], s->P.features);
+        rows += (particle_fields[k].where & PF_VIEW) && particle_field_present(&particle_fields[k], s->phys.P.features);
     assert_int_equal(mixsph_sim_particle_field_count(s), rows);
     mixsph_particles_view v;
     assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
@@ -219,8 +219,8 @@ static void test_state_holds_the_present_rows_by_name(void **state)
 {
     (void)state;
     mixsph_sim *e = make(0), *i = make(1);
-    assert_null(e->P.visc_dvx);
-    assert_non_null(i->P.visc_dvx);
+    assert_null(e->phys.P.visc_dvx);
+    assert_non_null(i->phys.P.visc_dvx);
     assert_int_equal(mixsph_sim_step(e), MIXSPH_OK);
     assert_int_equal(mixsph_sim_step(i), MIXSPH_OK);
     void *be, *bi;
@@ -231,8 +231,8 @@ static void test_state_holds_the_present_rows_by_name(void **state)
     for (size_t k = 0; k < particle_field_count; k++) {
         const struct particle_field *f = &particle_fields[k];
         if (!(f->where & PF_STATE)) continue;
-        assert_int_equal(state_names(be, le, f->name), particle_field_present(f, e->P.features));
-        assert_int_equal(state_names(bi, li, f->name), particle_field_present(f, i->P.features));
+        assert_int_equal(state_names(be, le, f->name), particle_field_present(f, e->phys.P.features));
+        assert_int_equal(state_names(bi, li, f->name), particle_field_present(f, i->phys.P.features));
         if (f->needs == PARTICLE_FEATURE_IMPLICIT_VISCOUS) /* the implicit scheme's: only there */
             assert_true(state_names(bi, li, f->name) == 1 && state_names(be, le, f->name) == 0);
     }

@@ -81,7 +81,7 @@ static void test_case_key(void **state)
 /* The new pressure of every non-wall particle by a brute-force sum over all non-wall pairs. */
 static double *brute_force(const mixsph_sim *s, double f)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     double *out = calloc(P->n, sizeof *out);
     assert_non_null(out);
     for (size_t i = 0; i < P->n; i++) {
@@ -90,7 +90,7 @@ static double *brute_force(const mixsph_sim *s, double f)
         for (size_t j = 0; j < P->n; j++) {
             if (j == i || P->state[j] == MIXSPH_STATE_WALL) continue;
             const double r = hypot(P->x[i] - P->x[j], P->z[i] - P->z[j]);
-            const double w = kernel_w(&s->K, r) * P->m[j] / P->rho[j];
+            const double w = kernel_w(&s->phys.K, r) * P->m[j] / P->rho[j];
             a += (P->p[j] - P->p[i] + 0.5 * (P->rho[i] + P->rho[j]) * G_ACC * (P->z[j] - P->z[i])) * w;
             u += w;
         }
@@ -103,9 +103,9 @@ static double *brute_force(const mixsph_sim *s, double f)
  * EOS afterwards; returns the pressures before it (caller frees). */
 static double *smooth_checked(mixsph_sim *s)
 {
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const double c = s->cfg.media[0].c;
-    s->dt = F_STEP * s->h / (THETA * c);
+    s->phys.dt = F_STEP * s->phys.h / (THETA * c);
     double *before = malloc(P->n * sizeof *before);
     assert_non_null(before);
     memcpy(before, P->p, P->n * sizeof *before);
@@ -138,8 +138,8 @@ static void test_hydrostatic_fixed_point(void **state)
     mixsph_sim *s = create_ok(", \"pressure_smoothing\": 0.4");
     double *before = smooth_checked(s);
     double worst = 0.0;
-    for (size_t i = 0; i < s->P.n; i++)
-        if (s->P.state[i] != MIXSPH_STATE_WALL) worst = fmax(worst, fabs(s->P.p[i] - before[i]));
+    for (size_t i = 0; i < s->phys.P.n; i++)
+        if (s->phys.P.state[i] != MIXSPH_STATE_WALL) worst = fmax(worst, fabs(s->phys.P.p[i] - before[i]));
     print_message("hydrostatic tank: largest pressure change %.3g Pa (rho g dx = %.3g Pa)\n", worst, RHO0 * G_ACC * DX);
     assert_true(worst <= 0.01 * RHO0 * G_ACC * DX);
     free(before);
@@ -155,7 +155,7 @@ static void test_checkerboard_damped(void **state)
 {
     (void)state;
     mixsph_sim *s = create_ok(", \"pressure_smoothing\": 0.4");
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const double A = 100.0, c = s->cfg.media[0].c;
     double *hyd = malloc(P->n * sizeof *hyd);
     assert_non_null(hyd);
@@ -170,13 +170,13 @@ static void test_checkerboard_damped(void **state)
     for (int a = -3; a <= 3; a++)
         for (int b = -3; b <= 3; b++) {
             if (a == 0 && b == 0) continue;
-            const double w = kernel_w(&s->K, hypot(a, b) * DX);
+            const double w = kernel_w(&s->phys.K, hypot(a, b) * DX);
             sw += w;
             sa += ((a + b) % 2 ? -1.0 : 1.0) * w;
         }
     const double kappa = -sa / sw, factor = 1.0 - F_STEP * (1.0 + kappa);
     double *before = smooth_checked(s);
-    const double margin = 2.0 * s->h + DX;
+    const double margin = 2.0 * s->phys.h + DX;
     double s0 = 0.0, s1 = 0.0;
     long n_in = 0;
     for (size_t i = 0; i < P->n; i++) {

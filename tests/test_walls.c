@@ -64,7 +64,7 @@ static void launch_in_basin(const char *placement, const char *bodies, double u,
     char text[4096];
     snprintf(text, sizeof text, BASIN_FMT, placement, bodies);
     mixsph_sim *s = create_text(text, "basin.json");
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     size_t n_fluid = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
@@ -99,12 +99,12 @@ static void launch_in_basin(const char *placement, const char *bodies, double u,
     const long lost = mixsph_sim_output_find(s, "lost_particles"), clips = mixsph_sim_output_find(s, "wall_corrections");
     print_message("%zu particles launched at (%g, %g) m/s: closest approach to a wall %.4f dx at t = %.4f s, "
                   "highest z %.3f m, largest x %.3f m, %.0f wall corrections, %llu steps\n",
-                  n_fluid, u, w, d_min / s->dx, t_dmin, z_max, x_max, mixsph_sim_output_value(s, (size_t)clips),
+                  n_fluid, u, w, d_min / s->phys.dx, t_dmin, z_max, x_max, mixsph_sim_output_value(s, (size_t)clips),
                   (unsigned long long)mixsph_sim_steps(s));
     assert_true(mixsph_sim_output_value(s, (size_t)lost) == 0.0);
     /* the particles did reach the walls they were aimed at: within 2 dx of the slope or the right
      * wall (a check of the test itself) */
-    assert_true(x_max > 0.3 && d_min < 2.0 * s->dx);
+    assert_true(x_max > 0.3 && d_min < 2.0 * s->phys.dx);
     mixsph_sim_destroy(s);
 }
 
@@ -156,9 +156,9 @@ static void test_aligned_placement(void **state)
 {
     (void)state;
     mixsph_sim *s = create_text(STEP_CASE, "step.json");
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const struct wall *wl = &s->cfg.walls[0];
-    const double dx = s->dx, depth = s->cfg.wall_layers * dx;
+    const double dx = s->phys.dx, depth = s->cfg.wall_layers * dx;
     double volume = 0.0, nearest = INFINITY;
     size_t n_wall = 0, off_row = 0, first_row = 0;
     for (size_t i = 0; i < P->n; i++) {
@@ -261,7 +261,7 @@ static void test_moving_plate(void **state)
              "}\n",
              t_list, v_list, z_list, PLATE_SPEED_SCALE);
     mixsph_sim *s = create_text(text, "plate.json");
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const size_t plate = 0;
     assert_string_equal(s->cfg.walls[plate].name, "plate");
     double gap_min = INFINITY, t_gap = 0.0, err_max = 0.0, z_max = 0.0;
@@ -274,10 +274,10 @@ static void test_moving_plate(void **state)
         /* the plate follows its law: reference, the integral of the law; tolerance 1e-6 m (the
          * mid-step velocity is exact on the linear pieces; a step across a kink of the law errs
          * by about |jump of acceleration| dt^2 / 8, < 1e-8 m here, at 6 kinks) */
-        const double e = fabs(s->walls[plate].ox - X);
+        const double e = fabs(s->phys.walls.state[plate].ox - X);
         err_max = fmax(err_max, e);
         assert_true(e < 1e-6);
-        assert_true(fabs(s->walls[plate].oz) < 1e-15);
+        assert_true(fabs(s->phys.walls.state[plate].oz) < 1e-15);
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
@@ -298,12 +298,12 @@ static void test_moving_plate(void **state)
     const long clips = mixsph_sim_output_find(s, "wall_corrections");
     print_message("plate stroke %.4f m (law %.4f m, largest deviation %.2e m); closest particle %.4f dx in front "
                   "of it at t = %.4f s; highest particle z = %.3f m; %.0f wall corrections; %llu steps\n",
-                  s->walls[plate].ox, law_displacement(t_end), err_max, gap_min / s->dx, t_gap, z_max,
+                  s->phys.walls.state[plate].ox, law_displacement(t_end), err_max, gap_min / s->phys.dx, t_gap, z_max,
                   mixsph_sim_output_value(s, (size_t)clips), (unsigned long long)mixsph_sim_steps(s));
     /* the stroke of the law: about 0.34 m at speed scale 1 (cases/vajont_padua.json), checked on the table */
     assert_true(fabs(law_displacement(t_end) / PLATE_SPEED_SCALE - 0.34) < 0.01);
     /* the test did push: the water reached the plate's face closely */
-    assert_true(gap_min < s->dx);
+    assert_true(gap_min < s->phys.dx);
     assert_true(z_max < 0.5); /* nothing went over the plate (so the check above covered all) */
     mixsph_sim_destroy(s);
 }

@@ -277,6 +277,11 @@ mixsph_status mixsph_sim_wall_travel_direction(const mixsph_sim *s, size_t k, do
  *  in err, when the file cannot be read or is not JSON. */
 mixsph_status mixsph_case_declares_parameter(const char *case_path, const char *name, int *declared, char *err,
                                              size_t err_len);
+/** The value simulation s uses for a numeric key of its case's top level, `numerics` or `output`
+ *  (e.g. "numerics.cfl": the case file's, an override's or the default; a choice as its number).
+ *  MIXSPH_ERR_ARG for another key. */
+mixsph_status mixsph_sim_case_number(const mixsph_sim *s, const char *key, double *value);
+
 /** The names the case file `case_path` declares in its `parameters` block, in file order,
  *  separated by ", " into names[names_len] (cut short if it does not fit), and their number in *n
  *  ("" and 0 when it declares none). Errors as mixsph_case_declares_parameter. */

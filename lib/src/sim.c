@@ -54,8 +54,8 @@ static int site_blocked(const mixsph_sim *s, double x, double z)
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         int at_end = 0;
         double d;
-        walls_signed_distance(&s->cfg, s->walls, w, x, z, &d, &at_end);
-        if (!at_end && d < 0.5 * s->dx * (1.0 - 1e-9)) return 1;
+        walls_signed_distance(&s->phys.walls, w, x, z, &d, &at_end);
+        if (!at_end && d < 0.5 * s->phys.dx * (1.0 - 1e-9)) return 1;
     }
     return 0;
 }
@@ -65,7 +65,7 @@ static int site_blocked(const mixsph_sim *s, double x, double z)
  * p = sum over the sites above of rho0 g dx, plus half its own; rho from the EOS; m = rho dx^2. */
 static mixsph_status fill_bodies(mixsph_sim *s)
 {
-    const double dx = s->dx, z_off = geom_lattice_z_offset(s->cfg.lattice_z0, dx);
+    const double dx = s->phys.dx, z_off = geom_lattice_z_offset(s->cfg.lattice_z0, dx);
     size_t n = 0, cap = 1024;
     struct site *sites = malloc(cap * sizeof *sites);
     if (!sites) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -130,10 +130,10 @@ static mixsph_status fill_bodies(mixsph_sim *s)
                         "(numerics.max_particles)", s->cfg.origin, dx, n, s->cfg.max_particles);
     }
     qsort(sites, n, sizeof *sites, site_cmp);
-    s->P.features = s->cfg.viscosity_implicit ? PARTICLE_FEATURE_IMPLICIT_VISCOUS : 0u;
+    s->phys.P.features = s->cfg.viscosity_implicit ? PARTICLE_FEATURE_IMPLICIT_VISCOUS : 0u;
     for (size_t k = 0; k < s->cfg.n_media; k++)
-        if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->P.features |= PARTICLE_FEATURE_STRESS;
-    if (particles_alloc(&s->P, n + n / 2 + 1024) != 0) {
+        if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->phys.P.features |= PARTICLE_FEATURE_STRESS;
+    if (particles_alloc(&s->phys.P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
     }
@@ -145,11 +145,11 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         above += m->rho0 * s->cfg.g * dx;
         double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
         const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
-        particles_push(&s->P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
+        particles_push(&s->phys.P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
                        (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
-        s->P.mu[s->P.n - 1] = m->mu;
+        s->phys.P.mu[s->phys.P.n - 1] = m->mu;
     }
-    s->n_fluid = n;
+    s->phys.n_fluid = n;
     free(sites);
     return MIXSPH_OK;
 }
@@ -161,21 +161,21 @@ static void set_domain(mixsph_sim *s)
     if (s->cfg.has_domain) {
         /* the case's domain bounds the fluids; the wall layers behind the walls may reach past
          * it at coarse dx (layers x dx), so it grows to hold every wall particle */
-        memcpy(s->domain, s->cfg.domain, sizeof s->domain);
-        for (size_t i = s->n_fluid; i < s->P.n; i++) {
-            s->domain[0] = fmin(s->domain[0], s->P.x[i] - s->dx);
-            s->domain[1] = fmax(s->domain[1], s->P.x[i] + s->dx);
-            s->domain[2] = fmin(s->domain[2], s->P.z[i] - s->dx);
-            s->domain[3] = fmax(s->domain[3], s->P.z[i] + s->dx);
+        memcpy(s->phys.domain, s->cfg.domain, sizeof s->phys.domain);
+        for (size_t i = s->phys.n_fluid; i < s->phys.P.n; i++) {
+            s->phys.domain[0] = fmin(s->phys.domain[0], s->phys.P.x[i] - s->phys.dx);
+            s->phys.domain[1] = fmax(s->phys.domain[1], s->phys.P.x[i] + s->phys.dx);
+            s->phys.domain[2] = fmin(s->phys.domain[2], s->phys.P.z[i] - s->phys.dx);
+            s->phys.domain[3] = fmax(s->phys.domain[3], s->phys.P.z[i] + s->phys.dx);
         }
         return;
     }
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
-    for (size_t i = 0; i < s->P.n; i++) {
-        x0 = fmin(x0, s->P.x[i]);
-        x1 = fmax(x1, s->P.x[i]);
-        z0 = fmin(z0, s->P.z[i]);
-        z1 = fmax(z1, s->P.z[i]);
+    for (size_t i = 0; i < s->phys.P.n; i++) {
+        x0 = fmin(x0, s->phys.P.x[i]);
+        x1 = fmax(x1, s->phys.P.x[i]);
+        z0 = fmin(z0, s->phys.P.z[i]);
+        z1 = fmax(z1, s->phys.P.z[i]);
     }
     /* sweep of moving walls */
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
@@ -186,7 +186,7 @@ static void set_domain(mixsph_sim *s)
         const double dt = s->cfg.t_end / nsub;
         for (int k = 0; k < nsub; k++) {
             double vx, vz;
-            case_motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
+            motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
             ox += vx * dt;
             oz += vz * dt;
             oxmin = fmin(oxmin, ox);
@@ -199,79 +199,110 @@ static void set_domain(mixsph_sim *s)
         z0 += fmin(0.0, ozmin);
         z1 += fmax(0.0, ozmax);
     }
-    const double pad = 2.0 * s->dx;
-    s->domain[0] = x0 - pad;
-    s->domain[1] = x1 + pad;
-    s->domain[2] = z0 - pad;
-    s->domain[3] = z1 + 0.5 * (z1 - z0) + pad;
+    const double pad = 2.0 * s->phys.dx;
+    s->phys.domain[0] = x0 - pad;
+    s->phys.domain[1] = x1 + pad;
+    s->phys.domain[2] = z0 - pad;
+    s->phys.domain[3] = z1 + 0.5 * (z1 - z0) + pad;
 }
 
 /* The states of the material laws the media use, and the velocity gradient when one asks for it. */
 static mixsph_status create_laws(mixsph_sim *s)
 {
-    const struct law_setup setup = {.media = s->cfg.media, .n_media = s->cfg.n_media, .cap = s->P.n,
-                                     .x_min = s->domain[0], .x_max = s->domain[1], .dx = s->dx, .h = s->h,
+    const struct law_setup setup = {.media = s->cfg.media, .n_media = s->cfg.n_media, .cap = s->phys.P.n,
+                                     .x_min = s->phys.domain[0], .x_max = s->phys.domain[1], .dx = s->phys.dx, .h = s->phys.h,
                                      .g = s->cfg.g, .p_background = s->cfg.p_background,
                                      .fixed_bed_speed = s->cfg.fixed_bed_speed};
     for (size_t k = 0; k < s->cfg.n_media; k++) {
         const int id = s->cfg.media[k].law;
         const struct material_law *law = law_get(id);
-        s->law_features |= law->features;
-        if (law->create && !s->law_state[id] && !(s->law_state[id] = law->create(&setup)))
+        s->phys.law_features |= law->features;
+        if (law->create && !s->phys.law_state[id] && !(s->phys.law_state[id] = law->create(&setup)))
             return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (the state of the material law of medium %s)",
                             s->cfg.media[k].name);
     }
-    if (s->law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
-        for (size_t i = 0; i < s->P.n; i++)
-            s->P.wall_rough[i] = s->P.state[i] == MIXSPH_STATE_WALL &&
-                                 s->cfg.walls[particles_wall_index(&s->P, i)].slip == WALL_NO_SLIP;
-    if ((s->law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->grad, s->P.n) != 0)
+    if (s->phys.law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
+        for (size_t i = 0; i < s->phys.P.n; i++)
+            s->phys.P.wall_rough[i] = s->phys.P.state[i] == MIXSPH_STATE_WALL &&
+                                 s->cfg.walls[particles_wall_index(&s->phys.P, i)].slip == WALL_NO_SLIP;
+    if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
     return MIXSPH_OK;
+}
+
+/* The time schemes' parameters from the case and the laws' features (after create_laws). */
+static void set_scheme_params(mixsph_sim *s)
+{
+    const struct case_def *c = &s->cfg;
+    s->scheme = (struct scheme_params){
+        .media = c->media,
+        .n_media = c->n_media,
+        .implicit = c->viscosity_implicit,
+        .held_grains_rigid = c->held_grains_rigid,
+        .cfl = c->cfl,
+        .cfl_visc = c->cfl_visc,
+        .p_background = c->p_background,
+        .pressure_smoothing = c->pressure_smoothing,
+        .pair = {.K = s->phys.K,
+                 .eta2 = 0.01 * s->phys.h * s->phys.h,
+                 .g = c->g,
+                 .av_wall = c->av_wall,
+                 .av_mixed = c->av_mixed,
+                 .av_separating = c->av_separating,
+                 .implicit_viscosity = c->viscosity_implicit,
+                 .arithmetic_mean = c->viscosity_arithmetic,
+                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0},
+        .viscous = {.preconditioner = c->viscous_preconditioner,
+                    .tolerance = c->viscous_tolerance,
+                    .max_iterations = c->viscous_max_iterations},
+    };
 }
 
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
-    s->dx = s->cfg.dx;
-    s->h = s->cfg.h_over_dx * s->dx;
-    s->K = kernel_make_type(s->h, s->cfg.kernel);
-    s->c_max = law_max_wave_speed(s->cfg.media, s->cfg.n_media);
-    walls_start(&s->cfg, s->walls);
+    s->phys.dx = s->cfg.dx;
+    s->phys.h = s->cfg.h_over_dx * s->phys.dx;
+    s->phys.K = kernel_make_type(s->phys.h, s->cfg.kernel);
+    s->phys.c_max = law_max_wave_speed(s->cfg.media, s->cfg.n_media);
+    /* a wall particle with no fluid around it takes the first medium's density */
+    walls_init(&s->phys.walls, s->cfg.walls, s->cfg.n_walls, s->cfg.motions, s->cfg.wall_layers, s->cfg.wall_placement,
+               s->cfg.lattice_z0, s->cfg.g, s->cfg.media[0].rho0);
     if ((st = fill_bodies(s)) != MIXSPH_OK) return st;
-    const long n_wall = walls_generate(&s->cfg, s->walls, s->dx, &s->interrupt, &s->P);
+    const long n_wall = walls_generate(&s->phys.walls, s->phys.dx, &s->interrupt, &s->phys.P);
     if (n_wall == WALLS_INTERRUPTED)
         return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while placing the wall particles", s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
-    s->n_wall = (size_t)n_wall;
+    s->phys.n_wall = (size_t)n_wall;
     set_domain(s);
     if ((st = create_laws(s)) != MIXSPH_OK) return st;
-    if (!(s->forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
-    const double *dom = s->cfg.has_domain ? s->cfg.domain : s->domain;
-    for (size_t i = 0; i < s->n_fluid; i++) /* fluids come first until the first sort */
-        if (!(s->P.x[i] >= dom[0] && s->P.x[i] < dom[1] && s->P.z[i] >= dom[2] && s->P.z[i] < dom[3]))
+    set_scheme_params(s);
+    if (!(s->work.forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    const double *dom = s->cfg.has_domain ? s->cfg.domain : s->phys.domain;
+    for (size_t i = 0; i < s->phys.n_fluid; i++) /* fluids come first until the first sort */
+        if (!(s->phys.P.x[i] >= dom[0] && s->phys.P.x[i] < dom[1] && s->phys.P.z[i] >= dom[2] && s->phys.P.z[i] < dom[3]))
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
-                            s->P.x[i], s->P.z[i]);
-    s->NB.skin = NEIGHBOURS_SKIN_OVER_H * s->h;
-    if (cells_init_columns(&s->C, s->domain[0], s->domain[1], s->domain[2], s->domain[3], 2.0 * s->h + s->NB.skin,
+                            s->phys.P.x[i], s->phys.P.z[i]);
+    s->work.NB.skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
+    if (cells_init_columns(&s->work.C, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3], 2.0 * s->phys.h + s->work.NB.skin,
                            SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
-                        s->cfg.origin, s->domain[0], s->domain[1], s->domain[2], s->domain[3]);
-    if (cells_build(&s->C, &s->P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
-    s->n_lost = 0;
-    for (size_t i = 0; i < s->P.n; i++)
-        if (s->P.state[i] == MIXSPH_STATE_LOST)
+                        s->cfg.origin, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3]);
+    if (cells_build(&s->work.C, &s->phys.P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
+    s->phys.n_lost = 0;
+    for (size_t i = 0; i < s->phys.P.n; i++)
+        if (s->phys.P.state[i] == MIXSPH_STATE_LOST)
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
-                            s->P.x[i], s->P.z[i]);
+                            s->phys.P.x[i], s->phys.P.z[i]);
     if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after sorting the particles", s->cfg.origin);
-    if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+    if (neighbours_build(&s->work.NB, &s->work.C, &s->phys.P, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
     if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after the neighbour lists", s->cfg.origin);
     if ((st = integrate_build_gather_lists(s)) != MIXSPH_OK) return st;
     if ((st = integrate_initial_rates(s)) != MIXSPH_OK) return st;
     monitors_init(s);
-    s->next_sample = 0.0;
-    s->next_snapshot = 0.0;
+    s->out.next_sample = 0.0;
+    s->out.next_snapshot = 0.0;
     return MIXSPH_OK;
 }
 
@@ -403,7 +434,7 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
         char msg[900];
         st = sim_create_from_state(buf, len, interrupt, out, msg, sizeof msg);
         if (st != MIXSPH_OK) status_set(err, err_len, st, "checkpoint %s: %s", path, msg);
-        else (*out)->run_wall_s = run_wall;
+        else (*out)->out.run_wall_s = run_wall;
     }
     free(buf);
     return st;
@@ -412,20 +443,20 @@ mixsph_status mixsph_sim_create_from_checkpoint_interruptible(const char *path, 
 void mixsph_sim_destroy(mixsph_sim *s)
 {
     if (!s) return;
-    if (s->monitor_csv) fclose(s->monitor_csv);
+    if (s->out.monitor_csv) fclose(s->out.monitor_csv);
     output_close(s);
     for (int id = 0; id < LAW_COUNT; id++)
-        if (s->law_state[id]) law_get(id)->destroy(s->law_state[id]);
-    velocity_gradient_free(&s->grad);
-    forces_free(s->forces);
-    viscous_free(s->viscous);
-    free(s->viscous_unknown);
-    walls_mirror_free(s->wall_mirror);
-    particles_free(&s->P);
-    cells_free(&s->C);
-    neighbours_free(&s->NB);
-    neighbours_gather_free(&s->G);
-    free(s->near_wall);
+        if (s->phys.law_state[id]) law_get(id)->destroy(s->phys.law_state[id]);
+    velocity_gradient_free(&s->work.grad);
+    forces_free(s->work.forces);
+    viscous_free(s->work.viscous);
+    free(s->work.viscous_unknown);
+    walls_mirror_free(s->work.wall_mirror);
+    particles_free(&s->phys.P);
+    cells_free(&s->work.C);
+    neighbours_free(&s->work.NB);
+    neighbours_gather_free(&s->work.G);
+    free(s->work.near_wall);
     case_free(&s->cfg);
     for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
     free(s->ov_key);
@@ -448,9 +479,9 @@ mixsph_status mixsph_sim_set_threads(mixsph_sim *s, int n_threads)
 static mixsph_status sim_output_dir(mixsph_sim *s, const char *dir, int resume)
 {
     if (!s || !dir || !*dir) return s ? SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: empty name") : MIXSPH_ERR_ARG;
-    if (strlen(dir) >= sizeof s->out_dir) return SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: name too long");
+    if (strlen(dir) >= sizeof s->out.dir) return SIM_FAIL(s, MIXSPH_ERR_ARG, "output folder: name too long");
     /* create each missing component */
-    char path[sizeof s->out_dir];
+    char path[sizeof s->out.dir];
     strcpy(path, dir);
     for (char *p = path + 1; *p; p++) {
         if (*p != '/') continue;
@@ -461,18 +492,18 @@ static mixsph_status sim_output_dir(mixsph_sim *s, const char *dir, int resume)
     }
     if (make_dir(path) != 0 && errno != EEXIST)
         return SIM_FAIL(s, MIXSPH_ERR_IO, "output folder %s: cannot create: %s", dir, strerror(errno));
-    if (s->monitor_csv) {
-        fclose(s->monitor_csv);
-        s->monitor_csv = NULL;
+    if (s->out.monitor_csv) {
+        fclose(s->out.monitor_csv);
+        s->out.monitor_csv = NULL;
     }
     output_close(s);
-    strcpy(s->out_dir, dir);
+    strcpy(s->out.dir, dir);
     mixsph_status st = output_open(s, resume); /* first: it refuses the folder of another run */
     if (st == MIXSPH_OK) st = resume ? output_resume_monitors(s) : monitors_open(s);
     if (st != MIXSPH_OK) { /* no half-set output folder */
-        if (s->monitor_csv) fclose(s->monitor_csv);
-        s->monitor_csv = NULL;
-        s->out_dir[0] = '\0';
+        if (s->out.monitor_csv) fclose(s->out.monitor_csv);
+        s->out.monitor_csv = NULL;
+        s->out.dir[0] = '\0';
     }
     return st;
 }
@@ -499,14 +530,14 @@ static double next_output_time(double t, double interval)
 static mixsph_status sim_outputs_due(mixsph_sim *s)
 {
     mixsph_status st = monitors_profiles(s);
-    if (st == MIXSPH_OK && s->t >= s->next_sample - SIM_OUTPUT_SLACK) {
+    if (st == MIXSPH_OK && s->phys.t >= s->out.next_sample - SIM_OUTPUT_SLACK) {
         st = monitors_sample(s);
-        s->next_sample = next_output_time(s->t, s->cfg.monitor_interval);
+        s->out.next_sample = next_output_time(s->phys.t, s->cfg.monitor_interval);
     }
-    if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out_dir[0] &&
-        s->t >= s->next_snapshot - SIM_OUTPUT_SLACK) {
+    if (st == MIXSPH_OK && s->cfg.snapshot_interval > 0.0 && s->out.dir[0] &&
+        s->phys.t >= s->out.next_snapshot - SIM_OUTPUT_SLACK) {
         st = output_snapshot(s); /* snap_NNNN.csv and run.h5 */
-        s->next_snapshot = next_output_time(s->t, s->cfg.snapshot_interval);
+        s->out.next_snapshot = next_output_time(s->phys.t, s->cfg.snapshot_interval);
     }
     return st;
 }
@@ -516,21 +547,21 @@ mixsph_status mixsph_sim_step(mixsph_sim *s)
     if (!s) return MIXSPH_ERR_ARG;
     const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
-    if (s->step == 0 && s->n_samples == 0) st = sim_outputs_due(s);
+    if (s->phys.step == 0 && s->out.n_samples == 0) st = sim_outputs_due(s);
     if (st == MIXSPH_OK) st = integrate_step(s);
     if (st == MIXSPH_OK) st = sim_outputs_due(s);
-    s->run_wall_s += clock_monotonic_s() - t0;
+    s->out.run_wall_s += clock_monotonic_s() - t0;
     return st;
 }
 
 
-double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->run_wall_s : NAN; }
+double mixsph_sim_run_wall_time(const mixsph_sim *s) { return s ? s->out.run_wall_s : NAN; }
 
 mixsph_status mixsph_sim_viscous_cost(const mixsph_sim *s, uint64_t *iterations, double *wall_s)
 {
     if (!s || !iterations || !wall_s) return MIXSPH_ERR_ARG;
-    *iterations = s->viscous_iterations;
-    *wall_s = s->viscous_wall_s;
+    *iterations = s->work.viscous_iterations;
+    *wall_s = s->work.viscous_wall_s;
     return MIXSPH_OK;
 }
 
@@ -538,10 +569,10 @@ mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
 {
     if (!s) return MIXSPH_ERR_ARG;
     if (!isfinite(t)) return SIM_FAIL(s, MIXSPH_ERR_ARG, "advance_to: time %g is not finite", t);
-    while (s->t < t) {
+    while (s->phys.t < t) {
         if (sim_interrupted(s))
-            return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "interrupted at t = %.9g s, step %llu", s->t,
-                            (unsigned long long)s->step);
+            return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "interrupted at t = %.9g s, step %llu", s->phys.t,
+                            (unsigned long long)s->phys.step);
         mixsph_status st = mixsph_sim_step(s);
         if (st != MIXSPH_OK) return st;
     }
@@ -549,12 +580,12 @@ mixsph_status mixsph_sim_advance_to(mixsph_sim *s, double t)
 }
 
 const char *mixsph_sim_last_error(const mixsph_sim *s) { return s ? s->err : "no simulation"; }
-double mixsph_sim_time(const mixsph_sim *s) { return s->t; }
+double mixsph_sim_time(const mixsph_sim *s) { return s->phys.t; }
 double mixsph_sim_end_time(const mixsph_sim *s) { return s->cfg.t_end; }
-double mixsph_sim_dt(const mixsph_sim *s) { return s->dt; }
-uint64_t mixsph_sim_steps(const mixsph_sim *s) { return s->step; }
-size_t mixsph_sim_particles(const mixsph_sim *s) { return s->n_fluid; }
-size_t mixsph_sim_wall_particles(const mixsph_sim *s) { return s->n_wall; }
+double mixsph_sim_dt(const mixsph_sim *s) { return s->phys.dt; }
+uint64_t mixsph_sim_steps(const mixsph_sim *s) { return s->phys.step; }
+size_t mixsph_sim_particles(const mixsph_sim *s) { return s->phys.n_fluid; }
+size_t mixsph_sim_wall_particles(const mixsph_sim *s) { return s->phys.n_wall; }
 const char *mixsph_sim_name(const mixsph_sim *s) { return s->cfg.name; }
 const char *mixsph_sim_case_text(const mixsph_sim *s) { return s ? s->case_text : NULL; }
 const char *mixsph_sim_case_origin(const mixsph_sim *s) { return s ? s->case_origin : NULL; }
@@ -582,10 +613,10 @@ mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, doub
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s: external velocity (%g, %g) m/s is not finite", wall, vx, vz);
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
-    s->walls[w].ext = 1;
-    s->walls[w].ext_vx = vx;
-    s->walls[w].ext_vz = vz;
-    walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, 0.0, 0.0, &s->P);
+    s->phys.walls.state[w].ext = 1;
+    s->phys.walls.state[w].ext_vx = vx;
+    s->phys.walls.state[w].ext_vz = vz;
+    walls_change_velocity(&s->phys.walls, (size_t)w, vx, vz, 0.0, 0.0, &s->phys.P);
     return MIXSPH_OK;
 }
 
@@ -595,44 +626,44 @@ mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall)
     if (!wall) return SIM_FAIL(s, MIXSPH_ERR_ARG, "release_wall_velocity: no wall name");
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
-    if (s->walls[w].ext) {
+    if (s->phys.walls.state[w].ext) {
         const struct motion *law = &s->cfg.motions[s->cfg.walls[w].motion];
         double vx, vz, ax, az;
-        case_motion_velocity(law, s->t, &vx, &vz);
-        case_motion_acceleration(law, s->t, &ax, &az);
-        walls_change_velocity(&s->cfg, s->walls, (size_t)w, vx, vz, ax, az, &s->P);
+        motion_velocity(law, s->phys.t, &vx, &vz);
+        motion_acceleration(law, s->phys.t, &ax, &az);
+        walls_change_velocity(&s->phys.walls, (size_t)w, vx, vz, ax, az, &s->phys.P);
     }
-    s->walls[w].ext = 0;
+    s->phys.walls.state[w].ext = 0;
     return MIXSPH_OK;
 }
-size_t mixsph_sim_output_count(const mixsph_sim *s) { return s->n_out; }
+size_t mixsph_sim_output_count(const mixsph_sim *s) { return s->out.n; }
 
-const char *mixsph_sim_output_name(const mixsph_sim *s, size_t k) { return k < s->n_out ? s->out_name[k] : NULL; }
+const char *mixsph_sim_output_name(const mixsph_sim *s, size_t k) { return k < s->out.n ? s->out.name[k] : NULL; }
 
-double mixsph_sim_output_value(const mixsph_sim *s, size_t k) { return k < s->n_out ? monitors_value(s, k) : NAN; }
+double mixsph_sim_output_value(const mixsph_sim *s, size_t k) { return k < s->out.n ? monitors_value(s, k) : NAN; }
 
 void mixsph_sim_output_extremes(const mixsph_sim *s, size_t k, double *max, double *t_max, double *min, double *t_min)
 {
-    const int ok = k < s->n_out;
-    if (max) *max = ok ? s->out_max[k] : NAN;
-    if (t_max) *t_max = ok ? s->out_tmax[k] : NAN;
-    if (min) *min = ok ? s->out_min[k] : NAN;
-    if (t_min) *t_min = ok ? s->out_tmin[k] : NAN;
+    const int ok = k < s->out.n;
+    if (max) *max = ok ? s->out.max[k] : NAN;
+    if (t_max) *t_max = ok ? s->out.tmax[k] : NAN;
+    if (min) *min = ok ? s->out.min[k] : NAN;
+    if (t_min) *t_min = ok ? s->out.tmin[k] : NAN;
 }
 
 long mixsph_sim_output_find(const mixsph_sim *s, const char *name)
 {
-    for (size_t k = 0; k < s->n_out; k++)
-        if (name && strcmp(s->out_name[k], name) == 0) return (long)k;
+    for (size_t k = 0; k < s->out.n; k++)
+        if (name && strcmp(s->out.name[k], name) == 0) return (long)k;
     return -1;
 }
 
 mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v)
 {
     if (!s || !v) return MIXSPH_ERR_ARG;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     v->n = P->n;
-    v->n_fluid = s->n_fluid;
+    v->n_fluid = s->phys.n_fluid;
     v->x = P->x;
     v->z = P->z;
     v->vx = P->vx;

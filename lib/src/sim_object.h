@@ -1,6 +1,6 @@
 /* sim_object.h - the simulation object (the internal definition of the opaque mixsph_sim): the
- * case, the particles, the cell list and neighbour ranges, the walls' motion, the material laws'
- * and the passes' states, the solver's workspace, the outputs and files. A definition only: the
+ * case it was made from and the schemes' parameters set from it, the physical state, the
+ * solver's workspaces and the output schedule. A definition only: the
  * schemes (schemes/), the outputs (io/monitors.c, io/output.c) and the state (io/state.c) work on
  * it; the laws, passes and walls do not see it (they take the parts they need); sim.c, on top,
  * creates and drives it. */
@@ -17,6 +17,7 @@
 #include "law.h"
 #include "neighbours.h"
 #include "particles.h"
+#include "scheme_params.h"
 #include "viscous.h"
 #include "walls.h"
 
@@ -34,59 +35,72 @@
 
 #define SIM_MAX_OUTPUTS (10 + CASE_MAX_MONITORS)
 
-struct mixsph_sim {
-    struct case_def cfg;
-    /* what the simulation was created from (kept for state save/restore and metadata) */
-    char *case_text, *case_origin;
-    size_t n_ov;
-    char **ov_key;
-    double *ov_value;
+/* The physical state: what a state file or a checkpoint restores (io/state.c). */
+struct sim_physics {
     struct kernel K;
     double dx, h;
     double c_max;                 /* highest sound speed [m/s] */
     double domain[4];             /* x_min, x_max, z_min, z_max [m] */
     struct particles P;
+    size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
+    struct walls walls;           /* the walls' definitions and moving states */
+    void *law_state[LAW_COUNT];   /* each material law's state (laws/law.h); NULL: stateless or unused */
+    unsigned law_features;        /* the union of the media's law features (enum law_feature) */
+    long n_fixed;                 /* granular particles held fixed after the last step */
+    double t, dt;                 /* time, next time step [s] */
+    uint64_t step;
+    long n_lost;                  /* particles that left the domain */
+    long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
+};
+
+/* The solver's workspaces: rebuilt from the physical state, never saved. */
+struct sim_workspace {
     struct cells C;
     struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
     struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
     struct forces *forces;        /* the pair loops' cache and scratch */
+    struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */
     struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
     struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
-    struct viscous_report viscous_last; /* the last solve */
     unsigned char *viscous_unknown; /* per particle: an unknown of the implicit viscous step */
+    struct viscous_report viscous_last; /* the last solve */
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */
     double viscous_wall_s;        /* wall time in the implicit viscous step in this process [s] */
-    size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
-    struct wall_state walls[CASE_MAX_WALLS];
-    void *law_state[LAW_COUNT];   /* each material law's state (laws/law.h); NULL: stateless or unused */
-    unsigned law_features;        /* the union of the media's law features (enum law_feature) */
-    struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */
-    long n_fixed;                 /* granular particles held fixed after the last step */
+};
 
-    double t, dt;                 /* time, next time step [s] */
-    uint64_t step;
-    int n_threads;
-    long n_lost;                  /* particles that left the domain */
-    long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
-
-    /* outputs: diagnostics then the case's monitors */
-    size_t n_out;
-    char out_name[SIM_MAX_OUTPUTS][CASE_NAME_LEN];
-    int out_monitor[SIM_MAX_OUTPUTS];             /* case monitor behind output k, -1 for diagnostics */
+/* The output schedule and files (io/monitors.c, io/output.c): diagnostics, then the case's
+ * monitors, and the snapshots. */
+struct sim_outputs {
+    size_t n;
+    char name[SIM_MAX_OUTPUTS][CASE_NAME_LEN];
+    int monitor[SIM_MAX_OUTPUTS];                 /* case monitor behind output k, -1 for diagnostics */
     size_t profile_next[CASE_MAX_MONITORS];       /* profile monitors: next time to write */
-    double out_max[SIM_MAX_OUTPUTS], out_tmax[SIM_MAX_OUTPUTS];
-    double out_min[SIM_MAX_OUTPUTS], out_tmin[SIM_MAX_OUTPUTS];
+    double max[SIM_MAX_OUTPUTS], tmax[SIM_MAX_OUTPUTS];
+    double min[SIM_MAX_OUTPUTS], tmin[SIM_MAX_OUTPUTS];
     long n_samples;
     double next_sample, next_snapshot;
     int snap_index;
-    char out_dir[512];
+    char dir[512];
     FILE *monitor_csv;
     struct output *h5;            /* run.h5 and run.xdmf (output.c); NULL without an output folder */
-    double out_seconds[3];        /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
+    double seconds[3];            /* wall time writing CSV snapshots, HDF5 snapshots, checkpoints [s] */
     double run_wall_s;            /* wall time stepping this run since t = 0, incl. before a restart [s] */
     int csv_snapshots_off;        /* no snap_NNNN.csv (run.h5 only) */
+};
 
+struct mixsph_sim {
+    struct case_def cfg;          /* read when the simulation is created and by the outputs, not by a step */
+    /* what the simulation was created from (kept for state save/restore and metadata) */
+    char *case_text, *case_origin;
+    size_t n_ov;
+    char **ov_key;
+    double *ov_value;
+    struct scheme_params scheme;  /* what a step reads, set once from cfg */
+    struct sim_physics phys;
+    struct sim_workspace work;
+    struct sim_outputs out;
+    int n_threads;
     mixsph_interrupt interrupt;   /* the host's request to stop, polled during creation and stepping */
     char err[1024];
 };

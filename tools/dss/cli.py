@@ -45,6 +45,25 @@ def parse_sets(items) -> dict:
     return out
 
 
+def parse_box(items) -> dict:
+    """--box NAME=lo:hi items -> {name: (lo, hi)}."""
+    from .scenarios import split_assignment
+    out = {}
+    for it in items or []:
+        k, v = split_assignment(it)
+        parts = v.split(":")
+        if len(parts) != 2:
+            raise UsageError(f"--box {it}: expected NAME=lo:hi")
+        out[k] = (float(parts[0]), float(parts[1]))
+    return out
+
+
+def parse_dists(items) -> dict:
+    """--dist NAME=SPEC items -> {name: scenarios.Distribution}."""
+    from .scenarios import Distribution, split_assignment
+    return {k: Distribution(k, v) for k, v in (split_assignment(it) for it in items or [])}
+
+
 def model_params(fmu_path: str):
     from fmpy import read_model_description
     md = read_model_description(fmu_path)

@@ -43,29 +43,8 @@ import numpy as np
 import pandas as pd
 
 from . import emulator as E
-from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_sets,
-                  parse_value, resolve_run, save_json)
-
-
-def _parse_box(items):
-    out = {}
-    for it in items or []:
-        from .scenarios import split_assignment
-        k, v = split_assignment(it)
-        parts = v.split(":")
-        if len(parts) != 2:
-            raise UsageError(f"--box {it}: expected NAME=lo:hi")
-        out[k] = (float(parts[0]), float(parts[1]))
-    return out
-
-
-def _dists(items):
-    from .scenarios import Distribution, split_assignment
-    d = {}
-    for it in items or []:
-        k, v = split_assignment(it)
-        d[k] = Distribution(k, v)
-    return d
+from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_box, parse_dists,
+                  parse_sets, parse_value, resolve_run, save_json)
 
 
 def _load(args):
@@ -318,7 +297,7 @@ def fit_folder(folder, outputs=None, inputs=None, box=None, fmu=None, mode="auto
 
 def cmd_fit(args):
     inputs = [s.strip() for s in args.inputs.split(",")] if args.inputs else None
-    em, files, fit_s = fit_folder(args.sweep, args.output or None, inputs, _parse_box(args.box),
+    em, files, fit_s = fit_folder(args.sweep, args.output or None, inputs, parse_box(args.box),
                                   args.fmu, args.categorical, args.folds, args.restarts,
                                   args.seed, args.out, not args.no_plots,
                                   args.noise_floor, args.noise)
@@ -445,7 +424,7 @@ def cmd_risk(args):
             output = next(iter(em.models))
         else:
             raise UsageError(f"no emulator of {output!r} ({', '.join(em.models)})")
-    dists = _dists(args.dist)
+    dists = parse_dists(args.dist)
     fixed = parse_sets(args.set)
     if not dists:
         raise UsageError("give the inputs' distributions with --dist NAME=SPEC")

@@ -23,7 +23,8 @@ import pandas as pd
 
 from . import emulator as E
 from . import multifidelity as M
-from .cli import UsageError, common_cluster_args, common_run_args, default_fmu, parse_sets
+from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_box, parse_dists,
+                  parse_sets)
 
 # the default ladder: the coarse spacings of the convergence table of docs/validation/vajont.md
 DEFAULT_LEVELS = "0.03,0.02,0.015"
@@ -300,7 +301,6 @@ def _runs(folders):
 
 
 def cmd_mf_fit(args):
-    from .emulate import _parse_box
     df = _runs(args.folders)
     fmu = args.fmu
     if not fmu:
@@ -312,7 +312,7 @@ def cmd_mf_fit(args):
     if not os.path.isfile(fmu):
         raise UsageError(f"the FMU {fmu} of these runs is not there: give --fmu")
     inputs = [x.strip() for x in args.inputs.split(",") if x.strip()]
-    box = _parse_box(args.box) or None
+    box = parse_box(args.box) or None
     if box is not None:
         missing = [n for n in inputs if n not in box]
         if missing:
@@ -427,9 +427,8 @@ def cmd_mf_validate(args):
 
 
 def cmd_mf_risk(args):
-    from .emulate import _dists
     em = _load(args)
-    dists = _dists(args.dist)
+    dists = parse_dists(args.dist)
     if not dists:
         raise UsageError("give the inputs' distributions with --dist NAME=SPEC")
     fixed = parse_sets(args.set)

@@ -76,9 +76,10 @@ def parse_args(prog, o, argv=None):
 
 def add_options(ap, o):
     """The options every validation script has, with o's defaults (a CaseOptions)."""
-    known = f"{min(o.known)}-{max(o.known)}"
-    ap.add_argument("--runs", default=o.runs, help=f"paper runs to do, {known}, comma-separated or 'all' "
-                    f"(default {o.runs})")
+    if o.known:   # a script of the paper's numbered runs
+        known = f"{min(o.known)}-{max(o.known)}"
+        ap.add_argument("--runs", default=o.runs, help=f"paper runs to do, {known}, comma-separated or 'all' "
+                        f"(default {o.runs})")
     ap.add_argument("--dx", type=float, default=o.dx, help=o.dx_help)
     ap.add_argument("--out", default=os.path.join(ROOT, "out", o.out), help=f"output folder (default out/{o.out})")
     ap.add_argument("--threads", type=int, help="OpenMP threads of each run (default max(1, cores // jobs))")
@@ -97,9 +98,12 @@ def add_options(ap, o):
                     f"runs every this many seconds (default {o.progress:g}, 0: never)")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", dest="sets",
                     help=f"an override passed to every run after the run's own (repeatable), e.g. {o.set_example}")
-    ap.add_argument("--sphera", action="store_true", help="run with the numerical options of SPHERA's own input "
-                    "for this test (" + ", ".join(f"{k}={num(v)}" for k, v in o.sphera) + "), before any --set")
-    ap.add_argument("--twin", type=float, metavar="REL", help=o.twin_help)
+    if o.sphera:
+        ap.add_argument("--sphera", action="store_true", help="run with the numerical options of SPHERA's own "
+                        "input for this test (" + ", ".join(f"{k}={num(v)}" for k, v in o.sphera) + "), before any "
+                        "--set")
+    if o.twin_help:
+        ap.add_argument("--twin", type=float, metavar="REL", help=o.twin_help)
 
 
 def parse_runs(text, what, known, example, prefix=""):
@@ -178,7 +182,8 @@ def settings(args, prog, o, n_runs):
     twins (--jobs more than that gain nothing). Raises ToolError on a bad option or input;
     creates nothing."""
     _check_numbers(args)
-    extra = (list(o.sphera) if args.sphera else []) + parse_sets(args.sets, o.set_example)
+    twin = getattr(args, "twin", None)
+    extra = (list(o.sphera) if getattr(args, "sphera", False) else []) + parse_sets(args.sets, o.set_example)
     mixsph = os.path.abspath(args.mixsph)
     if not (os.path.isfile(mixsph) and os.access(mixsph, os.X_OK)):
         raise ToolError(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
@@ -187,11 +192,11 @@ def settings(args, prog, o, n_runs):
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
     if not math.isfinite(t_end):
         raise ToolError(f"{show(case)}: no numerics.t_end (give --t-end)")
-    g_twin = twin_gravity(case_json, extra, args.twin, show(case)) if args.twin is not None else None
+    g_twin = twin_gravity(case_json, extra, twin, show(case)) if twin is not None else None
     cores = usable_cores()
     jobs = min(args.jobs, max(1, n_runs))
     threads = args.threads if args.threads is not None else max(1, cores // jobs)
-    return Settings(prog, mixsph, case, case_json, case_sha, t_end, args.t_end, extra, args.twin, g_twin, cores,
+    return Settings(prog, mixsph, case, case_json, case_sha, t_end, args.t_end, extra, twin, g_twin, cores,
                     jobs, threads, os.path.abspath(args.out), args.reuse, args.checkpoint_every, args.progress)
 
 

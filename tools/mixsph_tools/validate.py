@@ -5,6 +5,8 @@
     mixsph-validate erosive-ensemble --group explicit DIR... --group implicit DIR...   # tools/erosive_ensemble.py
     mixsph-validate column --runs 1,2,3 --jobs 2      # tools/column_collapse.py, docs/validation/granular.md
     mixsph-validate convergence --set numerics.viscosity=1   # tools/vajont_convergence.py, docs/validation/vajont.md
+    mixsph-validate runout --aspects 0.5,1,2                 # tools/column_runout.py, docs/validation/granular.md
+    mixsph-validate step --case cases/column_collapse.json   # tools/step_independence.py, docs/validation/granular.md
 
 CASE's options, outputs and exit status are its script's (``mixsph-validate CASE --help``).
 """
@@ -18,6 +20,10 @@ CASES = {
     "erosive-ensemble": ("erosive_ensemble", "ensembles of erosive dam break runs: a scheme's difference "
                          "against its runs' drift under a round-off-size perturbation"),
     "column": ("column_collapse", "a dry granular column collapse: does the deposit come to rest?"),
+    "runout": ("column_runout", "dry columns of several aspect ratios against the run-out and final-height "
+               "laws of Lube et al. (2005); do their deposits rest?"),
+    "step": ("step_independence", "a case at its default time step, half and a quarter of it, against the "
+             "spread of gravity-perturbed twins"),
     "convergence": ("vajont_convergence", "Vajont V1 against the particle spacing, and the cheapest spacing "
                     "within a tolerance of the finest"),
 }

@@ -7,6 +7,8 @@
 #define MIXSPH_SCHEMA_H
 #include <stddef.h>
 
+/* Room for the name of a case entry (a medium, a body, a wall, a motion, a monitor). */
+#define SCHEMA_NAME_LEN 48
 
 enum case_type {
     CASE_NUMBER,  /* a finite number in [lo, hi] (open ends as flagged) -> double */

@@ -470,6 +470,27 @@ static mixsph_status read_full_scale(const struct case_reader *r, const cJSON *r
     return MIXSPH_OK;
 }
 
+mixsph_status case_number(const struct case_def *c, const char *key, double *value, char *err, size_t err_len)
+{
+    static const char *const own[] = {"numerics", "output"}; /* sections stored in struct case_def */
+    const char *dot = strchr(key, '.');
+    const struct case_section *sec = NULL;
+    const char *name = key;
+    if (!dot) {
+        sec = case_schema_find("case");
+    } else {
+        for (size_t k = 0; k < sizeof own / sizeof own[0]; k++)
+            if ((size_t)(dot - key) == strlen(own[k]) && strncmp(key, own[k], strlen(own[k])) == 0)
+                sec = case_schema_find(own[k]);
+        name = dot + 1;
+    }
+    const struct case_key *k = sec ? case_schema_key(sec, name) : NULL;
+    if (!k || case_schema_stored_number(k, c, value) != 0)
+        return status_set(err, err_len, MIXSPH_ERR_ARG,
+                          "%s: not a numeric key of the case's top level, numerics or output", key);
+    return MIXSPH_OK;
+}
+
 double case_profile_bin_count(const struct monitor_def *md)
 {
     return fmax(1.0, ceil((md->x_max - md->x_min) / md->bin));
@@ -653,62 +674,4 @@ void case_free(struct case_def *c)
         free(c->motions[i].vz);
         c->motions[i].t = c->motions[i].vx = c->motions[i].vz = NULL;
     }
-}
-
-/* ---- motion laws ------------------------------------------------------------------------- */
-
-/* Interval k and fraction f of law time tl: t[k] <= tl < t[k+1]; k = -1 before, n-1 after. */
-static void motion_locate(const struct motion *m, double tl, size_t *k, double *f, int *outside)
-{
-    *outside = 0;
-    if (m->n == 1 || tl <= m->t[0]) {
-        *k = 0;
-        *f = 0.0;
-        *outside = 1;
-        return;
-    }
-    if (tl >= m->t[m->n - 1]) {
-        *k = m->n - 1;
-        *f = 0.0;
-        *outside = 1;
-        return;
-    }
-    size_t lo = 0, hi = m->n - 1;
-    while (hi - lo > 1) {
-        size_t mid = (lo + hi) / 2;
-        if (m->t[mid] <= tl) lo = mid;
-        else hi = mid;
-    }
-    *k = lo;
-    *f = (tl - m->t[lo]) / (m->t[lo + 1] - m->t[lo]);
-}
-
-void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz)
-{
-    size_t k;
-    double f;
-    int outside;
-    motion_locate(m, t / m->time_scale, &k, &f, &outside);
-    if (outside) {
-        *vx = m->speed_scale * m->vx[k];
-        *vz = m->speed_scale * m->vz[k];
-        return;
-    }
-    *vx = m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k]));
-    *vz = m->speed_scale * (m->vz[k] + f * (m->vz[k + 1] - m->vz[k]));
-}
-
-void case_motion_acceleration(const struct motion *m, double t, double *ax, double *az)
-{
-    size_t k;
-    double f;
-    int outside;
-    motion_locate(m, t / m->time_scale, &k, &f, &outside);
-    if (outside) {
-        *ax = *az = 0.0;
-        return;
-    }
-    const double dt = (m->t[k + 1] - m->t[k]) * m->time_scale;
-    *ax = m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt;
-    *az = m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt;
 }

@@ -7,11 +7,12 @@
 #include "geometry.h"
 #include "medium.h"
 #include "mixsph.h"
+#include "wall_def.h"
 
 #define CASE_NAME_LEN MEDIUM_NAME_LEN /* names of all entries */
 #define CASE_MAX_MEDIA 8
 #define CASE_MAX_BODIES 16
-#define CASE_MAX_WALLS 16
+#define CASE_MAX_WALLS WALLS_MAX
 #define CASE_MAX_MOTIONS 8
 #define CASE_MAX_MONITORS 16
 
@@ -20,24 +21,6 @@ struct body {
     int medium;               /* index into media */
     struct polyline polygon;  /* closed implicitly [m] */
     double z_min, z_max;      /* the body is clipped to z_min <= z <= z_max [m] */
-};
-
-struct motion {
-    char name[CASE_NAME_LEN];
-    size_t n;
-    double *t, *vx, *vz;      /* velocity law, linear between rows [s], [m/s] */
-    double speed_scale;       /* velocities are multiplied by this [-] */
-    double time_scale;        /* the law is stretched in time by this [-] */
-};
-
-enum wall_slip { WALL_NO_SLIP = 0, WALL_FREE_SLIP = 1 };
-
-struct wall {
-    char name[CASE_NAME_LEN];
-    struct polyline line;     /* open polyline [m] */
-    int side;                 /* +1: fluid on the left of the direction of travel, -1: right */
-    int motion;               /* index into motions, -1 for a fixed wall */
-    int slip;                 /* enum wall_slip */
 };
 
 #define CASE_MAX_PROFILE_TIMES 16
@@ -146,6 +129,11 @@ mixsph_status case_read_file(const char *path, char **text, char *err, size_t er
 
 void case_free(struct case_def *c);
 
+/** The value a case gives a numeric key of its top level, `numerics` or `output` ("numerics.cfl",
+ *  "t_end"...: the file's, an override's or the default; a choice as its value). MIXSPH_ERR_ARG,
+ *  with a message, for any other key. */
+mixsph_status case_number(const struct case_def *c, const char *key, double *value, char *err, size_t err_len);
+
 /** Full-scale elevation of a lab elevation z [m] (the case's full_scale map; z itself without one). */
 double case_full_scale_z(const struct case_def *c, double z);
 /** The error (13) [%] of a full-scale elevation Z against the case's reference (NAN without one). */
@@ -154,10 +142,5 @@ double case_full_scale_error(const struct case_def *c, double Z);
 /** Number of x bins of a profile monitor: ceil(width / bin), at least 1 (not finite when the
  *  bin is too small to count them; the budget refuses that). */
 double case_profile_bin_count(const struct monitor_def *md);
-
-/** Velocity of a motion law at time t (linear between rows, held at the ends). */
-void case_motion_velocity(const struct motion *m, double t, double *vx, double *vz);
-/** Acceleration of a motion law at time t (slope of the current interval). */
-void case_motion_acceleration(const struct motion *m, double t, double *ax, double *az);
 
 #endif

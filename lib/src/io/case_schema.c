@@ -448,6 +448,19 @@ mixsph_status case_schema_points(const struct case_reader *r, const cJSON *obj, 
 
 static void *field_of(const struct case_key *k, void *base) { return base && k->field ? (char *)base + k->field - 1 : NULL; }
 
+int case_schema_stored_number(const struct case_key *k, const void *base, double *value)
+{
+    const void *f = field_of(k, (void *)base);
+    if (!f) return -1;
+    switch (k->type) {
+    case CASE_NUMBER: *value = *(const double *)f; return 0;
+    case CASE_INTEGER:
+    case CASE_BOOL:
+    case CASE_CHOICE: *value = *(const int *)f; return 0;
+    default: return -1;
+    }
+}
+
 /* A number of the key's type in its range. */
 static mixsph_status read_number(const struct case_reader *r, const cJSON *it, const char *kp, const struct case_key *k,
                                  double *v)

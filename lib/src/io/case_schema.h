@@ -37,6 +37,10 @@ mixsph_status case_schema_read(const struct case_reader *r, const struct cJSON *
 mixsph_status case_schema_read_key(const struct case_reader *r, const struct cJSON *obj, const char *path,
                                    const struct case_key *k, void *base);
 
+/** The value stored in the field of a number, integer, boolean or choice key of the struct at
+ *  `base` (a choice: its value). -1 when the key has no such field, 0 otherwise. */
+int case_schema_stored_number(const struct case_key *k, const void *base, double *value);
+
 /** An array of n >= min_n finite numbers (caller frees *out). */
 mixsph_status case_schema_numbers(const struct case_reader *r, const struct cJSON *obj, const char *path,
                                   const char *key, size_t min_n, double **out, size_t *n);

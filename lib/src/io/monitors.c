@@ -53,34 +53,34 @@ static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffi
     memcpy(name, s->cfg.monitors[m].name, a);
     memcpy(name + a, suffix, b + 1);
     name[CASE_NAME_LEN - 1] = '\0'; /* never cut: case.c checked the length */
-    s->out_monitor[s->n_out] = OUT_CODE(m, kind);
-    memcpy(s->out_name[s->n_out++], name, CASE_NAME_LEN);
+    s->out.monitor[s->out.n] = OUT_CODE(m, kind);
+    memcpy(s->out.name[s->out.n++], name, CASE_NAME_LEN);
 }
 
 void monitors_init(mixsph_sim *s)
 {
-    s->n_out = 0;
+    s->out.n = 0;
     const size_t n_diag = s->cfg.viscosity_implicit ? OUT_N_DIAG : OUT_VISC_ITER;
     for (size_t k = 0; k < n_diag; k++) {
-        s->out_monitor[s->n_out] = OUT_DIAG_CODE(k);
-        snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", diag_names[k]);
+        s->out.monitor[s->out.n] = OUT_DIAG_CODE(k);
+        snprintf(s->out.name[s->out.n++], CASE_NAME_LEN, "%s", diag_names[k]);
     }
     for (size_t k = 0; k < s->cfg.n_monitors; k++) {
-        s->profile_next[k] = 0;
+        s->out.profile_next[k] = 0;
         if (s->cfg.monitors[k].kind == MONITOR_PROFILE) continue;
-        s->out_monitor[s->n_out] = OUT_CODE(k, OUTK_VALUE);
-        snprintf(s->out_name[s->n_out++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
+        s->out.monitor[s->out.n] = OUT_CODE(k, OUTK_VALUE);
+        snprintf(s->out.name[s->out.n++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
     }
     /* case.c checked that the names fit and that there are at most CASE_MAX_SCALAR_OUTPUTS */
     const struct full_scale *fs = &s->cfg.full_scale;
     for (size_t k = 0; fs->on && k < s->cfg.n_monitors; k++)
         if (s->cfg.monitors[k].kind == MONITOR_MAX_ELEVATION) out_add_full_scale(s, (int)k, OUTK_FULL_Z, CASE_FULL_SCALE_SUFFIX_Z);
     if (fs->on && fs->ref_monitor >= 0) out_add_full_scale(s, fs->ref_monitor, OUTK_FULL_ERR, CASE_FULL_SCALE_SUFFIX_ERR);
-    for (size_t k = 0; k < s->n_out; k++) {
-        s->out_max[k] = s->out_min[k] = NAN;
-        s->out_tmax[k] = s->out_tmin[k] = NAN;
+    for (size_t k = 0; k < s->out.n; k++) {
+        s->out.max[k] = s->out.min[k] = NAN;
+        s->out.tmax[k] = s->out.tmin[k] = NAN;
     }
-    s->n_samples = 0;
+    s->out.n_samples = 0;
 }
 
 static int in_region(const struct monitor_def *md, double x, double z)
@@ -90,15 +90,15 @@ static int in_region(const struct monitor_def *md, double x, double z)
 
 static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     double best = NAN;
     if (md->kind == MONITOR_WALL_PRESSURE) {
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P->x[i], P->z[i])) continue;
             double d;
             int at_end;
-            walls_signed_distance(&s->cfg, s->walls, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
-            if (d < -s->dx) continue; /* first layer only */
+            walls_signed_distance(&s->phys.walls, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
+            if (d < -s->phys.dx) continue; /* first layer only */
             if (isnan(best) || P->p[i] > best) best = P->p[i];
         }
         return best;
@@ -122,27 +122,27 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
 
 double monitors_value(const mixsph_sim *s, size_t k)
 {
-    const struct particles *P = &s->P;
-    if (s->out_monitor[k] >= 0) {
-        const int m = s->out_monitor[k] % CASE_MAX_MONITORS, kind = s->out_monitor[k] / CASE_MAX_MONITORS;
+    const struct particles *P = &s->phys.P;
+    if (s->out.monitor[k] >= 0) {
+        const int m = s->out.monitor[k] % CASE_MAX_MONITORS, kind = s->out.monitor[k] / CASE_MAX_MONITORS;
         if (kind == OUTK_FULL_ERR) {
             /* the error (13) of the highest value so far of the monitor's own output */
-            for (size_t j = 0; j < s->n_out; j++)
-                if (s->out_monitor[j] == OUT_CODE(m, OUTK_VALUE))
-                    return isnan(s->out_max[j]) ? NAN
-                                                : case_full_scale_error(&s->cfg, case_full_scale_z(&s->cfg, s->out_max[j]));
+            for (size_t j = 0; j < s->out.n; j++)
+                if (s->out.monitor[j] == OUT_CODE(m, OUTK_VALUE))
+                    return isnan(s->out.max[j]) ? NAN
+                                                : case_full_scale_error(&s->cfg, case_full_scale_z(&s->cfg, s->out.max[j]));
             return NAN;
         }
         const double v = monitor_eval(s, &s->cfg.monitors[m]);
         return kind == OUTK_FULL_Z && !isnan(v) ? case_full_scale_z(&s->cfg, v) : v;
     }
-    const int d = -1 - s->out_monitor[k];
-    if (d == OUT_DT) return s->dt;
-    if (d == OUT_LOST) return (double)s->n_lost;
-    if (d == OUT_CLIPS) return (double)s->n_clipped;
-    if (d == OUT_FIXED) return (double)s->n_fixed;
-    if (d == OUT_VISC_ITER) return (double)s->viscous_last.iterations;
-    if (d == OUT_VISC_RES) return s->viscous_last.residual;
+    const int d = -1 - s->out.monitor[k];
+    if (d == OUT_DT) return s->phys.dt;
+    if (d == OUT_LOST) return (double)s->phys.n_lost;
+    if (d == OUT_CLIPS) return (double)s->phys.n_clipped;
+    if (d == OUT_FIXED) return (double)s->phys.n_fixed;
+    if (d == OUT_VISC_ITER) return (double)s->work.viscous_last.iterations;
+    if (d == OUT_VISC_RES) return s->work.viscous_last.residual;
     double ke = 0.0, mass = 0.0, vmax = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
@@ -157,13 +157,13 @@ double monitors_value(const mixsph_sim *s, size_t k)
 mixsph_status monitors_open(mixsph_sim *s)
 {
     char path[600];
-    snprintf(path, sizeof path, "%s/monitors.csv", s->out_dir);
-    s->monitor_csv = fopen(path, "w");
-    if (!s->monitor_csv) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
-    fprintf(s->monitor_csv, "t,step");
-    for (size_t k = 0; k < s->n_out; k++) fprintf(s->monitor_csv, ",%s", s->out_name[k]);
-    fprintf(s->monitor_csv, "\n");
-    fflush(s->monitor_csv);
+    snprintf(path, sizeof path, "%s/monitors.csv", s->out.dir);
+    s->out.monitor_csv = fopen(path, "w");
+    if (!s->out.monitor_csv) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    fprintf(s->out.monitor_csv, "t,step");
+    for (size_t k = 0; k < s->out.n; k++) fprintf(s->out.monitor_csv, ",%s", s->out.name[k]);
+    fprintf(s->out.monitor_csv, "\n");
+    fflush(s->out.monitor_csv);
     return MIXSPH_OK;
 }
 
@@ -171,7 +171,7 @@ mixsph_status monitors_open(mixsph_sim *s)
 static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, const char *tag, double t_req,
                                    const char *note)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const size_t nb = (size_t)case_profile_bin_count(md); /* >= 1, within output.max_profile_bins (budget.c) */
     double *top = malloc(nb * sizeof *top);
     if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
@@ -181,17 +181,17 @@ static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, 
         if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
         size_t b = (size_t)((P->x[i] - md->x_min) / md->bin);
         if (b >= nb) b = nb - 1;
-        if (P->z[i] + 0.5 * s->dx > top[b]) top[b] = P->z[i] + 0.5 * s->dx;
+        if (P->z[i] + 0.5 * s->phys.dx > top[b]) top[b] = P->z[i] + 0.5 * s->phys.dx;
     }
     char path[700];
-    snprintf(path, sizeof path, "%s/profile_%s_%s.csv", s->out_dir, md->name, tag);
+    snprintf(path, sizeof path, "%s/profile_%s_%s.csv", s->out.dir, md->name, tag);
     FILE *f = fopen(path, "w");
     if (!f) {
         free(top);
         return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     }
     fprintf(f, "# profile %s of %s at t = %.9g s (requested %.9g s): top of the medium per x bin%s\nx,z_top\n",
-            md->name, s->cfg.media[md->medium].name, s->t, t_req, note);
+            md->name, s->cfg.media[md->medium].name, s->phys.t, t_req, note);
     for (size_t b = 0; b < nb; b++) {
         fprintf(f, "%.7g,", md->x_min + (b + 0.5) * md->bin);
         if (isfinite(top[b])) fprintf(f, "%.7g\n", top[b]);
@@ -208,15 +208,15 @@ mixsph_status monitors_profiles(mixsph_sim *s)
 {
     for (size_t k = 0; k < s->cfg.n_monitors; k++) {
         const struct monitor_def *md = &s->cfg.monitors[k];
-        if (md->kind != MONITOR_PROFILE || s->profile_next[k] >= md->n_times || s->t < md->times[s->profile_next[k]])
+        if (md->kind != MONITOR_PROFILE || s->out.profile_next[k] >= md->n_times || s->phys.t < md->times[s->out.profile_next[k]])
             continue;
-        if (s->out_dir[0]) {
+        if (s->out.dir[0]) {
             char tag[32];
-            snprintf(tag, sizeof tag, "%zu", s->profile_next[k]);
-            mixsph_status st = profile_write(s, md, tag, md->times[s->profile_next[k]], "");
+            snprintf(tag, sizeof tag, "%zu", s->out.profile_next[k]);
+            mixsph_status st = profile_write(s, md, tag, md->times[s->out.profile_next[k]], "");
             if (st != MIXSPH_OK) return st;
         }
-        s->profile_next[k]++;
+        s->out.profile_next[k]++;
     }
     return MIXSPH_OK;
 }
@@ -224,12 +224,12 @@ mixsph_status monitors_profiles(mixsph_sim *s)
 /* Rewrite the at_max_of profiles of case monitor m, which has just reached a new maximum. */
 static mixsph_status profiles_at_max(mixsph_sim *s, int m)
 {
-    for (size_t k = 0; s->out_dir[0] && k < s->cfg.n_monitors; k++) {
+    for (size_t k = 0; s->out.dir[0] && k < s->cfg.n_monitors; k++) {
         const struct monitor_def *md = &s->cfg.monitors[k];
         if (md->kind != MONITOR_PROFILE || md->at_max_of != m) continue;
         char note[96];
         snprintf(note, sizeof note, ", at the maximum of %s so far", s->cfg.monitors[m].name);
-        mixsph_status st = profile_write(s, md, "atmax", s->t, note);
+        mixsph_status st = profile_write(s, md, "atmax", s->phys.t, note);
         if (st != MIXSPH_OK) return st;
     }
     return MIXSPH_OK;
@@ -239,29 +239,29 @@ mixsph_status monitors_sample(mixsph_sim *s)
 {
 
     double v[SIM_MAX_OUTPUTS];
-    for (size_t k = 0; k < s->n_out; k++) {
+    for (size_t k = 0; k < s->out.n; k++) {
         v[k] = monitors_value(s, k);
         if (isnan(v[k])) continue;
-        if (isnan(s->out_max[k]) || v[k] > s->out_max[k]) {
-            s->out_max[k] = v[k];
-            s->out_tmax[k] = s->t;
-            const int code = s->out_monitor[k];
+        if (isnan(s->out.max[k]) || v[k] > s->out.max[k]) {
+            s->out.max[k] = v[k];
+            s->out.tmax[k] = s->phys.t;
+            const int code = s->out.monitor[k];
             if (code >= 0 && code < CASE_MAX_MONITORS && s->cfg.monitors[code].kind == MONITOR_MAX_ELEVATION) {
                 mixsph_status st = profiles_at_max(s, code);
                 if (st != MIXSPH_OK) return st;
             }
         }
-        if (isnan(s->out_min[k]) || v[k] < s->out_min[k]) {
-            s->out_min[k] = v[k];
-            s->out_tmin[k] = s->t;
+        if (isnan(s->out.min[k]) || v[k] < s->out.min[k]) {
+            s->out.min[k] = v[k];
+            s->out.tmin[k] = s->phys.t;
         }
     }
-    s->n_samples++;
-    if (s->monitor_csv) {
-        fprintf(s->monitor_csv, "%.9g,%llu", s->t, (unsigned long long)s->step);
-        for (size_t k = 0; k < s->n_out; k++) fprintf(s->monitor_csv, ",%.9g", v[k]);
-        fprintf(s->monitor_csv, "\n");
-        if (fflush(s->monitor_csv) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s/monitors.csv: write failed", s->out_dir);
+    s->out.n_samples++;
+    if (s->out.monitor_csv) {
+        fprintf(s->out.monitor_csv, "%.9g,%llu", s->phys.t, (unsigned long long)s->phys.step);
+        for (size_t k = 0; k < s->out.n; k++) fprintf(s->out.monitor_csv, ",%.9g", v[k]);
+        fprintf(s->out.monitor_csv, "\n");
+        if (fflush(s->out.monitor_csv) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s/monitors.csv: write failed", s->out.dir);
     }
     return MIXSPH_OK;
 }
@@ -316,8 +316,8 @@ static void csv_run_write(FILE *f, const struct csv_run *r, size_t i)
 mixsph_status monitors_snapshot(mixsph_sim *s)
 {
     char path[600];
-    snprintf(path, sizeof path, "%s/snap_%04d.csv", s->out_dir, s->snap_index);
-    const struct particles *P = &s->P;
+    snprintf(path, sizeof path, "%s/snap_%04d.csv", s->out.dir, s->out.snap_index);
+    const struct particles *P = &s->phys.P;
     const struct particle_field *cols[64];
     if (particle_field_count > 64) return SIM_FAIL(s, MIXSPH_ERR_ARG, "%s: more particle fields than 64", path);
     const size_t nc = csv_fields(P, cols);
@@ -344,7 +344,7 @@ mixsph_status monitors_snapshot(mixsph_sim *s)
         free(runs);
         return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     }
-    fprintf(f, "# t = %.9g s\n", s->t);
+    fprintf(f, "# t = %.9g s\n", s->phys.t);
     for (size_t c = 0; c < nc; c++) fprintf(f, "%s%s", c ? "," : "", cols[c]->columns);
     fputc('\n', f);
     for (size_t i = 0; i < P->n; i++)
@@ -352,6 +352,6 @@ mixsph_status monitors_snapshot(mixsph_sim *s)
     free(runs);
     const int bad = ferror(f);
     if (fclose(f) != 0 || bad) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: write failed", path);
-    s->snap_index++;
+    s->out.snap_index++;
     return MIXSPH_OK;
 }

@@ -334,10 +334,10 @@ static mixsph_status run_create(mixsph_sim *s, struct output *o)
     if (!bad)
         bad = dset_string(g, "case_json", s->case_text ? s->case_text : "") ||
               attr_str(g, "case_origin", s->case_origin ? s->case_origin : "") || attr_str(g, "overrides", ov) ||
-              attr_f64(g, "dx", s->dx) || attr_f64(g, "h", s->h) || attr_f64(g, "t_end", s->cfg.t_end) ||
+              attr_f64(g, "dx", s->phys.dx) || attr_f64(g, "h", s->phys.h) || attr_f64(g, "t_end", s->cfg.t_end) ||
               attr_f64(g, "snapshot_interval", s->cfg.snapshot_interval) ||
               attr_f64(g, "monitor_interval", s->cfg.monitor_interval) || attr_f64(g, "gravity", s->cfg.g) ||
-              attr_i64(g, "n_particles", (long long)s->n_fluid) || attr_i64(g, "n_wall_particles", (long long)s->n_wall) ||
+              attr_i64(g, "n_particles", (long long)s->phys.n_fluid) || attr_i64(g, "n_wall_particles", (long long)s->phys.n_wall) ||
               attr_strs(g, "media", media, s->cfg.n_media) || attr_strs(g, "walls", walls, s->cfg.n_walls) ||
               attr_str(g, "states", "0 mobile, 1 fixed (granular, elastic-plastic regime), 2 wall, 3 lost");
     if (g >= 0) H5Gclose(g);
@@ -421,7 +421,7 @@ static mixsph_status run_continue(mixsph_sim *s, struct output *o)
                         "folder",
                         o->path);
     for (int pass = 0;; pass++) {
-        struct scan sc = {s, o, s->snap_index, {{0}}, 0, 0};
+        struct scan sc = {s, o, s->out.snap_index, {{0}}, 0, 0};
         o->n_snaps = 0;
         hsize_t idx = 0;
         if (H5Literate_by_name(o->file, "snapshots", H5_INDEX_NAME, H5_ITER_INC, &idx, scan_snapshot, &sc, H5P_DEFAULT) < 0) {
@@ -441,7 +441,7 @@ static mixsph_status run_continue(mixsph_sim *s, struct output *o)
     }
     long long restarts = 0;
     attr_read_i64(o->file, "restarts", &restarts);
-    if (attr_i64(o->file, "restarts", restarts + 1) || attr_f64(o->file, "last_restart_time", s->t) ||
+    if (attr_i64(o->file, "restarts", restarts + 1) || attr_f64(o->file, "last_restart_time", s->phys.t) ||
         attr_i64(o->file, "n_snapshots", (long long)o->n_snaps) || H5Fflush(o->file, H5F_SCOPE_LOCAL) < 0) {
         H5_FAIL(s, "cannot update the run file", o->path);
         return MIXSPH_ERR_IO;
@@ -509,14 +509,14 @@ static int xdmf_write(const mixsph_sim *s, const struct output *o)
         for (size_t k = 0; k < particle_field_count; k++) {
             const struct particle_field *pf = &particle_fields[k];
             if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == (PF_HDF5 | PF_GEOMETRY) &&
-                particle_field_present(pf, s->P.features))
+                particle_field_present(pf, s->phys.P.features))
                 xdmf_item(f, "          ", r->n, (int)pf->components, pf->type == PF_F64 ? "Float" : "UInt",
                           (int)particle_field_size(pf->type), r->index, pf->name);
         }
         fprintf(f, "        </Geometry>\n");
         for (size_t k = 0; k < particle_field_count; k++) {
             const struct particle_field *pf = &particle_fields[k];
-            if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == PF_HDF5 && particle_field_present(pf, s->P.features))
+            if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == PF_HDF5 && particle_field_present(pf, s->phys.P.features))
                 xdmf_attribute(f, r, pf);
         }
         fprintf(f, "      </Grid>\n");
@@ -538,8 +538,8 @@ mixsph_status output_open(mixsph_sim *s, int resume)
     struct output *o = calloc(1, sizeof *o);
     if (!o) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     o->file = -1;
-    snprintf(o->path, sizeof o->path, "%s/%s", s->out_dir, RUN_FILE);
-    snprintf(o->xdmf, sizeof o->xdmf, "%s/%s", s->out_dir, XDMF_FILE);
+    snprintf(o->path, sizeof o->path, "%s/%s", s->out.dir, RUN_FILE);
+    snprintf(o->xdmf, sizeof o->xdmf, "%s/%s", s->out.dir, XDMF_FILE);
     struct quiet q;
     quiet_on(&q);
     mixsph_status st;
@@ -549,8 +549,8 @@ mixsph_status output_open(mixsph_sim *s, int resume)
         st = run_create(s, o);
         /* a restored run in a new folder: its snapshots start at the restored index */
         if (st == MIXSPH_OK && resume &&
-            (attr_i64(o->file, "restarts", 1) || attr_f64(o->file, "last_restart_time", s->t) ||
-             attr_i64(o->file, "first_snapshot", s->snap_index))) {
+            (attr_i64(o->file, "restarts", 1) || attr_f64(o->file, "last_restart_time", s->phys.t) ||
+             attr_i64(o->file, "first_snapshot", s->out.snap_index))) {
             H5_FAIL(s, "cannot write the metadata", o->path);
             st = MIXSPH_ERR_IO;
         }
@@ -558,14 +558,14 @@ mixsph_status output_open(mixsph_sim *s, int resume)
     quiet_off(&q);
     if (st == MIXSPH_OK && xdmf_write(s, o) != 0)
         st = SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));
-    s->h5 = o;
+    s->out.h5 = o;
     if (st != MIXSPH_OK) output_close(s);
     return st;
 }
 
 void output_close(mixsph_sim *s)
 {
-    struct output *o = s->h5;
+    struct output *o = s->out.h5;
     if (!o) return;
     if (o->file >= 0) {
         struct quiet q;
@@ -576,7 +576,7 @@ void output_close(mixsph_sim *s)
     free(o->snaps);
     free(o->scratch);
     free(o);
-    s->h5 = NULL;
+    s->out.h5 = NULL;
 }
 
 static void *scratch(struct output *o, size_t bytes)
@@ -639,7 +639,7 @@ static int write_field(struct output *o, hid_t g, const struct particles *P, int
 
 static int write_snapshot(mixsph_sim *s, struct output *o, long index)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     int by_id = 1;
     for (size_t i = 0; i < P->n && by_id; i++) by_id = P->id[i] < P->n;
     char name[64];
@@ -650,7 +650,7 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
     const hid_t g = H5Gcreate2(o->file, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
     if (g < 0) return -1;
     /* the attribute index is written last: a group without it is incomplete */
-    int bad = attr_f64(g, "time", s->t) || attr_i64(g, "step", (long long)s->step) ||
+    int bad = attr_f64(g, "time", s->phys.t) || attr_i64(g, "step", (long long)s->phys.step) ||
               attr_i64(g, "n", (long long)P->n) || attr_str(g, "time_units", "s");
     for (size_t k = 0; k < particle_field_count && !bad; k++) {
         const struct particle_field *f = &particle_fields[k];
@@ -666,14 +666,14 @@ static int write_snapshot(mixsph_sim *s, struct output *o, long index)
 
 mixsph_status output_snapshot(mixsph_sim *s)
 {
-    const long index = s->snap_index;
+    const long index = s->out.snap_index;
     const double t0 = clock_monotonic_s();
     mixsph_status st = MIXSPH_OK;
-    if (s->csv_snapshots_off) s->snap_index++;
+    if (s->out.csv_snapshots_off) s->out.snap_index++;
     else st = monitors_snapshot(s);
     const double t1 = clock_monotonic_s();
-    s->out_seconds[T_CSV] += t1 - t0;
-    struct output *o = s->h5;
+    s->out.seconds[T_CSV] += t1 - t0;
+    struct output *o = s->out.h5;
     if (st != MIXSPH_OK || !o) return st;
     struct quiet q;
     quiet_on(&q);
@@ -681,10 +681,10 @@ mixsph_status output_snapshot(mixsph_sim *s)
     if (bad) H5_FAIL(s, "cannot write a snapshot", o->path);
     quiet_off(&q);
     if (bad) return MIXSPH_ERR_IO;
-    if (snaps_push(o, (struct snap_rec){index, s->t, s->step, s->P.n}))
+    if (snaps_push(o, (struct snap_rec){index, s->phys.t, s->phys.step, s->phys.P.n}))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     if (xdmf_write(s, o) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", o->xdmf, strerror(errno));
-    s->out_seconds[T_HDF5] += clock_monotonic_s() - t1;
+    s->out.seconds[T_HDF5] += clock_monotonic_s() - t1;
     return MIXSPH_OK;
 }
 
@@ -693,11 +693,11 @@ mixsph_status output_snapshot(mixsph_sim *s)
 mixsph_status output_resume_monitors(mixsph_sim *s)
 {
     char path[600];
-    snprintf(path, sizeof path, "%s/monitors.csv", s->out_dir);
+    snprintf(path, sizeof path, "%s/monitors.csv", s->out.dir);
     FILE *f = fopen(path, "r");
     if (!f) return monitors_open(s);
     /* keep the header line and the first n_samples rows */
-    long keep_lines = 1 + s->n_samples, lines = 0;
+    long keep_lines = 1 + s->out.n_samples, lines = 0;
     off_t pos = 0;
     int c;
     while (lines < keep_lines && (c = fgetc(f)) != EOF) {
@@ -706,8 +706,8 @@ mixsph_status output_resume_monitors(mixsph_sim *s)
     }
     fclose(f);
     if (truncate(path, pos) != 0) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot truncate: %s", path, strerror(errno));
-    s->monitor_csv = fopen(path, "a");
-    if (!s->monitor_csv) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
+    s->out.monitor_csv = fopen(path, "a");
+    if (!s->out.monitor_csv) return SIM_FAIL(s, MIXSPH_ERR_IO, "%s: cannot write: %s", path, strerror(errno));
     return MIXSPH_OK;
 }
 
@@ -743,8 +743,8 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
         bad = attr_str(f, "format", "mixsph-checkpoint") || attr_i64(f, "format_version", RUN_FORMAT_VERSION) ||
               attr_str(f, "mixsph_version", MIXSPH_VERSION) || attr_str(f, "case_name", s->cfg.name) ||
               attr_str(f, "case_origin", s->case_origin ? s->case_origin : "") || attr_str(f, "created_utc", created) ||
-              attr_f64(f, "time", s->t) || attr_i64(f, "step", (long long)s->step) ||
-              attr_f64(f, "run_wall_time_s", s->run_wall_s) ||
+              attr_f64(f, "time", s->phys.t) || attr_i64(f, "step", (long long)s->phys.step) ||
+              attr_f64(f, "run_wall_time_s", s->out.run_wall_s) ||
               dset_write(f, "state", H5T_STD_U8LE, H5T_NATIVE_UINT8, len, 0, buf, "1",
                          "mixsph_sim_save_state buffer (versioned, checksummed; same build and machine type)");
     if (f >= 0) bad |= H5Fclose(f) < 0;
@@ -766,8 +766,8 @@ mixsph_status mixsph_sim_write_checkpoint(mixsph_sim *s, const char *path)
     if (bad) remove(tmp);
     free(tmp);
     const double spent = clock_monotonic_s() - t0;
-    s->out_seconds[T_CKPT] += spent;
-    s->run_wall_s += spent; /* the run's time includes its checkpoints (after this one's attribute) */
+    s->out.seconds[T_CKPT] += spent;
+    s->out.run_wall_s += spent; /* the run's time includes its checkpoints (after this one's attribute) */
     return bad ? MIXSPH_ERR_IO : MIXSPH_OK;
 }
 
@@ -826,13 +826,13 @@ mixsph_status output_read_checkpoint(const char *path, unsigned char **state, si
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)
 {
     if (!s) return MIXSPH_ERR_ARG;
-    s->csv_snapshots_off = !on;
+    s->out.csv_snapshots_off = !on;
     return MIXSPH_OK;
 }
 
 void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, double *checkpoint_s)
 {
-    if (csv_s) *csv_s = s ? s->out_seconds[T_CSV] : 0.0;
-    if (hdf5_s) *hdf5_s = s ? s->out_seconds[T_HDF5] : 0.0;
-    if (checkpoint_s) *checkpoint_s = s ? s->out_seconds[T_CKPT] : 0.0;
+    if (csv_s) *csv_s = s ? s->out.seconds[T_CSV] : 0.0;
+    if (hdf5_s) *hdf5_s = s ? s->out.seconds[T_HDF5] : 0.0;
+    if (checkpoint_s) *checkpoint_s = s ? s->out.seconds[T_CKPT] : 0.0;
 }

@@ -19,7 +19,7 @@
 mixsph_status output_open(mixsph_sim *s, int resume)
 {
     (void)resume;
-    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "no output folder (%s): run files are HDF5 files", s->out_dir);
+    return SIM_FAIL(s, MIXSPH_ERR_IO, NO_HDF5 "no output folder (%s): run files are HDF5 files", s->out.dir);
 }
 
 /* Never reached: output_open fails, so no output folder is ever set. */
@@ -55,7 +55,7 @@ mixsph_status output_read_checkpoint(const char *path, unsigned char **state, si
 mixsph_status mixsph_sim_set_csv_snapshots(mixsph_sim *s, int on)
 {
     if (!s) return MIXSPH_ERR_ARG;
-    s->csv_snapshots_off = !on;
+    s->out.csv_snapshots_off = !on;
     return MIXSPH_OK;
 }
 

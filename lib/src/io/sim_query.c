@@ -12,6 +12,13 @@
 #include "sim.h"
 #include "status.h"
 
+mixsph_status mixsph_sim_case_number(const mixsph_sim *s, const char *key, double *value)
+{
+    if (!s || !key || !value) return MIXSPH_ERR_ARG;
+    char unused[160]; /* s is the host's to read: it keeps no message of a query */
+    return case_number(&s->cfg, key, value, unused, sizeof unused);
+}
+
 size_t mixsph_sim_wall_count(const mixsph_sim *s)
 {
     return s ? s->cfg.n_walls : 0;
@@ -111,7 +118,7 @@ static const struct particle_field *view_field(const mixsph_sim *s, size_t k)
 {
     for (size_t r = 0; r < particle_field_count; r++) {
         const struct particle_field *f = &particle_fields[r];
-        if ((f->where & PF_VIEW) && particle_field_present(f, s->P.features) && k-- == 0) return f;
+        if ((f->where & PF_VIEW) && particle_field_present(f, s->phys.P.features) && k-- == 0) return f;
     }
     return NULL;
 }
@@ -135,8 +142,8 @@ static void view_fill(const mixsph_sim *s, const struct particle_field *pf, mixs
     f->owner = particle_field_owner_name(pf->owner);
     f->components = pf->components;
     f->type = types[pf->type];
-    f->n = s->P.n;
-    for (unsigned c = 0; c < pf->components; c++) f->data[c] = particles_array(&s->P, pf->member[c]);
+    f->n = s->phys.P.n;
+    for (unsigned c = 0; c < pf->components; c++) f->data[c] = particles_array(&s->phys.P, pf->member[c]);
 }
 
 mixsph_status mixsph_sim_particle_field(const mixsph_sim *s, size_t k, mixsph_particle_field *f)

@@ -140,38 +140,38 @@ static void put_source(struct writer *w, const mixsph_sim *s)
 /* Scalars, walls and particles, in one order used by both directions: `io` copies between the
  * simulation's field and the stream (writer or reader). */
 #define STATE_SCALARS(IO, s)                                           \
-    IO(&(s)->t, sizeof(s)->t) IO(&(s)->dt, sizeof(s)->dt)              \
-    IO(&(s)->step, sizeof(s)->step) IO(&(s)->n_lost, sizeof(s)->n_lost) \
-    IO(&(s)->n_clipped, sizeof(s)->n_clipped) IO(&(s)->n_fixed, sizeof(s)->n_fixed) \
-    IO(&(s)->n_samples, sizeof(s)->n_samples) IO(&(s)->next_sample, sizeof(s)->next_sample) \
-    IO(&(s)->next_snapshot, sizeof(s)->next_snapshot) IO(&(s)->snap_index, sizeof(s)->snap_index) \
-    IO(&(s)->viscous_last.iterations, sizeof(s)->viscous_last.iterations)                       \
-    IO(&(s)->viscous_last.residual, sizeof(s)->viscous_last.residual)                           \
-    IO(&(s)->viscous_iterations, sizeof(s)->viscous_iterations)
+    IO(&(s)->phys.t, sizeof(s)->phys.t) IO(&(s)->phys.dt, sizeof(s)->phys.dt)              \
+    IO(&(s)->phys.step, sizeof(s)->phys.step) IO(&(s)->phys.n_lost, sizeof(s)->phys.n_lost) \
+    IO(&(s)->phys.n_clipped, sizeof(s)->phys.n_clipped) IO(&(s)->phys.n_fixed, sizeof(s)->phys.n_fixed) \
+    IO(&(s)->out.n_samples, sizeof(s)->out.n_samples) IO(&(s)->out.next_sample, sizeof(s)->out.next_sample) \
+    IO(&(s)->out.next_snapshot, sizeof(s)->out.next_snapshot) IO(&(s)->out.snap_index, sizeof(s)->out.snap_index) \
+    IO(&(s)->work.viscous_last.iterations, sizeof(s)->work.viscous_last.iterations)                       \
+    IO(&(s)->work.viscous_last.residual, sizeof(s)->work.viscous_last.residual)                           \
+    IO(&(s)->work.viscous_iterations, sizeof(s)->work.viscous_iterations)
 
 static void put_dynamic(struct writer *w, const mixsph_sim *s)
 {
 #define W(ptr, n) put(w, (ptr), (n));
     STATE_SCALARS(W, s)
 #undef W
-    put_u64(w, s->n_out);
-    put(w, s->out_max, s->n_out * sizeof(double));
-    put(w, s->out_tmax, s->n_out * sizeof(double));
-    put(w, s->out_min, s->n_out * sizeof(double));
-    put(w, s->out_tmin, s->n_out * sizeof(double));
+    put_u64(w, s->out.n);
+    put(w, s->out.max, s->out.n * sizeof(double));
+    put(w, s->out.tmax, s->out.n * sizeof(double));
+    put(w, s->out.min, s->out.n * sizeof(double));
+    put(w, s->out.tmin, s->out.n * sizeof(double));
     put_u64(w, s->cfg.n_monitors);
-    put(w, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
+    put(w, s->out.profile_next, s->cfg.n_monitors * sizeof(size_t));
     put_u64(w, s->cfg.n_walls);
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
-        const struct wall_state *ws = &s->walls[k];
+        const struct wall_state *ws = &s->phys.walls.state[k];
         const double v[8] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz};
         put(w, v, sizeof v);
         put_u64(w, (uint64_t)ws->ext);
     }
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     put_u64(w, P->n);
-    put_u64(w, s->n_fluid);
-    put_u64(w, s->n_wall);
+    put_u64(w, s->phys.n_fluid);
+    put_u64(w, s->phys.n_wall);
     for (size_t k = 0; k < particle_field_count; k++) {
         const struct particle_field *f = &particle_fields[k];
         if (!(f->where & PF_STATE) || !particle_field_present(f, P->features)) continue;
@@ -182,9 +182,9 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
             put(w, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
     }
     /* the neighbour lists' build positions: the lists (and the pair order) are rebuilt from them */
-    put(w, s->NB.x0, P->n * sizeof(double));
-    put(w, s->NB.z0, P->n * sizeof(double));
-    put_u64(w, s->NB.builds);
+    put(w, s->work.NB.x0, P->n * sizeof(double));
+    put(w, s->work.NB.z0, P->n * sizeof(double));
+    put_u64(w, s->work.NB.builds);
 }
 
 mixsph_status mixsph_sim_save_state(const mixsph_sim *s, void **buf, size_t *len)
@@ -283,9 +283,9 @@ static int state_same_case(const mixsph_sim *s, const char *text, const char *co
 /* Cells and neighbour lists from the build positions (the particles are in their build order). */
 static mixsph_status state_relist(mixsph_sim *s)
 {
-    forces_forget_cache(s->forces);
-    if (cells_index(&s->C, &s->P, s->NB.x0, s->NB.z0) != 0 ||
-        neighbours_relist(&s->NB, &s->C, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+    forces_forget_cache(s->work.forces);
+    if (cells_index(&s->work.C, &s->phys.P, s->work.NB.x0, s->work.NB.z0) != 0 ||
+        neighbours_relist(&s->work.NB, &s->work.C, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particles not in cell order (or out of memory)");
     return integrate_build_gather_lists(s);
 }
@@ -297,16 +297,16 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
 #define R(ptr, n) get(r, (ptr), (n));
     STATE_SCALARS(R, s)
 #undef R
-    if (get_u64(r) != s->n_out) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: output count differs from the case's");
-    get(r, s->out_max, s->n_out * sizeof(double));
-    get(r, s->out_tmax, s->n_out * sizeof(double));
-    get(r, s->out_min, s->n_out * sizeof(double));
-    get(r, s->out_tmin, s->n_out * sizeof(double));
+    if (get_u64(r) != s->out.n) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: output count differs from the case's");
+    get(r, s->out.max, s->out.n * sizeof(double));
+    get(r, s->out.tmax, s->out.n * sizeof(double));
+    get(r, s->out.min, s->out.n * sizeof(double));
+    get(r, s->out.tmin, s->out.n * sizeof(double));
     if (get_u64(r) != s->cfg.n_monitors) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: monitor count differs from the case's");
-    get(r, s->profile_next, s->cfg.n_monitors * sizeof(size_t));
+    get(r, s->out.profile_next, s->cfg.n_monitors * sizeof(size_t));
     if (get_u64(r) != s->cfg.n_walls) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: wall count differs from the case's");
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
-        struct wall_state *ws = &s->walls[k];
+        struct wall_state *ws = &s->phys.walls.state[k];
         double v[8];
         get(r, v, sizeof v);
         ws->ox = v[0];
@@ -319,9 +319,9 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
         ws->ext_vz = v[7];
         ws->ext = get_u64(r) != 0;
     }
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const uint64_t n = get_u64(r), n_fluid = get_u64(r), n_wall = get_u64(r);
-    if (r->bad || n != P->n || n_fluid != s->n_fluid || n_wall != s->n_wall)
+    if (r->bad || n != P->n || n_fluid != s->phys.n_fluid || n_wall != s->phys.n_wall)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particle counts differ from the case's (%llu vs %zu)", (unsigned long long)n,
                         P->n);
     for (size_t k = 0; k < particle_field_count; k++) {
@@ -340,9 +340,9 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
         for (unsigned c = 0; c < f->components; c++)
             get(r, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
     }
-    get(r, s->NB.x0, P->n * sizeof(double));
-    get(r, s->NB.z0, P->n * sizeof(double));
-    s->NB.builds = get_u64(r);
+    get(r, s->work.NB.x0, P->n * sizeof(double));
+    get(r, s->work.NB.z0, P->n * sizeof(double));
+    s->work.NB.builds = get_u64(r);
     if (r->bad || r->pos != r->len) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: malformed particle section");
     return state_relist(s);
 }
@@ -364,28 +364,28 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     if (st != MIXSPH_OK) return st;
     /* keep a copy so that a malformed payload leaves the simulation unchanged */
     mixsph_sim *keep = malloc(sizeof *keep);
-    const size_t nb = s->P.n * sizeof(double);
+    const size_t nb = s->phys.P.n * sizeof(double);
     double *x0k = malloc(nb + 1), *z0k = malloc(nb + 1);
     struct particles Pk;
-    if (!keep || !x0k || !z0k || particles_copy(&Pk, &s->P) != 0) {
+    if (!keep || !x0k || !z0k || particles_copy(&Pk, &s->phys.P) != 0) {
         free(keep);
         free(x0k);
         free(z0k);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     }
-    memcpy(x0k, s->NB.x0, nb);
-    memcpy(z0k, s->NB.z0, nb);
+    memcpy(x0k, s->work.NB.x0, nb);
+    memcpy(z0k, s->work.NB.z0, nb);
     memcpy(keep, s, sizeof *s);
     st = read_dynamic(&r, s);
     if (st != MIXSPH_OK) {
         char msg[sizeof s->err];
         memcpy(msg, s->err, sizeof msg);
-        struct particles P = s->P;
+        struct particles P = s->phys.P;
         memcpy(s, keep, sizeof *s);
-        s->P = P;
-        particles_copy_values(&s->P, &Pk);
-        memcpy(s->NB.x0, x0k, nb);
-        memcpy(s->NB.z0, z0k, nb);
+        s->phys.P = P;
+        particles_copy_values(&s->phys.P, &Pk);
+        memcpy(s->work.NB.x0, x0k, nb);
+        memcpy(s->work.NB.z0, z0k, nb);
         state_relist(s);
         memcpy(s->err, msg, sizeof msg);
     }

@@ -6,7 +6,9 @@
 #ifndef MIXSPH_MEDIUM_H
 #define MIXSPH_MEDIUM_H
 
-#define MEDIUM_NAME_LEN 48
+#include "schema.h"
+
+#define MEDIUM_NAME_LEN SCHEMA_NAME_LEN
 
 /* The material laws (laws/law_registry.c holds one entry per law, in this order). */
 enum law_id {

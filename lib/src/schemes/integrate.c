@@ -49,12 +49,12 @@
  * nearly balance stay fixed (docs/model.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
 static inline double particle_time_step(const mixsph_sim *s, size_t i, int implicit)
 {
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
     double mu = implicit ? 0.0 : P->mu[i];
     if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) /* the viscosity it will have once mobilised */
-        mu = mixture_paper_held_viscosity(&s->cfg.media[P->medium[i]]);
-    return time_step_bound(s->cfg.cfl, s->cfg.cfl_visc, s->h, s->c_max, u, P->rho[i], mu);
+        mu = mixture_paper_held_viscosity(&s->scheme.media[P->medium[i]]);
+    return time_step_bound(s->scheme.cfl, s->scheme.cfl_visc, s->phys.h, s->phys.c_max, u, P->rho[i], mu);
 }
 
 /* A loop of this file over the particles: the simulation, the loop's parameters and its
@@ -75,7 +75,7 @@ static void time_step_range(void *arg, size_t b, size_t e)
 {
     struct particle_loop *L = arg;
     const mixsph_sim *s = L->s;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     double dt = INFINITY;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
@@ -88,29 +88,29 @@ static void time_step_range(void *arg, size_t b, size_t e)
 double integrate_time_step(const mixsph_sim *s)
 {
     /* no viscous bound with the implicit viscous step */
-    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = s->cfg.viscosity_implicit, .dt_min = INFINITY};
-    team_for(SIM_THREADS(s), s->P.n, time_step_range, &L);
+    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = s->scheme.implicit, .dt_min = INFINITY};
+    team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
     return L.dt_min;
 }
 
 /* The equation of state of particle i (not a wall, not lost): pressure, 1/rho, volume, alpha c h. */
 static inline void particle_pressure(mixsph_sim *s, size_t i)
 {
-    struct particles *P = &s->P;
-    const struct medium *m = &s->cfg.media[P->medium[i]];
-    const double pb = s->cfg.p_background;
+    struct particles *P = &s->phys.P;
+    const struct medium *m = &s->scheme.media[P->medium[i]];
+    const double pb = s->scheme.p_background;
     double p = eos_pressure(P->rho[i], m->rho0, m->c) + pb;
     if (m->tension_cutoff && p < pb) p = pb; /* a cohesionless medium carries no tension */
     P->p[i] = p;
     P->inv_rho[i] = 1.0 / P->rho[i];
     P->vol[i] = P->m[i] * P->inv_rho[i];
-    P->avc[i] = m->alpha_m * m->c * s->h;
+    P->avc[i] = m->alpha_m * m->c * s->phys.h;
 }
 
 static void pressure_range(void *arg, size_t b, size_t e)
 {
     mixsph_sim *s = ((struct particle_loop *)arg)->s;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
         particle_pressure(s, i);
@@ -120,15 +120,15 @@ static void pressure_range(void *arg, size_t b, size_t e)
 void integrate_pressure_and_derived(mixsph_sim *s)
 {
     struct particle_loop L = {.s = s};
-    team_for(SIM_THREADS(s), s->P.n, pressure_range, &L);
+    team_for(SIM_THREADS(s), s->phys.P.n, pressure_range, &L);
 }
 
 mixsph_status integrate_rebuild_lists(mixsph_sim *s)
 {
-    const long lost = cells_build(&s->C, &s->P);
+    const long lost = cells_build(&s->work.C, &s->phys.P);
     if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
-    s->n_lost += lost;
-    if (neighbours_build(&s->NB, &s->C, &s->P, s->C.start[s->C.ncell], 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+    s->phys.n_lost += lost;
+    if (neighbours_build(&s->work.NB, &s->work.C, &s->phys.P, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
     return integrate_build_gather_lists(s);
 }
@@ -138,18 +138,18 @@ static void near_wall_range(void *arg, size_t b, size_t e)
 {
     const struct particle_loop *L = arg;
     const mixsph_sim *s = L->s;
-    const struct particles *P = &s->P;
+    const struct particles *P = &s->phys.P;
     const double reach = L->a;
     for (size_t i = b; i < e; i++) {
         int close = 0;
         if (P->state[i] != MIXSPH_STATE_WALL)
-            for (size_t w = 0; w < s->cfg.n_walls && !close; w++) {
+            for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
                 double d;
                 int at_end;
-                walls_signed_distance(&s->cfg, s->walls, w, P->x[i], P->z[i], &d, &at_end);
+                walls_signed_distance(&s->phys.walls, w, P->x[i], P->z[i], &d, &at_end);
                 close = !(fabs(d) > reach); /* NaN counts as close */
             }
-        s->near_wall[i] = (uint8_t)close;
+        s->work.near_wall[i] = (uint8_t)close;
     }
 }
 
@@ -157,25 +157,25 @@ static void near_wall_range(void *arg, size_t b, size_t e)
  * non-wall ones (their pressure). */
 mixsph_status integrate_build_gather_lists(mixsph_sim *s)
 {
-    const struct particles *P = &s->P;
-    const size_t n = s->C.start[s->C.ncell];
-    if (neighbours_gather_reserve(&s->G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
+    const struct particles *P = &s->phys.P;
+    const size_t n = s->work.C.start[s->work.C.ncell];
+    if (neighbours_gather_reserve(&s->work.G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     for (size_t i = 0; i < n; i++) {
         uint8_t mode = NEIGHBOURS_GATHER_NONE;
-        if (P->state[i] == MIXSPH_STATE_WALL || (s->cfg.media[P->medium[i]].features & LAW_USES_GRADIENT))
+        if (P->state[i] == MIXSPH_STATE_WALL || (s->scheme.media[P->medium[i]].features & LAW_USES_GRADIENT))
             mode = NEIGHBOURS_GATHER_ALL;
-        s->G.mode[i] = mode;
+        s->work.G.mode[i] = mode;
     }
-    if (neighbours_gather_build(&s->G, &s->NB, &s->C, P->state, n, 2.0 * s->h + s->NB.skin, SIM_THREADS(s)) != 0)
+    if (neighbours_gather_build(&s->work.G, &s->work.NB, &s->work.C, P->state, n, 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     /* Particles that may reach a wall before the next build: until then every particle and
      * every wall moves less than skin/2 from its build position, so from any time in between
      * the remaining relative motion is below 2 skin. The others skip the wall-crossing test
      * (which could not fire for them: skipping it changes no result). */
-    uint8_t *near = realloc(s->near_wall, P->cap ? P->cap : 1);
+    uint8_t *near = realloc(s->work.near_wall, P->cap ? P->cap : 1);
     if (!near) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
-    s->near_wall = near;
-    struct particle_loop L = {.s = s, .a = 2.0 * s->NB.skin + 2.0 * s->dx};
+    s->work.near_wall = near;
+    struct particle_loop L = {.s = s, .a = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx};
     team_for(SIM_THREADS(s), n, near_wall_range, &L);
     return MIXSPH_OK;
 }
@@ -183,52 +183,44 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
 struct pair_system sim_pair_system(mixsph_sim *s)
 {
     struct pair_system S;
-    S.P = &s->P;
-    S.C = &s->C;
-    S.NB = &s->NB;
-    S.G = &s->G;
-    S.media = s->cfg.media;
-    S.params.K = s->K;
-    S.params.eta2 = 0.01 * s->h * s->h;
-    S.params.g = s->cfg.g;
-    S.params.av_wall = s->cfg.av_wall;
-    S.params.av_mixed = s->cfg.av_mixed;
-    S.params.av_separating = s->cfg.av_separating;
-    S.params.implicit_viscosity = s->cfg.viscosity_implicit;
-    S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
-    S.params.stress = (s->law_features & LAW_HAS_STRESS) != 0;
+    S.P = &s->phys.P;
+    S.C = &s->work.C;
+    S.NB = &s->work.NB;
+    S.G = &s->work.G;
+    S.media = s->scheme.media;
+    S.params = s->scheme.pair;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
 
-static size_t active_particles(const mixsph_sim *s) { return s->C.start[s->C.ncell]; }
+static size_t active_particles(const mixsph_sim *s) { return s->work.C.start[s->work.C.ncell]; }
 
 /* Whether a medium of the case uses law `id`. */
 static int law_in_use(const mixsph_sim *s, int id)
 {
-    for (size_t k = 0; k < s->cfg.n_media; k++)
-        if (s->cfg.media[k].law == id) return 1;
+    for (size_t k = 0; k < s->scheme.n_media; k++)
+        if (s->scheme.media[k].law == id) return 1;
     return 0;
 }
 
 int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 {
-    if (s->law_features & LAW_USES_GRADIENT) return forces_density_rate_gradient(s->forces, S, &s->grad);
-    return forces_density_rate(s->forces, S);
+    if (s->phys.law_features & LAW_USES_GRADIENT) return forces_density_rate_gradient(s->work.forces, S, &s->work.grad);
+    return forces_density_rate(s->work.forces, S);
 }
 
 /* The material laws' updates over law_dt (0: at the current state, no advance), in the order of
  * their ids; the paper's law reports the grains it holds fixed. */
 void integrate_update_laws(mixsph_sim *s, double law_dt)
 {
-    const struct law_step step = {.P = &s->P, .n = active_particles(s), .media = s->cfg.media, .grad = &s->grad,
-                                  .G = &s->G, .K = &s->K, .dt = law_dt,
-                                  .p_background = s->cfg.p_background, .n_threads = SIM_THREADS(s)};
+    const struct law_step step = {.P = &s->phys.P, .n = active_particles(s), .media = s->scheme.media, .grad = &s->work.grad,
+                                  .G = &s->work.G, .K = &s->phys.K, .dt = law_dt,
+                                  .p_background = s->scheme.p_background, .n_threads = SIM_THREADS(s)};
     for (int id = 0; id < LAW_COUNT; id++) {
         const struct material_law *law = law_get(id);
         if (!law->update || !law_in_use(s, id)) continue;
-        const long count = law->update(s->law_state[id], &step);
-        if (id == LAW_MIXTURE_PAPER) s->n_fixed = count;
+        const long count = law->update(s->phys.law_state[id], &step);
+        if (id == LAW_MIXTURE_PAPER) s->phys.n_fixed = count;
     }
 }
 
@@ -237,9 +229,9 @@ void integrate_update_laws(mixsph_sim *s, double law_dt)
  * when out of memory. */
 static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int smooth, double law_dt)
 {
-    if (smooth && forces_smooth_pressure(s->forces, S, s->cfg.pressure_smoothing * s->dt / s->h) != 0) return -1;
+    if (smooth && forces_smooth_pressure(s->work.forces, S, s->scheme.pressure_smoothing * s->phys.dt / s->phys.h) != 0) return -1;
     integrate_update_laws(s, law_dt);
-    walls_extrapolate_fluid(&s->cfg, s->walls, &s->K, &s->G, s->dx, &s->P, active_particles(s), S->n_threads);
+    walls_extrapolate_fluid(&s->phys.walls, &s->phys.K, &s->work.G, s->phys.dx, &s->phys.P, active_particles(s), S->n_threads);
     return 0;
 }
 
@@ -249,12 +241,12 @@ static void kick_range(void *arg, size_t b, size_t e)
 {
     const struct particle_loop *L = arg;
     const mixsph_sim *s = L->s;
-    struct particles *P = &L->s->P;
-    const int rigid = s->cfg.viscosity_implicit && s->cfg.held_grains_rigid;
+    struct particles *P = &L->s->phys.P;
+    const int rigid = s->scheme.implicit && s->scheme.held_grains_rigid;
     const double dt = L->a;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], rigid))
+        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid))
             continue;
         P->vx[i] += dt * P->ax[i];
         P->vz[i] += dt * P->az[i];
@@ -264,7 +256,7 @@ static void kick_range(void *arg, size_t b, size_t e)
 static void kick_velocities(mixsph_sim *s, double dt)
 {
     struct particle_loop L = {.s = s, .a = dt};
-    team_for(SIM_THREADS(s), s->P.n, kick_range, &L);
+    team_for(SIM_THREADS(s), s->phys.P.n, kick_range, &L);
 }
 
 /* The time step the explicit scheme would take from the current state, at most dt: the kick over
@@ -275,7 +267,7 @@ static void kick_velocities(mixsph_sim *s, double dt)
 static double held_grain_judge_dt(const mixsph_sim *s, double dt)
 {
     struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = 0, .dt_min = dt};
-    team_for(SIM_THREADS(s), s->P.n, time_step_range, &L);
+    team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
     return L.dt_min;
 }
 
@@ -303,10 +295,10 @@ static void held_kick_range(void *arg, size_t b, size_t e)
 {
     const struct held_kick_loop *L = arg;
     const mixsph_sim *s = L->s;
-    struct particles *P = &L->s->P;
+    struct particles *P = &L->s->phys.P;
     const double judge_dt = L->judge_dt, *lx = L->lx, *lz = L->lz;
     for (size_t i = b; i < e; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0))
+        if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))
             continue;
         P->vx[i] = judge_dt * (P->ax[i] - lx[i] / P->m[i]);
         P->vz[i] = judge_dt * (P->az[i] - lz[i] / P->m[i]);
@@ -316,7 +308,7 @@ static void held_kick_range(void *arg, size_t b, size_t e)
 static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double judge_dt)
 {
     const double *lx, *lz;
-    if (viscous_solution_operator(s->viscous, s->forces, S, &lx, &lz) != 0) return -1;
+    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
     struct held_kick_loop L = {.s = s, .judge_dt = judge_dt, .lx = lx, .lz = lz};
     team_for(S->n_threads, active_particles(s), held_kick_range, &L);
     return 0;
@@ -335,60 +327,58 @@ static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double j
 static void unknowns_range(void *arg, size_t b, size_t e)
 {
     mixsph_sim *s = ((struct particle_loop *)arg)->s;
-    const struct particles *P = &s->P;
-    const int rigid = s->cfg.held_grains_rigid;
+    const struct particles *P = &s->phys.P;
+    const int rigid = s->scheme.held_grains_rigid;
     for (size_t i = b; i < e; i++)
-        s->viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
+        s->work.viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
                                 (P->state[i] == MIXSPH_STATE_FIXED &&
-                                 mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], rigid));
+                                 mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
 }
 
 static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judge_dt)
 {
-    if (!s->viscous && !(s->viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    if (!s->work.viscous && !(s->work.viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const struct pair_system S = sim_pair_system(s);
-    if (!forces_viscous_ready(s->forces)) {
+    if (!forces_viscous_ready(s->work.forces)) {
         /* a restored state: the couplings at its positions; the momentum pass also rewrites the
          * accelerations from the kicked velocities, and rigid held grains are judged on the
          * restored ones, so those are kept */
-        const size_t bytes = s->P.n * sizeof(double);
+        const size_t bytes = s->phys.P.n * sizeof(double);
         double *ax = malloc(bytes ? bytes : 1), *az = malloc(bytes ? bytes : 1);
         int bad = !ax || !az;
         if (!bad) {
-            memcpy(ax, s->P.ax, bytes);
-            memcpy(az, s->P.az, bytes);
-            bad = integrate_density_rates(s, &S) < 0 || forces_momentum(s->forces, &S) < 0;
-            memcpy(s->P.ax, ax, bytes);
-            memcpy(s->P.az, az, bytes);
+            memcpy(ax, s->phys.P.ax, bytes);
+            memcpy(az, s->phys.P.az, bytes);
+            bad = integrate_density_rates(s, &S) < 0 || forces_momentum(s->work.forces, &S) < 0;
+            memcpy(s->phys.P.ax, ax, bytes);
+            memcpy(s->phys.P.az, az, bytes);
         }
         free(ax);
         free(az);
         if (bad) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     }
-    if (!s->wall_mirror && !(s->wall_mirror = walls_mirror_create()))
+    if (!s->work.wall_mirror && !(s->work.wall_mirror = walls_mirror_create()))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
-    struct viscous_report *rep = &s->viscous_last;
-    if (!(s->viscous_unknown = realloc_unknowns(s->viscous_unknown, s->P.cap)))
+    struct viscous_report *rep = &s->work.viscous_last;
+    if (!(s->work.viscous_unknown = realloc_unknowns(s->work.viscous_unknown, s->phys.P.cap)))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
-    const int rigid = s->cfg.held_grains_rigid;
+    const int rigid = s->scheme.held_grains_rigid;
     struct particle_loop L = {.s = s};
     team_for(S.n_threads, active_particles(s), unknowns_range, &L);
-    const struct viscous_params vp = {.preconditioner = s->cfg.viscous_preconditioner,
-                                      .tolerance = s->cfg.viscous_tolerance,
-                                      .max_iterations = s->cfg.viscous_max_iterations};
+    const struct viscous_params *vp = &s->scheme.viscous;
     const double t0 = clock_monotonic_s();
-    int failed = viscous_step(s->viscous, s->forces, &S, s->wall_mirror, &s->cfg, s->walls, s->t, dt,
-                              s->viscous_unknown, &vp, rep);
+    int failed = viscous_step(s->work.viscous, s->work.forces, &S, s->work.wall_mirror, &s->phys.walls, s->phys.t, dt,
+                              s->work.viscous_unknown, vp, rep);
     if (!failed && rigid && judge_dt > 0.0) failed = held_grain_kicks(s, &S, judge_dt);
-    s->viscous_wall_s += clock_monotonic_s() - t0;
+    s->work.viscous_wall_s += clock_monotonic_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
-    s->viscous_iterations += (uint64_t)rep->iterations;
+    s->work.viscous_iterations += (uint64_t)rep->iterations;
     if (!rep->converged)
         return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                         "implicit viscous step: relative residual %.3g after %d iterations (tolerance %g, "
                         "numerics.viscous_max_iterations %d) at t = %.6g s (step %llu)",
-                        rep->residual, rep->iterations, s->cfg.viscous_tolerance, s->cfg.viscous_max_iterations, s->t,
-                        (unsigned long long)s->step);
+                        rep->residual, rep->iterations, vp->tolerance, vp->max_iterations, s->phys.t,
+                        (unsigned long long)s->phys.step);
     return MIXSPH_OK;
 }
 
@@ -400,10 +390,10 @@ mixsph_status integrate_initial_rates(mixsph_sim *s)
     if (bad) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite density rates in the initial state");
     integrate_pressure_and_derived(s);
     pressures_and_regimes(s, &S, 0, 0.0);
-    const int bad_a = forces_momentum(s->forces, &S);
+    const int bad_a = forces_momentum(s->work.forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad_a) return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "non-finite forces in the initial state");
-    s->dt = integrate_time_step(s);
+    s->phys.dt = integrate_time_step(s);
     return MIXSPH_OK;
 }
 
@@ -412,10 +402,10 @@ mixsph_status integrate_initial_rates(mixsph_sim *s)
 /* The time step about to be taken, or a failure when it collapsed. */
 static mixsph_status check_time_step(mixsph_sim *s)
 {
-    const double dt = s->dt;
+    const double dt = s->phys.dt;
     if (!(dt > 1e-14) || !isfinite(dt))
-        return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "time step collapsed to %g s at t = %.6g s (step %llu)", dt, s->t,
-                        (unsigned long long)s->step);
+        return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE, "time step collapsed to %g s at t = %.6g s (step %llu)", dt, s->phys.t,
+                        (unsigned long long)s->phys.step);
     return MIXSPH_OK;
 }
 
@@ -427,12 +417,12 @@ static void drift_range(void *arg, size_t b, size_t e)
 {
     struct particle_loop *L = arg;
     const mixsph_sim *s = L->s;
-    struct particles *P = &L->s->P;
-    const double dt = L->a, half_kick = L->b, gap = INTEGRATE_CLIP_GAP * s->dx;
+    struct particles *P = &L->s->phys.P;
+    const double dt = L->a, half_kick = L->b, gap = INTEGRATE_CLIP_GAP * s->phys.dx;
     const double *ox_old = L->ox_old, *oz_old = L->oz_old;
     const size_t n_active = L->n_active;
-    const double *x_build = s->NB.x0, *z_build = s->NB.z0;
-    const struct cells *C = &s->C;
+    const double *x_build = s->work.NB.x0, *z_build = s->work.NB.z0;
+    const struct cells *C = &s->work.C;
     const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
     long clips = 0;
     double shift2 = 0.0;
@@ -441,15 +431,15 @@ static void drift_range(void *arg, size_t b, size_t e)
         const int st = P->state[i];
         if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
             const double kick =
-                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0) ? 0.0
+                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0) ? 0.0
                                                                                                            : half_kick;
             double vx = P->vx[i] + kick * P->ax[i];
             double vz = P->vz[i] + kick * P->az[i];
             if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
                 const double x0 = P->x[i], z0 = P->z[i];
                 double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
-                if (s->near_wall[i])
-                    walls_clip(&s->cfg, s->walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
+                if (s->work.near_wall[i])
+                    walls_clip(&s->phys.walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
                 P->x[i] = x1;
                 P->z[i] = z1;
             }
@@ -475,25 +465,25 @@ static void drift_range(void *arg, size_t b, size_t e)
  * or left the grid. */
 static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
 {
-    struct particles *P = &s->P;
-    double ox_old[CASE_MAX_WALLS], oz_old[CASE_MAX_WALLS];
-    for (size_t w = 0; w < s->cfg.n_walls; w++) {
-        ox_old[w] = s->walls[w].ox;
-        oz_old[w] = s->walls[w].oz;
+    struct particles *P = &s->phys.P;
+    double ox_old[WALLS_MAX], oz_old[WALLS_MAX];
+    for (size_t w = 0; w < s->phys.walls.n; w++) {
+        ox_old[w] = s->phys.walls.state[w].ox;
+        oz_old[w] = s->phys.walls.state[w].oz;
     }
-    walls_move(&s->cfg, s->walls, P, s->t, dt);
+    walls_move(&s->phys.walls, P, s->phys.t, dt);
     struct particle_loop L = {.s = s, .a = dt, .b = half_kick, .ox_old = ox_old, .oz_old = oz_old,
-                              .n_active = s->C.start[s->C.ncell]};
+                              .n_active = s->work.C.start[s->work.C.ncell]};
     team_for(SIM_THREADS(s), P->n, drift_range, &L);
     const long clips = L.count;
     const double shift2 = L.shift2;
     const int outside = L.flag;
-    s->n_clipped += clips;
-    s->t += dt;
-    s->step++;
+    s->phys.n_clipped += clips;
+    s->phys.t += dt;
+    s->phys.step++;
     /* the lists hold while no particle has moved skin/2 since their build; a particle that left
      * the grid is marked lost by the rebuild at once */
-    if (outside || 4.0 * shift2 >= s->NB.skin * s->NB.skin) return integrate_rebuild_lists(s);
+    if (outside || 4.0 * shift2 >= s->work.NB.skin * s->work.NB.skin) return integrate_rebuild_lists(s);
     return MIXSPH_OK;
 }
 
@@ -502,7 +492,7 @@ static void density_update_range(void *arg, size_t b, size_t e)
 {
     struct particle_loop *L = arg;
     mixsph_sim *s = L->s;
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const double dt = L->a;
     int bad_rho = 0;
     for (size_t i = b; i < e; i++) {
@@ -519,7 +509,7 @@ static void density_update_range(void *arg, size_t b, size_t e)
  * walls' extrapolated state and the momentum pass. */
 static mixsph_status new_rates(mixsph_sim *s, double dt)
 {
-    struct particles *P = &s->P;
+    struct particles *P = &s->phys.P;
     const struct pair_system S = sim_pair_system(s);
     int bad_rho = integrate_density_rates(s, &S);
     if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -529,14 +519,14 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
     bad_rho |= L.flag;
     if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
-    const int bad_a = forces_momentum(s->forces, &S);
+    const int bad_a = forces_momentum(s->work.forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad_a || bad_rho) {
         for (size_t i = 0; i < P->n; i++)
             if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                                 "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
-                                P->rho[i], P->id[i], P->x[i], P->z[i], s->t);
+                                P->rho[i], P->id[i], P->x[i], P->z[i], s->phys.t);
     }
     return MIXSPH_OK;
 }
@@ -546,14 +536,14 @@ static void last_kick_range(void *arg, size_t b, size_t e)
 {
     struct particle_loop *L = arg;
     const mixsph_sim *s = L->s;
-    struct particles *P = &L->s->P;
+    struct particles *P = &L->s->phys.P;
     const double last_kick = L->a;
     const int implicit = L->implicit;
     double dt_next = INFINITY;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         if (last_kick > 0.0 &&
-            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->cfg.media[P->medium[i]], 0))) {
+            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))) {
             P->vx[i] += last_kick * P->ax[i];
             P->vz[i] += last_kick * P->az[i];
         }
@@ -566,8 +556,8 @@ static void last_kick_range(void *arg, size_t b, size_t e)
 static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implicit)
 {
     struct particle_loop L = {.s = s, .a = last_kick, .implicit = implicit, .dt_min = INFINITY};
-    team_for(SIM_THREADS(s), s->P.n, last_kick_range, &L);
-    s->dt = L.dt_min;
+    team_for(SIM_THREADS(s), s->phys.P.n, last_kick_range, &L);
+    s->phys.dt = L.dt_min;
 }
 
 /* ---- the two schemes ------------------------------------------------------------------------ */
@@ -578,7 +568,7 @@ static mixsph_status explicit_step(mixsph_sim *s)
 {
     mixsph_status st = check_time_step(s);
     if (st != MIXSPH_OK) return st;
-    const double dt = s->dt;
+    const double dt = s->phys.dt;
     if ((st = move_particles(s, dt, 0.5 * dt)) != MIXSPH_OK) return st; /* v^{n+1/2}, x^{n+1} */
     if ((st = new_rates(s, dt)) != MIXSPH_OK) return st;                /* rho^{n+1}, a^{n+1} */
     last_kick_and_time_step(s, 0.5 * dt, 0);                            /* v^{n+1} */
@@ -593,9 +583,9 @@ static mixsph_status implicit_step(mixsph_sim *s)
 {
     mixsph_status st = check_time_step(s);
     if (st != MIXSPH_OK) return st;
-    const double dt = s->dt;
+    const double dt = s->phys.dt;
     /* from the state before the kick, as the explicit scheme's step would be; 0: none held */
-    const double judge_dt = s->cfg.held_grains_rigid && s->n_fixed > 0 ? held_grain_judge_dt(s, dt) : 0.0;
+    const double judge_dt = s->scheme.held_grains_rigid && s->phys.n_fixed > 0 ? held_grain_judge_dt(s, dt) : 0.0;
     kick_velocities(s, dt);
     if ((st = implicit_viscous_step(s, dt, judge_dt)) != MIXSPH_OK) return st;
     if ((st = move_particles(s, dt, 0.0)) != MIXSPH_OK) return st;
@@ -606,5 +596,5 @@ static mixsph_status implicit_step(mixsph_sim *s)
 
 mixsph_status integrate_step(mixsph_sim *s)
 {
-    return s->cfg.viscosity_implicit ? implicit_step(s) : explicit_step(s);
+    return s->scheme.implicit ? implicit_step(s) : explicit_step(s);
 }

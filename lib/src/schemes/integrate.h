@@ -37,7 +37,7 @@ void integrate_pressure_and_derived(mixsph_sim *s);
  *  pass) as at the end of a step, for the initial state. */
 mixsph_status integrate_initial_rates(mixsph_sim *s);
 
-/** One leapfrog step of s->dt. */
+/** One leapfrog step of s->phys.dt. */
 mixsph_status integrate_step(mixsph_sim *s);
 
 #endif

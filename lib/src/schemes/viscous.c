@@ -618,7 +618,7 @@ static void stage1_guess_range(void *arg, size_t b, size_t e);
 static void stage2_guess_range(void *arg, size_t b, size_t e);
 
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                 struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
+                 struct wall_mirror *M, const struct walls *W, double t, double dt,
                  const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report)
 {
     const size_t n = S->C->start[S->C->ncell];
@@ -632,20 +632,20 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = g * dt, .n = n, .unknown = unknown};
     const struct particles *P = S->P;
     const int threads = S->n_threads;
-    if (walls_mirror_build(M, cfg, &S->params.K, S->G, P, n, threads) != 0) return -1;
+    if (walls_mirror_build(M, W, &S->params.K, S->G, P, n, threads) != 0) return -1;
     load_velocities(&c);
     /* stage 1: w = u*, first guess u* + the first-stage increment extrapolated linearly from
      * the last two steps (closer than the last increment alone where the flow changes smoothly;
      * measured in docs/numerics.md) */
     struct vloop L = {.c = &c, .k0 = (1.0 - g) / g};
     team_for(threads, n, stage1_guess_range, &L);
-    walls_mirror_at(M, cfg, ws, P, t, g * dt, threads);
+    walls_mirror_at(M, W, P, t, g * dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess U1 + the second stage's own
      * change (U2 - U1 = dv - d1) extrapolated linearly from the last two steps; the increments
      * of the last step become those of the step before */
     team_for(threads, n, stage2_guess_range, &L);
-    walls_mirror_at(M, cfg, ws, P, t, dt, threads);
+    walls_mirror_at(M, W, P, t, dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     store(&c);
     return 0;

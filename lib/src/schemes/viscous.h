@@ -42,7 +42,7 @@ void viscous_free(struct viscous_solver *V);
 
 /** The implicit viscous step over dt from t (walls not yet moved): the two-stage SDIRK of
  *  docs/numerics.md, each stage a solve (m + gamma dt L) U = m w - gamma dt L u_B with the
- *  walls' mirror (M, rebuilt here at the current positions; the case's walls `cfg` at `ws`) at
+ *  walls' mirror (M, rebuilt here at the current positions; the walls W) at
  *  the stage's time, warm-started from its increments of the last two steps. unknown[i] != 0:
  *  particle i's velocity is solved for; the others (walls aside) are prescribed at theirs.
  *  Updates P->vx, P->vz of the unknowns, the increments (visc_dv*, visc_d1* and those of the step
@@ -50,7 +50,7 @@ void viscous_free(struct viscous_solver *V);
  *  the larger residual; a stage stops at ||r|| <= tolerance ||b|| or after max_iterations (vp).
  *  Returns -1 when out of memory, 0 otherwise (convergence is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                 struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws, double t, double dt,
+                 struct wall_mirror *M, const struct walls *W, double t, double dt,
                  const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report);
 
 /** The viscous operator applied to the last step's solved velocity field (its wall rows as the

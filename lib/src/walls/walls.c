@@ -21,20 +21,22 @@
 #include "mixsph.h"
 #include "team.h"
 
-void walls_signed_distance(const struct case_def *cfg, const struct wall_state *ws, size_t w, double x, double z,
-                           double *d, int *at_end)
+void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end)
 {
-    const struct wall *wl = &cfg->walls[w];
-    *d = geom_signed_distance(&wl->line, wl->side, x - ws[w].ox, z - ws[w].oz, at_end);
+    const struct wall *wl = &W->def[w];
+    *d = geom_signed_distance(&wl->line, wl->side, x - W->state[w].ox, z - W->state[w].oz, at_end);
 }
 
-void walls_start(const struct case_def *cfg, struct wall_state *ws)
+void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
+                int placement, double lattice_z0, double g, double rho_alone)
 {
-    for (size_t w = 0; w < cfg->n_walls; w++) {
-        const int mo = cfg->walls[w].motion;
+    *W = (struct walls){.n = n, .def = def, .motions = motions, .layers = layers, .placement = placement,
+                        .lattice_z0 = lattice_z0, .g = g, .rho_alone = rho_alone};
+    for (size_t w = 0; w < n; w++) {
+        const int mo = def[w].motion;
         if (mo < 0) continue;
-        case_motion_velocity(&cfg->motions[mo], 0.0, &ws[w].vx, &ws[w].vz);
-        case_motion_acceleration(&cfg->motions[mo], 0.0, &ws[w].ax, &ws[w].az);
+        motion_velocity(&motions[mo], 0.0, &W->state[w].vx, &W->state[w].vz);
+        motion_acceleration(&motions[mo], 0.0, &W->state[w].ax, &W->state[w].az);
     }
 }
 
@@ -42,10 +44,10 @@ void walls_start(const struct case_def *cfg, struct wall_state *ws)
  * this a grain held fixed beside a wall that jumps to a new speed keeps its state (its strain rate
  * reads the old mirror) and then takes the new velocity difference with the viscosity mu_thr,
  * over a time step made for mu0 (an impulsive push of 1.5 m/s threw such grains at 20 m/s). */
-void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, size_t w, double vx, double vz, double ax,
-                           double az, struct particles *P)
+void walls_change_velocity(struct walls *W, size_t w, double vx, double vz, double ax, double az, struct particles *P)
 {
-    const double mirror = cfg->walls[w].slip == WALL_NO_SLIP ? 2.0 : 0.0; /* d u_g / d v_w */
+    struct wall_state *ws = W->state;
+    const double mirror = W->def[w].slip == WALL_NO_SLIP ? 2.0 : 0.0; /* d u_g / d v_w */
     const double dvx = vx - ws[w].vx, dvz = vz - ws[w].vz;
     ws[w].vx = vx;
     ws[w].vz = vz;
@@ -62,13 +64,13 @@ void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, si
 
 /* Whether (x, z) lies behind a fixed wall before w, within the layers' depth: among fixed walls a
  * site is filled once (a site behind two walls). */
-static int behind_earlier_fixed_wall(const struct case_def *cfg, size_t w, double x, double z, double depth)
+static int behind_earlier_fixed_wall(const struct walls *W, size_t w, double x, double z, double depth)
 {
-    if (cfg->walls[w].motion >= 0) return 0;
+    if (W->def[w].motion >= 0) return 0;
     for (size_t v = 0; v < w; v++) {
-        if (cfg->walls[v].motion >= 0) continue;
+        if (W->def[v].motion >= 0) continue;
         int at_end = 0;
-        const double d = geom_signed_distance(&cfg->walls[v].line, cfg->walls[v].side, x, z, &at_end);
+        const double d = geom_signed_distance(&W->def[v].line, W->def[v].side, x, z, &at_end);
         if (!at_end && d < 0.0 && d >= -depth) return 1;
     }
     return 0;
@@ -143,13 +145,14 @@ static int near_placed(const struct particles *P, size_t first, double x, double
  * filled by a fan: rings at radius (l + 1/2) dx with round(theta r / dx) particles each. So the
  * first row is dx/2 behind the wall line everywhere, as on a wall along the lattice, and a wall
  * at an angle to the lattice is not a staircase. */
-static long walls_generate_aligned(const struct case_def *cfg, const struct wall_state *ws, double dx,
-                                   const mixsph_interrupt *interrupt, struct particles *P)
+static long walls_generate_aligned(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
+                                   struct particles *P)
 {
-    const double depth = cfg->wall_layers * dx;
+    const struct wall_state *ws = W->state;
+    const double depth = W->layers * dx;
     long added = 0;
-    for (size_t w = 0; w < cfg->n_walls; w++) {
-        const struct wall *wl = &cfg->walls[w];
+    for (size_t w = 0; w < W->n; w++) {
+        const struct wall *wl = &W->def[w];
         const size_t nseg = wl->line.n - 1, first = P->n;
         for (size_t k = 0; k < nseg; k++) {
             if (interrupt && interrupt->requested && interrupt->requested(interrupt->user)) return WALLS_INTERRUPTED;
@@ -161,7 +164,7 @@ static long walls_generate_aligned(const struct case_def *cfg, const struct wall
             const int edge_after = has_next && !turns_toward_fluid(&g, &next);
             const long n_along = lround(g.len / dx) > 1 ? lround(g.len / dx) : 1;
             const double ds = g.len / (double)n_along;
-            for (int l = 0; l < cfg->wall_layers; l++) {
+            for (int l = 0; l < W->layers; l++) {
                 const double d = (l + 0.5) * dx;
                 for (long m = 0; m < n_along; m++) {
                     const double s = (m + 0.5) * ds;
@@ -170,7 +173,7 @@ static long walls_generate_aligned(const struct case_def *cfg, const struct wall
                     if (edge_after && owned_by_other(&next, x, z, d)) continue;
                     const int at_edge = (edge_before && s < depth + dx) || (edge_after && s > g.len - depth - dx);
                     if (at_edge && near_placed(P, first, x, z, 0.5 * dx)) continue;
-                    if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                    if (behind_earlier_fixed_wall(W, w, x, z, depth)) continue;
                     if (push_wall_particle(ws, w, x, z, ds * dx, P) < 0) return -1;
                     added++;
                 }
@@ -185,14 +188,14 @@ static long walls_generate_aligned(const struct case_def *cfg, const struct wall
             if (!(un > 0.0)) continue;
             ux /= un;
             uz /= un;
-            for (int l = 0; l < cfg->wall_layers; l++) {
+            for (int l = 0; l < W->layers; l++) {
                 const double r = (l + 0.5) * dx;
                 const long n_arc = lround(theta * r / dx);
                 for (long j = 0; j < n_arc; j++) {
                     const double phi = (j + 0.5) * theta / (double)n_arc;
                     const double x = vx + r * (cos(phi) * -g.nx + sin(phi) * ux);
                     const double z = vz + r * (cos(phi) * -g.nz + sin(phi) * uz);
-                    if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                    if (behind_earlier_fixed_wall(W, w, x, z, depth)) continue;
                     if (push_wall_particle(ws, w, x, z, theta * r / (double)n_arc * dx, P) < 0) return -1;
                     added++;
                 }
@@ -202,14 +205,14 @@ static long walls_generate_aligned(const struct case_def *cfg, const struct wall
     return added;
 }
 
-long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
-                    struct particles *P)
+long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt, struct particles *P)
 {
-    if (cfg->wall_placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(cfg, ws, dx, interrupt, P);
-    const double depth = cfg->wall_layers * dx, z_off = geom_lattice_z_offset(cfg->lattice_z0, dx);
+    if (W->placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(W, dx, interrupt, P);
+    const struct wall_state *ws = W->state;
+    const double depth = W->layers * dx, z_off = geom_lattice_z_offset(W->lattice_z0, dx);
     long added = 0;
-    for (size_t w = 0; w < cfg->n_walls; w++) {
-        const struct wall *wl = &cfg->walls[w];
+    for (size_t w = 0; w < W->n; w++) {
+        const struct wall *wl = &W->def[w];
         double xmin = INFINITY, xmax = -INFINITY, zmin = INFINITY, zmax = -INFINITY;
         for (size_t k = 0; k < wl->line.n; k++) {
             xmin = fmin(xmin, wl->line.x[k]);
@@ -226,7 +229,7 @@ long walls_generate(const struct case_def *cfg, const struct wall_state *ws, dou
                 int at_end = 0;
                 const double d = geom_signed_distance(&wl->line, wl->side, x, z, &at_end);
                 if (at_end || d >= 0.0 || d < -depth) continue;
-                if (behind_earlier_fixed_wall(cfg, w, x, z, depth)) continue;
+                if (behind_earlier_fixed_wall(W, w, x, z, depth)) continue;
                 if (push_wall_particle(ws, w, x, z, dx * dx, P) < 0) return -1;
                 added++;
             }
@@ -244,20 +247,21 @@ static void step_end_velocity(const struct motion *m, const struct wall_state *w
         *vx = ws->ext_vx;
         *vz = ws->ext_vz;
     } else {
-        case_motion_velocity(m, t_from + dt, vx, vz);
+        motion_velocity(m, t_from + dt, vx, vz);
     }
 }
 
 /* Move the walls from t_from by dt: each moving wall translates by its velocity at mid-step
  * (exact for a law linear over the step), then takes the velocity and acceleration at t+dt. */
-void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct particles *P, double t_from, double dt)
+void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
 {
+    struct wall_state *wstate = W->state;
     int moving = 0;
-    double dxw[CASE_MAX_WALLS] = {0}, dzw[CASE_MAX_WALLS] = {0};
-    for (size_t w = 0; w < cfg->n_walls; w++) {
-        const int mo = cfg->walls[w].motion;
+    double dxw[WALLS_MAX] = {0}, dzw[WALLS_MAX] = {0};
+    for (size_t w = 0; w < W->n; w++) {
+        const int mo = W->def[w].motion;
         if (mo < 0) continue;
-        const struct motion *m = &cfg->motions[mo];
+        const struct motion *m = &W->motions[mo];
         struct wall_state *ws = &wstate[w];
         double vx, vz;
         step_end_velocity(m, ws, t_from, dt, &ws->vx, &ws->vz);
@@ -266,8 +270,8 @@ void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct pa
             vz = ws->vz;
             ws->ax = ws->az = 0.0;
         } else {
-            case_motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
-            case_motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
+            motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
+            motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
         }
         dxw[w] = vx * dt;
         dzw[w] = vz * dt;
@@ -279,7 +283,7 @@ void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct pa
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
         const size_t w = particles_wall_index(P, i);
-        if (cfg->walls[w].motion < 0) continue;
+        if (W->def[w].motion < 0) continue;
         P->x[i] += dxw[w];
         P->z[i] += dzw[w];
         P->vx[i] = wstate[w].vx;
@@ -287,14 +291,14 @@ void walls_move(const struct case_def *cfg, struct wall_state *wstate, struct pa
     }
 }
 
-void walls_clip(const struct case_def *cfg, const struct wall_state *wstate, const double *ox_old, const double *oz_old,
-                double gap, double x0, double z0, double *x1, double *z1, double *vx, double *vz, long *clips)
+void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
+                double *x1, double *z1, double *vx, double *vz, long *clips)
 {
     for (int pass = 0; pass < 4; pass++) {
         int hit = 0;
-        for (size_t w = 0; w < cfg->n_walls && !hit; w++) {
-            const struct wall *wl = &cfg->walls[w];
-            const struct wall_state *ws = &wstate[w];
+        for (size_t w = 0; w < W->n && !hit; w++) {
+            const struct wall *wl = &W->def[w];
+            const struct wall_state *ws = &W->state[w];
             /* the path in the frame of the wall */
             const double ax = x0 - ox_old[w], az = z0 - oz_old[w];
             const double bx = *x1 - ws->ox, bz = *z1 - ws->oz;
@@ -343,8 +347,7 @@ static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
 
 /* The arguments of a parallel loop of this file (core/team.h). */
 struct wall_loop {
-    const struct case_def *cfg;
-    const struct wall_state *wstate;
+    const struct walls *W;
     const struct kernel *K;
     const struct gather *G;
     double dx;
@@ -362,12 +365,12 @@ static void mirror_apply_range(void *arg, size_t b, size_t e);
 static void extrapolate_range(void *arg, size_t b, size_t e)
 {
     const struct wall_loop *L = arg;
-    const struct case_def *cfg = L->cfg;
-    const struct wall_state *wstate = L->wstate;
+    const struct walls *W = L->W;
+    const struct wall_state *wstate = W->state;
     const struct kernel *K = L->K;
     const struct gather *G = L->G;
     struct particles *P = L->P;
-    const double g = cfg->g, vol = L->dx * L->dx, rho_default = cfg->media[0].rho0;
+    const double g = W->g, vol = L->dx * L->dx, rho_alone = W->rho_alone;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
@@ -387,7 +390,7 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
             srho += P->rho[j] * wgt;
             svz += P->vz[j] * wgt;
         }
-        const int noslip = cfg->walls[w].slip == WALL_NO_SLIP;
+        const int noslip = W->def[w].slip == WALL_NO_SLIP;
         if (sw > 0.0) {
             const double pw = sp / sw;
             P->p[i] = pw > 0.0 ? pw : 0.0;
@@ -396,7 +399,7 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
             P->rho[i] = srho / sw;
         } else {
             P->p[i] = 0.0;
-            P->rho[i] = rho_default;
+            P->rho[i] = rho_alone;
             P->uvx[i] = ws->vx;
             P->uvz[i] = ws->vz;
         }
@@ -405,10 +408,10 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
     }
 }
 
-void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state *wstate, const struct kernel *K,
-                             const struct gather *G, double dx, struct particles *P, size_t n, int n_threads)
+void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K, const struct gather *G, double dx,
+                             struct particles *P, size_t n, int n_threads)
 {
-    struct wall_loop L = {.cfg = cfg, .wstate = wstate, .K = K, .G = G, .dx = dx, .P = P};
+    struct wall_loop L = {.W = W, .K = K, .G = G, .dx = dx, .P = P};
     team_for(n_threads, n, extrapolate_range, &L);
 }
 
@@ -453,14 +456,14 @@ static int mirror_reserve(struct wall_mirror *M, size_t n, size_t n_list)
     return 0;
 }
 
-int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const struct kernel *K,
+int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struct kernel *K,
                        const struct gather *G, const struct particles *P, size_t n, int n_threads)
 {
     if (mirror_reserve(M, n, G->start[n]) != 0) return -1;
     M->n_rows = 0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) M->rows[M->n_rows++] = i;
-    struct wall_loop L = {.cfg = cfg, .K = K, .G = G, .cP = P, .M = M};
+    struct wall_loop L = {.W = W, .K = K, .G = G, .cP = P, .M = M};
     team_for(n_threads, M->n_rows, mirror_weights_range, &L);
     return 0;
 }
@@ -468,7 +471,7 @@ int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const 
 static void mirror_weights_range(void *arg, size_t b, size_t e)
 {
     const struct wall_loop *L = arg;
-    const struct case_def *cfg = L->cfg;
+    const struct walls *W = L->W;
     const struct kernel *K = L->K;
     const struct gather *G = L->G;
     const struct particles *P = L->cP;
@@ -482,7 +485,7 @@ static void mirror_weights_range(void *arg, size_t b, size_t e)
             M->weight[k] = extrapolation_weight(K, wendland, P->x[i] - P->x[j], P->z[i] - P->z[j]);
             sw += M->weight[k];
         }
-        const int noslip = cfg->walls[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
+        const int noslip = W->def[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
         if (sw > 0.0) {
             for (size_t k = G->start[i]; k < G->start[i + 1]; k++) M->weight[k] /= sw;
             M->sign[i] = noslip ? -1 : 1;
@@ -495,30 +498,31 @@ static void mirror_weights_range(void *arg, size_t b, size_t e)
 static void mirror_at_range(void *arg, size_t b, size_t e)
 {
     const struct wall_loop *L = arg;
-    const struct case_def *cfg = L->cfg;
+    const struct walls *W = L->W;
     const struct particles *P = L->cP;
     struct wall_mirror *M = L->M;
     const double *vx = L->vx_wall, *vz = L->vz_wall;
     for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
         const size_t w = particles_wall_index(P, i);
-        const int noslip = cfg->walls[w].slip == WALL_NO_SLIP;
+        const int noslip = W->def[w].slip == WALL_NO_SLIP;
         M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
         M->cz[i] = M->sign[i] ? mirror_velocity(noslip, vz[w], 0.0) : vz[w];
     }
 }
 
-void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *wstate,
-                     const struct particles *P, double t_from, double dt, int n_threads)
+void walls_mirror_at(struct wall_mirror *M, const struct walls *W, const struct particles *P, double t_from, double dt,
+                     int n_threads)
 {
-    double vx[CASE_MAX_WALLS], vz[CASE_MAX_WALLS];
-    for (size_t w = 0; w < cfg->n_walls; w++) {
-        const int mo = cfg->walls[w].motion;
+    const struct wall_state *wstate = W->state;
+    double vx[WALLS_MAX], vz[WALLS_MAX];
+    for (size_t w = 0; w < W->n; w++) {
+        const int mo = W->def[w].motion;
         vx[w] = wstate[w].vx;
         vz[w] = wstate[w].vz;
-        if (mo >= 0 && dt > 0.0) step_end_velocity(&cfg->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
+        if (mo >= 0 && dt > 0.0) step_end_velocity(&W->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
     }
-    struct wall_loop L = {.cfg = cfg, .cP = P, .M = M, .vx_wall = vx, .vz_wall = vz};
+    struct wall_loop L = {.W = W, .cP = P, .M = M, .vx_wall = vx, .vz_wall = vz};
     team_for(n_threads, M->n_rows, mirror_at_range, &L);
 }
 

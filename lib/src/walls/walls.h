@@ -6,10 +6,11 @@
 #define MIXSPH_WALLS_H
 #include <stddef.h>
 
-#include "case.h"
 #include "kernel.h"
+#include "mixsph.h" /* mixsph_interrupt */
 #include "neighbours.h"
 #include "particles.h"
+#include "wall_def.h"
 
 /* The moving state of one wall. */
 struct wall_state {
@@ -20,49 +21,65 @@ struct wall_state {
     double ext_vx, ext_vz; /* [m/s] */
 };
 
-/** Velocity and acceleration of every wall at t = 0 from its motion law. */
-void walls_start(const struct case_def *cfg, struct wall_state *ws);
-
-/** Give moving wall w the velocity (vx, vz) and acceleration (ax, az) from now on, between two
- *  steps: its state, its particles' velocity and their velocity in the viscous terms (the mirror
- *  of the last wall pass, which the next regime decision reads) change with it. */
-void walls_change_velocity(const struct case_def *cfg, struct wall_state *ws, size_t w, double vx, double vz, double ax,
-                           double az, struct particles *P);
-
-#define WALLS_INTERRUPTED (-2L)
-
 /* numerics.wall_placement: where the wall particles sit (docs/model.md section 8). */
 enum wall_placement {
     WALL_PLACEMENT_LATTICE = 0, /* the sites of the global lattice behind each wall */
     WALL_PLACEMENT_ALIGNED = 1  /* rows parallel to each segment, fans at inner corners */
 };
 
-/** Append the wall particles of every wall of the case at spacing dx (cfg->wall_layers layers
- *  deep, placed as cfg->wall_placement says); their `medium` field holds their wall's index and
+/* The walls of a simulation: their definitions and parameters, set once from the case
+ * (walls_init), and their moving states. */
+struct walls {
+    size_t n;                       /* number of walls */
+    const struct wall *def;         /* their definitions [n] (the case's) */
+    const struct motion *motions;   /* the motion laws def[w].motion indexes (the case's) */
+    int layers;                     /* layers of wall particles behind each wall */
+    int placement;                  /* enum wall_placement */
+    double lattice_z0;              /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
+    double g;                       /* gravity [m/s2] along -z, in the extrapolated pressure */
+    double rho_alone;               /* density of a wall particle with no fluid around it [kg/m3] */
+    struct wall_state state[WALLS_MAX];
+};
+
+/** The walls from their definitions (kept by reference: they must outlive W) and parameters, at
+ *  rest at t = 0 with their motion laws' velocity and acceleration there. */
+void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
+                int placement, double lattice_z0, double g, double rho_alone);
+
+/** Give moving wall w the velocity (vx, vz) and acceleration (ax, az) from now on, between two
+ *  steps: its state, its particles' velocity and their velocity in the viscous terms (the mirror
+ *  of the last wall pass, which the next regime decision reads) change with it. */
+void walls_change_velocity(struct walls *W, size_t w, double vx, double vz, double ax,
+                           double az, struct particles *P);
+
+#define WALLS_INTERRUPTED (-2L)
+
+/** Append the wall particles of every wall of the case at spacing dx (W->layers layers
+ *  deep, placed as W->placement says); their `medium` field holds their wall's index and
  *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row,
  *  or every segment when aligned. Returns the number added, -1 when out of memory,
  *  WALLS_INTERRUPTED when the host asked to stop. */
-long walls_generate(const struct case_def *cfg, const struct wall_state *ws, double dx, const mixsph_interrupt *interrupt,
+long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
 
 /** Signed distance of (x, z) to wall w at its current position (< 0 behind it), and whether the
  *  closest point is an end of the polyline. */
-void walls_signed_distance(const struct case_def *cfg, const struct wall_state *ws, size_t w, double x, double z,
+void walls_signed_distance(const struct walls *W, size_t w, double x, double z,
                            double *d, int *at_end);
 
 /** Move the walls and their particles from t_from by dt. */
-void walls_move(const struct case_def *cfg, struct wall_state *ws, struct particles *P, double t_from, double dt);
+void walls_move(struct walls *W, struct particles *P, double t_from, double dt);
 
 /** Keep a particle moving (x0,z0) -> (*x1,*z1) on the fluid side of every wall: a crossing is
  *  put back at `gap` from the wall and loses its velocity into it (counted in *clips).
  *  ox_old/oz_old: the walls' displacements at the start of the step (walls already moved). */
-void walls_clip(const struct case_def *cfg, const struct wall_state *ws, const double *ox_old, const double *oz_old,
+void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old,
                 double gap, double x0, double z0, double *x1, double *z1, double *vx, double *vz, long *clips);
 
 /** The state of the first n particles' wall particles from the fluid around them (Adami et
  *  al. 2012): pressure, viscous (mirror) velocity uvx/uvz, density and the mass the artificial
  *  viscosity sees. Needs the gather lists of G. */
-void walls_extrapolate_fluid(const struct case_def *cfg, const struct wall_state *ws, const struct kernel *K,
+void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K,
                              const struct gather *G, double dx, struct particles *P, size_t n, int n_threads);
 
 /* The wall particles' velocity in the viscous terms as the affine map of the non-wall
@@ -85,13 +102,13 @@ void walls_mirror_free(struct wall_mirror *M);
 
 /** The map's weights and signs at the current positions, over the first n particles. Needs the
  *  gather lists of G. Returns -1 when out of memory. */
-int walls_mirror_build(struct wall_mirror *M, const struct case_def *cfg, const struct kernel *K,
+int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struct kernel *K,
                        const struct gather *G, const struct particles *P, size_t n, int n_threads);
 
 /** The map's constants with the walls' velocities at t_from + dt (dt > 0: by their motion law or
  *  external velocity over the step from t_from, walls not yet moved) or their current ones
  *  (dt = 0). */
-void walls_mirror_at(struct wall_mirror *M, const struct case_def *cfg, const struct wall_state *ws,
+void walls_mirror_at(struct wall_mirror *M, const struct walls *W,
                      const struct particles *P, double t_from, double dt, int n_threads);
 
 /** Overwrite the wall rows of (vx, vz) with the map of their non-wall rows: c_g + s_g a u

@@ -1,0 +1,22 @@
+/* motion.h - a prescribed motion law: a velocity table, linear between its rows, stretched in
+ * time and scaled in speed (docs/cases.md, "motions"); the walls move by it. */
+#ifndef MIXSPH_MOTION_H
+#define MIXSPH_MOTION_H
+#include <stddef.h>
+
+#include "schema.h" /* SCHEMA_NAME_LEN */
+
+struct motion {
+    char name[SCHEMA_NAME_LEN];
+    size_t n;
+    double *t, *vx, *vz;      /* velocity law, linear between rows [s], [m/s] */
+    double speed_scale;       /* velocities are multiplied by this [-] */
+    double time_scale;        /* the law is stretched in time by this [-] */
+};
+
+/** Velocity of a motion law at time t (linear between rows, held at the ends). */
+void motion_velocity(const struct motion *m, double t, double *vx, double *vz);
+/** Acceleration of a motion law at time t (slope of the current interval). */
+void motion_acceleration(const struct motion *m, double t, double *ax, double *az);
+
+#endif
