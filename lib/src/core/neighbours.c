@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "mixsph.h"
+#include "team.h"
 
 void neighbours_free(struct neighbours *NB)
 {
@@ -54,12 +55,27 @@ static inline void trim(const double *x, const double *z, double xi, double zi, 
     *e = hi;
 }
 
-int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads)
+/* The arguments of a parallel loop of this file (core/team.h). */
+struct nb_loop {
+    struct neighbours *NB;
+    const struct neighbours *cNB;
+    struct gather *G;
+    const struct cells *C;
+    const struct particles *P;
+    const uint8_t *state;
+    double rc2;
+    double m;  /* max */
+    int out;   /* | */
+};
+
+static void relist_range(void *arg, size_t b, size_t e)
 {
-    const double rc2 = rc * rc;
+    const struct nb_loop *L = arg;
+    struct neighbours *NB = L->NB;
+    const struct cells *C = L->C;
+    const double rc2 = L->rc2;
     const double *x = NB->x0, *z = NB->z0;
-#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = b; i < e; i++) {
         const size_t c = C->cell[i];
         const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
         const int last = ix + C->kx < C->nx ? ix + C->kx : C->nx - 1;
@@ -73,25 +89,42 @@ int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, do
         NB->rng[4 * i + 2] = (uint32_t)b2;
         NB->rng[4 * i + 3] = (uint32_t)e2;
     }
+}
+
+int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads)
+{
+    struct nb_loop L = {.NB = NB, .C = C, .rc2 = rc * rc};
+    team_for(n_threads > 0 ? n_threads : 1, n, relist_range, &L);
     NB->builds++;
     return 0;
 }
 
-double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
-                             int *outside, int n_threads)
+static void shift_range(void *arg, size_t b, size_t e)
 {
+    struct nb_loop *L = arg;
+    const struct neighbours *NB = L->cNB;
+    const struct cells *C = L->C;
+    const struct particles *P = L->P;
     double m = 0.0;
     int out = 0;
     const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
-#pragma omp parallel for schedule(static) reduction(max : m) reduction(| : out) num_threads(n_threads > 0 ? n_threads : 1)
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = b; i < e; i++) {
         const double dx = P->x[i] - NB->x0[i], dz = P->z[i] - NB->z0[i];
         const double d2 = dx * dx + dz * dz;
         m = d2 > m ? d2 : m;
         out |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
     }
-    *outside = out;
-    return m;
+    team_max_double(&L->m, m);
+    team_or_int(&L->out, out);
+}
+
+double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
+                             int *outside, int n_threads)
+{
+    struct nb_loop L = {.cNB = NB, .C = C, .P = P};
+    team_for(n_threads > 0 ? n_threads : 1, n, shift_range, &L);
+    *outside = L.out;
+    return L.m;
 }
 
 void neighbours_gather_free(struct gather *G)
@@ -131,16 +164,22 @@ static inline size_t wall_scan(const struct gather *G, const double *x, const do
     return k;
 }
 
-int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const struct cells *C, const uint8_t *state,
-                            size_t n, double rc, int n_threads)
+/* Particles [b, e)'s gather ranges and, for wall particles, their neighbour counts (in
+ * G->start + 1): one loop, since a count reads only its own particle's ranges. */
+static void gather_ranges_range(void *arg, size_t i0, size_t i1)
 {
-    const double rc2 = rc * rc;
-    const double *x = NB->x0, *z = NB->z0;
-#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
-    for (size_t i = 0; i < n; i++) {
+    const struct nb_loop *L = arg;
+    struct gather *G = L->G;
+    const struct cells *C = L->C;
+    const uint8_t *state = L->state;
+    const double rc2 = L->rc2;
+    const double *x = L->cNB->x0, *z = L->cNB->z0;
+    size_t *cnt = G->start + 1;
+    for (size_t i = i0; i < i1; i++) {
         uint32_t *r = G->rng + 6 * i;
         if (G->mode[i] == NEIGHBOURS_GATHER_NONE) {
             memset(r, 0, 6 * sizeof *r);
+            cnt[i] = 0;
             continue;
         }
         const size_t c = C->cell[i];
@@ -152,10 +191,26 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
             r[2 * (row + 1)] = (uint32_t)b;
             r[2 * (row + 1) + 1] = (uint32_t)e;
         }
+        cnt[i] = state[i] == MIXSPH_STATE_WALL ? wall_scan(G, x, z, state, i, rc2, NULL) : 0;
     }
-    size_t *cnt = G->start + 1;
-#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
-    for (size_t i = 0; i < n; i++) cnt[i] = state[i] == MIXSPH_STATE_WALL ? wall_scan(G, x, z, state, i, rc2, NULL) : 0;
+}
+
+static void gather_list_range(void *arg, size_t b, size_t e)
+{
+    const struct nb_loop *L = arg;
+    const struct gather *G = L->G;
+    const uint8_t *state = L->state;
+    const double *x = L->cNB->x0, *z = L->cNB->z0;
+    for (size_t i = b; i < e; i++)
+        if (state[i] == MIXSPH_STATE_WALL) wall_scan(G, x, z, state, i, L->rc2, G->list + G->start[i]);
+}
+
+int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const struct cells *C, const uint8_t *state,
+                            size_t n, double rc, int n_threads)
+{
+    struct nb_loop L = {.cNB = NB, .G = G, .C = C, .state = state, .rc2 = rc * rc};
+    n_threads = n_threads > 0 ? n_threads : 1;
+    team_for(n_threads, n, gather_ranges_range, &L);
     G->start[0] = 0;
     for (size_t i = 0; i < n; i++) G->start[i + 1] += G->start[i];
     const size_t total = G->start[n];
@@ -164,8 +219,6 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
         if (grow((void **)&G->list, cap, sizeof(uint32_t))) return -1;
         G->cap_list = cap;
     }
-#pragma omp parallel for schedule(static) num_threads(n_threads > 0 ? n_threads : 1)
-    for (size_t i = 0; i < n; i++)
-        if (state[i] == MIXSPH_STATE_WALL) wall_scan(G, x, z, state, i, rc2, G->list + G->start[i]);
+    team_for(n_threads, n, gather_list_range, &L);
     return 0;
 }

@@ -21,6 +21,7 @@
 #include "law.h"
 #include "pore_pressure.h"
 #include "status.h"
+#include "team.h"
 
 static const struct case_choice granular_ep_type[] = {{"granular", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
 
@@ -96,18 +97,22 @@ static void *elastic_plastic_create(const struct law_setup *setup) { return pore
 
 static void elastic_plastic_destroy(void *state) { pore_columns_free(state); }
 
-/* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
-static long elastic_plastic_update(void *state, const struct law_step *step)
+struct plastic_loop {
+    const struct law_step *step;
+    const struct pore_columns *pore;
+    long plastic; /* + over the threads */
+};
+
+static void plastic_range(void *arg, size_t b, size_t e)
 {
-    struct pore_columns *pore = state;
+    struct plastic_loop *L = arg;
+    const struct law_step *step = L->step;
+    const struct pore_columns *pore = L->pore;
     struct particles *P = step->P;
     const struct medium *media = step->media;
     const double dt = step->dt, pb = step->p_background;
-    if (!(dt > 0.0)) return 0;
-    pore_columns_tops(pore, P, media); /* (of the saturated media, of any granular law) */
     long plastic = 0;
-#pragma omp parallel for schedule(static) reduction(+ : plastic) num_threads(step->n_threads)
-    for (size_t i = 0; i < step->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const struct medium *m = &media[P->medium[i]];
         if (m->law != LAW_ELASTIC_PLASTIC) continue;
@@ -128,7 +133,18 @@ static long elastic_plastic_update(void *state, const struct law_step *step)
         P->szz[i] = s.zz;
         P->syy[i] = s.yy;
     }
-    return plastic;
+    team_add_long(&L->plastic, plastic);
+}
+
+/* The per-step update: see the head of this file. Returns the grains on the cone or its apex. */
+static long elastic_plastic_update(void *state, const struct law_step *step)
+{
+    struct pore_columns *pore = state;
+    if (!(step->dt > 0.0)) return 0;
+    pore_columns_tops(pore, step->P, step->media); /* (of the saturated media, of any granular law) */
+    struct plastic_loop L = {.step = step, .pore = pore};
+    team_for(step->n_threads, step->n, plastic_range, &L);
+    return L.plastic;
 }
 
 const struct material_law law_elastic_plastic = {

@@ -9,6 +9,7 @@
 
 #include "elasticity.h"
 #include "law.h"
+#include "team.h"
 
 static const struct case_choice elastic_type[] = {{"elastic", LAW_ELASTIC_SOLID}, {NULL, 0}};
 
@@ -57,15 +58,13 @@ static double elastic_initial_pressure(const struct medium *m, double p_hydrosta
     return 0.0;
 }
 
-static long elastic_update(void *state, const struct law_step *step)
+static void elastic_range(void *arg, size_t b, size_t e)
 {
-    (void)state;
+    const struct law_step *step = arg;
     struct particles *P = step->P;
     const struct medium *media = step->media;
     const double dt = step->dt;
-    if (!(dt > 0.0)) return 0;
-#pragma omp parallel for schedule(static) num_threads(step->n_threads)
-    for (size_t i = 0; i < step->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || media[P->medium[i]].law != LAW_ELASTIC_SOLID) continue;
         double g[4];
         velocity_gradient_corrected(step->grad, i, g);
@@ -76,6 +75,13 @@ static long elastic_update(void *state, const struct law_step *step)
         P->szz[i] = s.zz;
         P->syy[i] = s.yy;
     }
+}
+
+static long elastic_update(void *state, const struct law_step *step)
+{
+    (void)state;
+    if (!(step->dt > 0.0)) return 0;
+    team_for(step->n_threads, step->n, elastic_range, (void *)step);
     return 0;
 }
 

@@ -46,6 +46,7 @@
 #include "pore_pressure.h"
 #include "rheology.h"
 #include "status.h"
+#include "team.h"
 
 /* ---- its case keys: media.<name> of type granular ------------------------------------------- */
 
@@ -212,90 +213,103 @@ static int frozen(const struct mixture *M, const struct particles *P, size_t i)
     return P->z[i] < M->bed_z[bed_column(M, P->x[i])] - 2.0 * M->h;
 }
 
-static long mixture_update(void *state, const struct law_step *step)
+/* The three loops of the update in one parallel region (each waits for the one before: the
+ * second reads the regimes of the first, the third the pressures of the second). */
+struct mixture_region {
+    struct mixture *M;
+    const struct law_step *step;
+    int fixed_bed;
+    long fixed; /* + over the threads */
+};
+
+static void mixture_region(void *arg, int tid, int nth)
 {
-    struct mixture *M = state;
+    struct mixture_region *R = arg;
+    struct mixture *M = R->M;
+    const struct law_step *step = R->step;
     const struct kernel *KW = step->K;
     const struct gather *G = step->G;
     struct particles *P = step->P;
-    const size_t n = step->n;
     const struct medium *media = M->media;
-    pore_columns_tops(M->pore, P, media);
-    const int fixed_bed = M->fixed_bed_speed >= 0.0;
-    if (fixed_bed) fixed_bed_tops(M, P, n);
-    long fixed = 0;
+    const int fixed_bed = R->fixed_bed;
     const double g = M->g, pb = M->p_background;
-    /* one parallel region for the three loops (each waits for the one before: the second reads the
-     * regimes of the first, the third the pressures of the second) */
-#pragma omp parallel num_threads(step->n_threads)
-    {
-#pragma omp for schedule(static) reduction(+ : fixed)
-        for (size_t i = 0; i < n; i++) {
-            if (P->state[i] == MIXSPH_STATE_WALL) continue;
-            const struct medium *m = &media[P->medium[i]];
-            if (m->law != LAW_MIXTURE_PAPER) continue;
-            double grad[4];
-            velocity_gradient_corrected(step->grad, i, grad);
-            const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
-            const double pw = m->saturated ? pore_pressure(M->pore, m, P->x[i], P->z[i]) : 0.0;
-            const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
-            const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
-            double mu;
-            int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
-            if (fixed_bed && frozen(M, P, i)) {
-                fix = 1;
-                mu = m->mu_thr;
-            }
-            if (fix) {
-                P->state[i] = MIXSPH_STATE_FIXED;
-                P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
-                fixed++;
-            } else {
-                P->state[i] = MIXSPH_STATE_MOBILE;
-            }
-            P->mu[i] = mu;
+    size_t b, e;
+    team_share(step->n, tid, nth, &b, &e);
+    long fixed = 0;
+    for (size_t i = b; i < e; i++) {
+        if (P->state[i] == MIXSPH_STATE_WALL) continue;
+        const struct medium *m = &media[P->medium[i]];
+        if (m->law != LAW_MIXTURE_PAPER) continue;
+        double grad[4];
+        velocity_gradient_corrected(step->grad, i, grad);
+        const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
+        const double pw = m->saturated ? pore_pressure(M->pore, m, P->x[i], P->z[i]) : 0.0;
+        const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
+        const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
+        double mu;
+        int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
+        if (fixed_bed && frozen(M, P, i)) {
+            fix = 1;
+            mu = m->mu_thr;
         }
-        if (fixed > 0) { /* the reduction is complete after the loop's barrier, in every thread */
-            /* pressure of the fixed grains from the mobile grains around them */
-#pragma omp for schedule(static)
-            for (size_t i = 0; i < n; i++) {
-                if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
-                const double xi = P->x[i], zi = P->z[i];
-                double sw = 0.0, sp = 0.0;
-                for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
-                    for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
-                    if (P->state[j] != MIXSPH_STATE_MOBILE || media[P->medium[j]].law != LAW_MIXTURE_PAPER) continue;
-                    const double rx = xi - P->x[j], rz = zi - P->z[j];
-                    const double r2 = rx * rx + rz * rz;
-                    if (r2 >= KW->r2max) continue;
-                    const double w = kernel_w(KW, sqrt(r2));
-                    sw += w;
-                    sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
-                }
-                if (sw > 0.0) {
-                    const double p = sp / sw;
-                    P->p[i] = media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
-                }
-            }
-            if (fixed_bed) {
-                /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
-                 * final: the top is never frozen, and its extrapolation above is done) */
-#pragma omp for schedule(static) nowait
-                for (size_t i = 0; i < n; i++) {
-                    if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
-                    const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
-                    const struct medium *m = &media[P->medium[i]];
-                    double p = P->p[top] + media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
-                    if (m->tension_cutoff && p < pb) p = pb;
-                    P->p[i] = p;
-                    P->rho[i] = eos_density(p - pb, m->rho0, m->c);
-                    P->inv_rho[i] = 1.0 / P->rho[i];
-                    P->vol[i] = P->m[i] * P->inv_rho[i];
-                }
-            }
+        if (fix) {
+            P->state[i] = MIXSPH_STATE_FIXED;
+            P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
+            fixed++;
+        } else {
+            P->state[i] = MIXSPH_STATE_MOBILE;
+        }
+        P->mu[i] = mu;
+    }
+    team_add_long(&R->fixed, fixed);
+    team_barrier(); /* the regimes, and the count of fixed grains, are complete */
+    if (R->fixed == 0) return;
+    /* pressure of the fixed grains from the mobile grains around them */
+    for (size_t i = b; i < e; i++) {
+        if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
+        const double xi = P->x[i], zi = P->z[i];
+        double sw = 0.0, sp = 0.0;
+        for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
+            for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
+            if (P->state[j] != MIXSPH_STATE_MOBILE || media[P->medium[j]].law != LAW_MIXTURE_PAPER) continue;
+            const double rx = xi - P->x[j], rz = zi - P->z[j];
+            const double r2 = rx * rx + rz * rz;
+            if (r2 >= KW->r2max) continue;
+            const double w = kernel_w(KW, sqrt(r2));
+            sw += w;
+            sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
+        }
+        if (sw > 0.0) {
+            const double p = sp / sw;
+            P->p[i] = media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
         }
     }
-    return fixed;
+    if (!fixed_bed) return;
+    team_barrier();
+    /* the frozen grains: hydrostatic from the top of their column's fixed bed (its pressure is
+     * final: the top is never frozen, and its extrapolation above is done) */
+    for (size_t i = b; i < e; i++) {
+        if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
+        const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
+        const struct medium *m = &media[P->medium[i]];
+        double p = P->p[top] + media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+        if (m->tension_cutoff && p < pb) p = pb;
+        P->p[i] = p;
+        P->rho[i] = eos_density(p - pb, m->rho0, m->c);
+        P->inv_rho[i] = 1.0 / P->rho[i];
+        P->vol[i] = P->m[i] * P->inv_rho[i];
+    }
+}
+
+static long mixture_update(void *state, const struct law_step *step)
+{
+    struct mixture *M = state;
+    struct particles *P = step->P;
+    pore_columns_tops(M->pore, P, M->media);
+    struct mixture_region R = {.M = M, .step = step, .fixed_bed = M->fixed_bed_speed >= 0.0};
+    if (R.fixed_bed) fixed_bed_tops(M, P, step->n);
+    team_run(step->n_threads, mixture_region, &R);
+    return R.fixed;
 }
 
 const struct material_law law_mixture_paper = {

@@ -51,6 +51,7 @@
 #include <stdint.h>
 
 #include "mixsph.h"
+#include "team.h"
 
 /* Not on Windows (the FMU's win64 binary): its loader has no ifunc to pick a clone. */
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && !defined(MIXSPH_NO_CLONES) && \
@@ -675,13 +676,15 @@ static int scratch_reserve(struct forces *F, size_t n)
 
 typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, struct particles *restrict, size_t, size_t);
 
-/* Walk `fn` over all bands of FORCES_BAND_ROWS cell rows, even bands in parallel, then odd:
- * orphaned worksharing loops, to be called by every thread of the enclosing parallel region (each
- * phase ends with the loop's barrier); called outside a region, the calling thread walks them all
- * in the same order. A pass opens one region for its bands and its per-particle loop after them,
- * so that a step has few parallel regions: each region's fork and join, and each barrier, waits
- * for a thread that another process may have descheduled (docs/performance.md, "Under load"). */
-static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X, int last_nowait)
+/* Walk `fn` over all bands of FORCES_BAND_ROWS cell rows, even bands in parallel, then odd, the
+ * threads taking bands one at a time from the counters bands[0] (even) and bands[1] (odd), reset
+ * before the region: to be called by every thread of a team region (core/team.h), each phase
+ * ending with a barrier (the odd one not with `last_nowait`); with one thread, the calling
+ * thread walks them all in the same order. A pass runs its bands and its per-particle loop after
+ * them in one region, so that a step has few fork-joins and barriers: each waits for a thread
+ * that another process may have descheduled (docs/performance.md, "Under load"). */
+static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X, team_counter bands[2],
+                          int last_nowait)
 {
     const struct cells *C = S->C;
     const long nb = (C->nz + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
@@ -692,16 +695,48 @@ static void bands_in_team(const struct pair_system *S, band_fn fn, const struct 
         const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;                        \
         fn(X, S->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);         \
     } while (0)
-#pragma omp for schedule(dynamic, 1)
-    for (long b = 0; b < nb; b += 2) FORCES_BAND(b);
-    if (last_nowait) {
-#pragma omp for schedule(dynamic, 1) nowait
-        for (long b = 1; b < nb; b += 2) FORCES_BAND(b);
-    } else {
-#pragma omp for schedule(dynamic, 1)
-        for (long b = 1; b < nb; b += 2) FORCES_BAND(b);
-    }
+    for (long b; (b = 2 * team_next(&bands[0])) < nb;) FORCES_BAND(b);
+    team_barrier();
+    for (long b; (b = 2 * team_next(&bands[1]) + 1) < nb;) FORCES_BAND(b);
+    if (!last_nowait) team_barrier();
 #undef FORCES_BAND
+}
+
+/* A pass's parallel region: its pair context, band counters and outcome. */
+struct pass_region {
+    const struct pair_system *S;
+    const struct pair_ctx *X;
+    band_fn fn;
+    team_counter bands[2];
+    size_t n;                         /* active particles */
+    struct velocity_gradient *grad;   /* density pass: the grains' velocity gradient, or NULL */
+    const double *count;              /* density pass: the neighbour counts */
+    double g;                         /* momentum pass: gravity */
+    const double *const *wall_sums;   /* momentum pass with stress: the walls' sums of the wall friction */
+    double theta_dt_over_h;           /* smoothing */
+    const double *sum, *weight;       /* smoothing: its sums */
+    int bad;                          /* a non-finite rate (| over the threads) */
+};
+
+static void pass_region_init(struct pass_region *R, const struct pair_system *S, const struct pair_ctx *X, band_fn fn,
+                             size_t n)
+{
+    memset(R, 0, sizeof *R);
+    R->S = S;
+    R->X = X;
+    R->fn = fn;
+    R->n = n;
+    team_counter_reset(&R->bands[0]);
+    team_counter_reset(&R->bands[1]);
+}
+
+/* A region of the bands alone (the viscous operator, the group couplings). */
+static void bands_region(void *arg, int tid, int nth)
+{
+    (void)tid;
+    (void)nth;
+    struct pass_region *R = arg;
+    bands_in_team(R->S, R->fn, R->X, R->bands, 1);
 }
 
 static size_t active_count(const struct pair_system *S) { return S->C->start[S->C->ncell]; }
@@ -710,6 +745,30 @@ static size_t active_count(const struct pair_system *S) { return S->C->start[S->
  * region: the gradient reads positions, velocities and volumes, which the density pass does not
  * write, so it runs while the last bands finish; the per-particle loop after the bands waits for
  * them. */
+static void density_region(void *arg, int tid, int nth)
+{
+    struct pass_region *R = arg;
+    struct particles *P = R->S->P;
+    const struct medium *M = R->S->media;
+    const double *count = R->count;
+    bands_in_team(R->S, continuity_band, R->X, R->bands, R->grad != NULL);
+    size_t b, e;
+    team_share(R->n, tid, nth, &b, &e);
+    if (R->grad) {
+        for (size_t i = b; i < e; i++)
+            if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
+                gradient_particle(R->X, R->S->G, P, R->grad, i);
+        team_barrier(); /* the last bands */
+    }
+    int bad = 0;
+    for (size_t i = b; i < e; i++) {
+        P->drho[i] *= P->rho[i];
+        P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
+        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
+    }
+    team_or_int(&R->bad, bad);
+}
+
 static int density_rate(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad)
 {
     struct particles *P = S->P;
@@ -725,26 +784,12 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
         X.fk = F->fk;
         X.fk_off = F->fk_off;
     }
-    int bad = 0;
-    const double *count = F->nbr_count;
-    const struct medium *M = S->media;
-#pragma omp parallel num_threads(S->n_threads)
-    {
-        bands_in_team(S, continuity_band, &X, grad != NULL);
-        if (grad) {
-#pragma omp for schedule(static)
-            for (size_t i = 0; i < n; i++)
-                if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
-                    gradient_particle(&X, S->G, P, grad, i);
-        }
-#pragma omp for schedule(static) reduction(| : bad) nowait
-        for (size_t i = 0; i < n; i++) {
-            P->drho[i] *= P->rho[i];
-            P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
-            bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
-        }
-    }
-    return bad;
+    struct pass_region R;
+    pass_region_init(&R, S, &X, continuity_band, n);
+    R.grad = grad;
+    R.count = F->nbr_count;
+    team_run(S->n_threads, density_region, &R);
+    return R.bad;
 }
 
 int forces_density_rate(struct forces *F, const struct pair_system *S) { return density_rate(F, S, NULL); }
@@ -754,17 +799,26 @@ int forces_density_rate_gradient(struct forces *F, const struct pair_system *S, 
     return density_rate(F, S, grad);
 }
 
+static void gradient_region(void *arg, int tid, int nth)
+{
+    const struct pass_region *R = arg;
+    const struct particles *P = R->S->P;
+    const struct medium *M = R->S->media;
+    size_t b, e;
+    team_share(R->n, tid, nth, &b, &e);
+    for (size_t i = b; i < e; i++)
+        if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
+            gradient_particle(R->X, R->S->G, P, R->grad, i);
+}
+
 void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradient *out)
 {
-    const struct particles *P = S->P;
-    const struct medium *M = S->media;
     struct pair_ctx X;
     pair_ctx_init(S, &X);
-    const size_t n = active_count(S);
-#pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++)
-        if (P->state[i] <= MIXSPH_STATE_FIXED && (M[P->medium[i]].features & LAW_USES_GRADIENT))
-            gradient_particle(&X, S->G, P, out, i);
+    struct pass_region R;
+    pass_region_init(&R, S, &X, NULL, active_count(S));
+    R.grad = out;
+    team_run(S->n_threads, gradient_region, &R);
 }
 
 /* The wall friction of an elastic-plastic grain i (docs/model.md [DP-W]): the tangential part F_t
@@ -797,6 +851,28 @@ static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, dou
     const double cut = (ft - bound) / ft;
     *fx -= cut * tx;
     *fz -= cut * tz;
+}
+
+static void momentum_region(void *arg, int tid, int nth)
+{
+    struct pass_region *R = arg;
+    struct particles *P = R->S->P;
+    const struct medium *M = R->S->media;
+    const double g = R->g, pb = R->S->params.p_background;
+    bands_in_team(R->S, momentum_band, R->X, R->bands, 0);
+    size_t b, e;
+    team_share(R->n, tid, nth, &b, &e);
+    int bad = 0;
+    for (size_t i = b; i < e; i++) {
+        if (R->wall_sums && P->state[i] != MIXSPH_STATE_WALL && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
+            const double s = M[P->medium[i]].sin_phi;
+            wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, &P->ax[i], &P->az[i]);
+        }
+        P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
+        P->az[i] = P->az[i] * P->inv_m[i] - g;
+        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
+    }
+    team_or_int(&R->bad, bad);
 }
 
 int forces_momentum(struct forces *F, const struct pair_system *S)
@@ -833,27 +909,13 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
             memset(F->wall_sum[q], 0, n * sizeof(double));
             X.wall_sum[q] = F->wall_sum[q];
         }
-    const double *const *ws = (const double *const *)F->wall_sum;
-    const struct medium *M = S->media;
-    const double pb = S->params.p_background;
-    const double g = X.g;
-    int bad = 0;
-#pragma omp parallel num_threads(S->n_threads)
-    {
-        bands_in_team(S, momentum_band, &X, 0);
-#pragma omp for schedule(static) reduction(| : bad) nowait
-        for (size_t i = 0; i < n; i++) {
-            if (friction && P->state[i] != MIXSPH_STATE_WALL && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
-                const double s = M[P->medium[i]].sin_phi;
-                wall_friction_bound(ws, i, P->vol[i], s / sqrt(1.0 - s * s), pb, &P->ax[i], &P->az[i]);
-            }
-            P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
-            P->az[i] = P->az[i] * P->inv_m[i] - g;
-            bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
-        }
-    }
+    struct pass_region R;
+    pass_region_init(&R, S, &X, momentum_band, n);
+    R.g = X.g;
+    R.wall_sums = friction ? (const double *const *)F->wall_sum : NULL;
+    team_run(S->n_threads, momentum_region, &R);
     F->visc_valid = X.visc_w != NULL;
-    return bad;
+    return R.bad;
 }
 
 /* A pass context over the couplings the last implicit momentum pass stored; -1 without them. */
@@ -880,8 +942,9 @@ int forces_viscous_apply(const struct forces *F, const struct pair_system *S, co
     X.out_x = out_x;
     X.out_z = out_z;
     X.out_diag = diag;
-#pragma omp parallel num_threads(S->n_threads)
-    bands_in_team(S, viscous_band, &X, 1);
+    struct pass_region R;
+    pass_region_init(&R, S, &X, viscous_band, n);
+    team_run(S->n_threads, bands_region, &R);
     return 0;
 }
 
@@ -893,8 +956,9 @@ int forces_viscous_group_couplings(const struct forces *F, const struct pair_sys
     X.group = group;
     X.group_stride = groups_per_row;
     X.group_w = sums;
-#pragma omp parallel num_threads(S->n_threads)
-    bands_in_team(S, group_band, &X, 1);
+    struct pass_region R;
+    pass_region_init(&R, S, &X, group_band, active_count(S));
+    team_run(S->n_threads, bands_region, &R);
     return 0;
 }
 
@@ -929,9 +993,28 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
  * and its density follows (rho_i += dp_i / c_i^2), so the next density step starts from the
  * smoothed state. Masses are untouched. A damping of the acoustic noise of weakly compressible
  * SPH (like delta-SPH's density diffusion); an option, off by default. */
+static void smooth_region(void *arg, int tid, int nth)
+{
+    struct pass_region *R = arg;
+    struct particles *P = R->S->P;
+    const struct medium *M = R->S->media;
+    const double *sum = R->sum, *weight = R->weight;
+    bands_in_team(R->S, smooth_band, R->X, R->bands, 0);
+    size_t b, e;
+    team_share(R->n, tid, nth, &b, &e);
+    for (size_t i = b; i < e; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED || !(weight[i] > 0.0)) continue;
+        const double c = M[P->medium[i]].c;
+        const double dp = R->theta_dt_over_h * c * sum[i] / weight[i];
+        P->p[i] += dp;
+        P->rho[i] += dp / (c * c);
+        P->inv_rho[i] = 1.0 / P->rho[i];
+        P->vol[i] = P->m[i] * P->inv_rho[i];
+    }
+}
+
 int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double theta_dt_over_h)
 {
-    struct particles *P = S->P;
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     const size_t n = active_count(S);
@@ -940,21 +1023,11 @@ int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double
     memset(F->smooth_weight, 0, n * sizeof(double));
     X.sum = F->smooth_sum;
     X.weight = F->smooth_weight;
-    const double *sum = F->smooth_sum, *weight = F->smooth_weight;
-    const struct medium *M = S->media;
-#pragma omp parallel num_threads(S->n_threads)
-    {
-        bands_in_team(S, smooth_band, &X, 0);
-#pragma omp for schedule(static) nowait
-        for (size_t i = 0; i < n; i++) {
-            if (P->state[i] > MIXSPH_STATE_FIXED || !(weight[i] > 0.0)) continue;
-            const double c = M[P->medium[i]].c;
-            const double dp = theta_dt_over_h * c * sum[i] / weight[i];
-            P->p[i] += dp;
-            P->rho[i] += dp / (c * c);
-            P->inv_rho[i] = 1.0 / P->rho[i];
-            P->vol[i] = P->m[i] * P->inv_rho[i];
-        }
-    }
+    struct pass_region R;
+    pass_region_init(&R, S, &X, smooth_band, n);
+    R.theta_dt_over_h = theta_dt_over_h;
+    R.sum = F->smooth_sum;
+    R.weight = F->smooth_weight;
+    team_run(S->n_threads, smooth_region, &R);
     return 0;
 }

@@ -29,6 +29,7 @@
 
 #include "clock.h"
 #include "integrate.h"
+#include "team.h"
 
 #include "eos.h"
 #include "time_step.h"
@@ -56,18 +57,40 @@ static inline double particle_time_step(const mixsph_sim *s, size_t i, int impli
     return time_step_bound(s->scheme.cfl, s->scheme.cfl_visc, s->phys.h, s->phys.c_max, u, P->rho[i], mu);
 }
 
-double integrate_time_step(const mixsph_sim *s)
+/* A loop of this file over the particles: the simulation, the loop's parameters and its
+ * reductions (exact: min, max, |, integer +, so any split of the loop gives the same). */
+struct particle_loop {
+    mixsph_sim *s;
+    int implicit;
+    double a, b;      /* the loop's parameters (a kick, a time step) */
+    const double *ox_old, *oz_old;
+    size_t n_active;
+    double dt_min;    /* min */
+    double shift2;    /* max */
+    int flag;         /* | */
+    long count;       /* + */
+};
+
+static void time_step_range(void *arg, size_t b, size_t e)
 {
+    struct particle_loop *L = arg;
+    const mixsph_sim *s = L->s;
     const struct particles *P = &s->phys.P;
-    const int implicit = s->scheme.implicit; /* no viscous bound: the viscous step is implicit */
     double dt = INFINITY;
-#pragma omp parallel for schedule(static) reduction(min : dt) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const double d = particle_time_step(s, i, implicit);
+        const double d = particle_time_step(s, i, L->implicit);
         if (d < dt) dt = d;
     }
-    return dt;
+    team_min_double(&L->dt_min, dt);
+}
+
+double integrate_time_step(const mixsph_sim *s)
+{
+    /* no viscous bound with the implicit viscous step */
+    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = s->scheme.implicit, .dt_min = INFINITY};
+    team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
+    return L.dt_min;
 }
 
 /* The equation of state of particle i (not a wall, not lost): pressure, 1/rho, volume, alpha c h. */
@@ -84,14 +107,20 @@ static inline void particle_pressure(mixsph_sim *s, size_t i)
     P->avc[i] = m->alpha_m * m->c * s->phys.h;
 }
 
-void integrate_pressure_and_derived(mixsph_sim *s)
+static void pressure_range(void *arg, size_t b, size_t e)
 {
-    struct particles *P = &s->phys.P;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
+    mixsph_sim *s = ((struct particle_loop *)arg)->s;
+    const struct particles *P = &s->phys.P;
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
         particle_pressure(s, i);
     }
+}
+
+void integrate_pressure_and_derived(mixsph_sim *s)
+{
+    struct particle_loop L = {.s = s};
+    team_for(SIM_THREADS(s), s->phys.P.n, pressure_range, &L);
 }
 
 mixsph_status integrate_rebuild_lists(mixsph_sim *s)
@@ -102,6 +131,26 @@ mixsph_status integrate_rebuild_lists(mixsph_sim *s)
     if (neighbours_build(&s->work.NB, &s->work.C, &s->phys.P, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
     return integrate_build_gather_lists(s);
+}
+
+/* near_wall[i]: whether particle i is within L->a of a wall. */
+static void near_wall_range(void *arg, size_t b, size_t e)
+{
+    const struct particle_loop *L = arg;
+    const mixsph_sim *s = L->s;
+    const struct particles *P = &s->phys.P;
+    const double reach = L->a;
+    for (size_t i = b; i < e; i++) {
+        int close = 0;
+        if (P->state[i] != MIXSPH_STATE_WALL)
+            for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
+                double d;
+                int at_end;
+                walls_signed_distance(&s->phys.walls, w, P->x[i], P->z[i], &d, &at_end);
+                close = !(fabs(d) > reach); /* NaN counts as close */
+            }
+        s->work.near_wall[i] = (uint8_t)close;
+    }
 }
 
 /* Grains gather over all their neighbours (the velocity gradient), wall particles over the
@@ -126,19 +175,8 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     uint8_t *near = realloc(s->work.near_wall, P->cap ? P->cap : 1);
     if (!near) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     s->work.near_wall = near;
-    const double reach = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < n; i++) {
-        int close = 0;
-        if (P->state[i] != MIXSPH_STATE_WALL)
-            for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
-                double d;
-                int at_end;
-                walls_signed_distance(&s->phys.walls, w, P->x[i], P->z[i], &d, &at_end);
-                close = !(fabs(d) > reach); /* NaN counts as close */
-            }
-        near[i] = (uint8_t)close;
-    }
+    struct particle_loop L = {.s = s, .a = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx};
+    team_for(SIM_THREADS(s), n, near_wall_range, &L);
     return MIXSPH_OK;
 }
 
@@ -199,18 +237,26 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
 
 /* v += dt a of the particles that take kicks (not walls, lost particles, grains held fixed with
  * hold_fixed or, in the implicit scheme, rigid ones: those stay at rest through the viscous step). */
-static void kick_velocities(mixsph_sim *s, double dt)
+static void kick_range(void *arg, size_t b, size_t e)
 {
-    struct particles *P = &s->phys.P;
+    const struct particle_loop *L = arg;
+    const mixsph_sim *s = L->s;
+    struct particles *P = &L->s->phys.P;
     const int rigid = s->scheme.implicit && s->scheme.held_grains_rigid;
-#pragma omp parallel for schedule(static) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
+    const double dt = L->a;
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid))
             continue;
         P->vx[i] += dt * P->ax[i];
         P->vz[i] += dt * P->az[i];
     }
+}
+
+static void kick_velocities(mixsph_sim *s, double dt)
+{
+    struct particle_loop L = {.s = s, .a = dt};
+    team_for(SIM_THREADS(s), s->phys.P.n, kick_range, &L);
 }
 
 /* The time step the explicit scheme would take from the current state, at most dt: the kick over
@@ -220,15 +266,9 @@ static void kick_velocities(mixsph_sim *s, double dt)
  * nearly balance would be released that the model holds. */
 static double held_grain_judge_dt(const mixsph_sim *s, double dt)
 {
-    const struct particles *P = &s->phys.P;
-    double dt_explicit = dt;
-#pragma omp parallel for schedule(static) reduction(min : dt_explicit) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const double d = particle_time_step(s, i, 0);
-        if (d < dt_explicit) dt_explicit = d;
-    }
-    return dt_explicit;
+    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = 0, .dt_min = dt};
+    team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
+    return L.dt_min;
 }
 
 /* Room for the implicit step's unknowns flags of cap particles (NULL when out of memory; the old
@@ -245,19 +285,32 @@ static unsigned char *realloc_unknowns(unsigned char *u, size_t cap)
  * it to the grain it judges (mixture_paper.c): its acceleration by the other forces (P->ax, P->az
  * of the last momentum pass) plus the viscous one from the solved velocities around it,
  * -(L u)_i / m_i with u_i = 0. One operator pass. Returns -1 when out of memory. */
-static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double judge_dt)
-{
-    struct particles *P = &s->phys.P;
+struct held_kick_loop {
+    mixsph_sim *s;
+    double judge_dt;
     const double *lx, *lz;
-    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
-    const size_t n = active_particles(s);
-#pragma omp parallel for schedule(static) num_threads(S->n_threads)
-    for (size_t i = 0; i < n; i++) {
+};
+
+static void held_kick_range(void *arg, size_t b, size_t e)
+{
+    const struct held_kick_loop *L = arg;
+    const mixsph_sim *s = L->s;
+    struct particles *P = &L->s->phys.P;
+    const double judge_dt = L->judge_dt, *lx = L->lx, *lz = L->lz;
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))
             continue;
         P->vx[i] = judge_dt * (P->ax[i] - lx[i] / P->m[i]);
         P->vz[i] = judge_dt * (P->az[i] - lz[i] / P->m[i]);
     }
+}
+
+static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double judge_dt)
+{
+    const double *lx, *lz;
+    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
+    struct held_kick_loop L = {.s = s, .judge_dt = judge_dt, .lx = lx, .lz = lz};
+    team_for(S->n_threads, active_particles(s), held_kick_range, &L);
     return 0;
 }
 
@@ -269,6 +322,19 @@ static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double j
  * explicit leapfrog, would move them with an unbalanced half kick of the other forces: 2.4 % of
  * the lid speed in the lid-driven channel at 20 times the explicit viscous time step). A solve
  * that misses its tolerance stops the run. judge_dt: the kick of rigid held grains (viscous.h). */
+/* The implicit step's unknowns: mobile particles, and held grains that take their forces
+ * (mixture_paper.h). */
+static void unknowns_range(void *arg, size_t b, size_t e)
+{
+    mixsph_sim *s = ((struct particle_loop *)arg)->s;
+    const struct particles *P = &s->phys.P;
+    const int rigid = s->scheme.held_grains_rigid;
+    for (size_t i = b; i < e; i++)
+        s->work.viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
+                                (P->state[i] == MIXSPH_STATE_FIXED &&
+                                 mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
+}
+
 static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judge_dt)
 {
     if (!s->work.viscous && !(s->work.viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -297,14 +363,8 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     if (!(s->work.viscous_unknown = realloc_unknowns(s->work.viscous_unknown, s->phys.P.cap)))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
     const int rigid = s->scheme.held_grains_rigid;
-    struct particles *P = &s->phys.P;
-    const size_t n = active_particles(s);
-    /* the unknowns: mobile particles, and held grains that take their forces (mixture_paper.h) */
-#pragma omp parallel for schedule(static) num_threads(S.n_threads)
-    for (size_t i = 0; i < n; i++)
-        s->work.viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
-                                (P->state[i] == MIXSPH_STATE_FIXED &&
-                                 mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
+    struct particle_loop L = {.s = s};
+    team_for(S.n_threads, active_particles(s), unknowns_range, &L);
     const struct viscous_params *vp = &s->scheme.viscous;
     const double t0 = clock_monotonic_s();
     int failed = viscous_step(s->work.viscous, s->work.forces, &S, s->work.wall_mirror, &s->phys.walls, s->phys.t, dt,
@@ -349,34 +409,25 @@ static mixsph_status check_time_step(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-/* The walls move over dt (their displacements before it kept in *ox_old, *oz_old), then every
- * particle takes `half_kick` of its acceleration (the explicit scheme's first half kick; 0: none)
- * and drifts with the result (grains held fixed are not moved; walls kept uncrossed); time
- * advances; the neighbour lists are rebuilt when a particle has moved skin/2 since their build
- * or left the grid. */
-static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
+/* The kick and drift of move_particles over particles [b, e): L->a = dt, L->b = the half kick.
+ * With the drift, in the same loop, the largest squared displacement of an active particle
+ * (walls included: they moved before) since the last build and whether one left the grid, as
+ * neighbours_max_shift2 computes them (max and | are exact, so any order gives the same). */
+static void drift_range(void *arg, size_t b, size_t e)
 {
-    struct particles *P = &s->phys.P;
-    double ox_old[WALLS_MAX], oz_old[WALLS_MAX];
-    for (size_t w = 0; w < s->phys.walls.n; w++) {
-        ox_old[w] = s->phys.walls.state[w].ox;
-        oz_old[w] = s->phys.walls.state[w].oz;
-    }
-    walls_move(&s->phys.walls, P, s->phys.t, dt);
-    const double gap = INTEGRATE_CLIP_GAP * s->phys.dx;
-    long clips = 0;
-    /* with the drift, in the same loop, the largest squared displacement of an active particle
-     * (walls included: they moved above) since the last build and whether one left the grid, as
-     * neighbours_max_shift2 computes them (max and | are exact, so any order gives the same) */
-    const size_t n_active = s->work.C.start[s->work.C.ncell];
+    struct particle_loop *L = arg;
+    const mixsph_sim *s = L->s;
+    struct particles *P = &L->s->phys.P;
+    const double dt = L->a, half_kick = L->b, gap = INTEGRATE_CLIP_GAP * s->phys.dx;
+    const double *ox_old = L->ox_old, *oz_old = L->oz_old;
+    const size_t n_active = L->n_active;
     const double *x_build = s->work.NB.x0, *z_build = s->work.NB.z0;
     const struct cells *C = &s->work.C;
     const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
+    long clips = 0;
     double shift2 = 0.0;
     int outside = 0;
-#pragma omp parallel for schedule(static) reduction(+ : clips) reduction(max : shift2) reduction(| : outside) \
-    num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
+    for (size_t i = b; i < e; i++) {
         const int st = P->state[i];
         if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
             const double kick =
@@ -402,6 +453,31 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
             outside |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
         }
     }
+    team_add_long(&L->count, clips);
+    team_max_double(&L->shift2, shift2);
+    team_or_int(&L->flag, outside);
+}
+
+/* The walls move over dt (their displacements before it kept in *ox_old, *oz_old), then every
+ * particle takes `half_kick` of its acceleration (the explicit scheme's first half kick; 0: none)
+ * and drifts with the result (grains held fixed are not moved; walls kept uncrossed); time
+ * advances; the neighbour lists are rebuilt when a particle has moved skin/2 since their build
+ * or left the grid. */
+static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
+{
+    struct particles *P = &s->phys.P;
+    double ox_old[WALLS_MAX], oz_old[WALLS_MAX];
+    for (size_t w = 0; w < s->phys.walls.n; w++) {
+        ox_old[w] = s->phys.walls.state[w].ox;
+        oz_old[w] = s->phys.walls.state[w].oz;
+    }
+    walls_move(&s->phys.walls, P, s->phys.t, dt);
+    struct particle_loop L = {.s = s, .a = dt, .b = half_kick, .ox_old = ox_old, .oz_old = oz_old,
+                              .n_active = s->work.C.start[s->work.C.ncell]};
+    team_for(SIM_THREADS(s), P->n, drift_range, &L);
+    const long clips = L.count;
+    const double shift2 = L.shift2;
+    const int outside = L.flag;
     s->phys.n_clipped += clips;
     s->phys.t += dt;
     s->phys.step++;
@@ -409,6 +485,23 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
      * the grid is marked lost by the rebuild at once */
     if (outside || 4.0 * shift2 >= s->work.NB.skin * s->work.NB.skin) return integrate_rebuild_lists(s);
     return MIXSPH_OK;
+}
+
+/* rho += dt drho (L->a = dt) and the equation of state; L->flag: a non-positive density. */
+static void density_update_range(void *arg, size_t b, size_t e)
+{
+    struct particle_loop *L = arg;
+    mixsph_sim *s = L->s;
+    struct particles *P = &s->phys.P;
+    const double dt = L->a;
+    int bad_rho = 0;
+    for (size_t i = b; i < e; i++) {
+        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
+        P->rho[i] += dt * P->drho[i];
+        bad_rho |= !(P->rho[i] > 0.0);
+        particle_pressure(s, i);
+    }
+    team_or_int(&L->flag, bad_rho);
 }
 
 /* The rates at the new positions: the density pass (and the velocity gradient), the densities
@@ -421,14 +514,10 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
     int bad_rho = integrate_density_rates(s, &S);
     if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     /* the densities and the equation of state, in one loop */
-#pragma omp parallel for schedule(static) reduction(| : bad_rho) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        P->rho[i] += dt * P->drho[i];
-        bad_rho |= !(P->rho[i] > 0.0);
-        particle_pressure(s, i);
-    }
-    if (pressures_and_regimes(s, &S, s->scheme.pressure_smoothing > 0.0, dt) != 0)
+    struct particle_loop L = {.s = s, .a = dt};
+    team_for(SIM_THREADS(s), P->n, density_update_range, &L);
+    bad_rho |= L.flag;
+    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->work.forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
@@ -443,12 +532,15 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
 }
 
 /* The last half kick (`last_kick`, 0 for none) and the next time step, in one loop. */
-static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implicit)
+static void last_kick_range(void *arg, size_t b, size_t e)
 {
-    struct particles *P = &s->phys.P;
+    struct particle_loop *L = arg;
+    const mixsph_sim *s = L->s;
+    struct particles *P = &L->s->phys.P;
+    const double last_kick = L->a;
+    const int implicit = L->implicit;
     double dt_next = INFINITY;
-#pragma omp parallel for schedule(static) reduction(min : dt_next) num_threads(SIM_THREADS(s))
-    for (size_t i = 0; i < P->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         if (last_kick > 0.0 &&
             !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))) {
@@ -458,7 +550,14 @@ static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implici
         const double d = particle_time_step(s, i, implicit);
         if (d < dt_next) dt_next = d;
     }
-    s->phys.dt = dt_next;
+    team_min_double(&L->dt_min, dt_next);
+}
+
+static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implicit)
+{
+    struct particle_loop L = {.s = s, .a = last_kick, .implicit = implicit, .dt_min = INFINITY};
+    team_for(SIM_THREADS(s), s->phys.P.n, last_kick_range, &L);
+    s->phys.dt = L.dt_min;
 }
 
 /* ---- the two schemes ------------------------------------------------------------------------ */

@@ -23,6 +23,7 @@
 #include <string.h>
 
 #include "mixsph.h"
+#include "team.h"
 #include "viscous_coarse.h"
 
 /* Dot products are summed per block of this many particles, then over the blocks in order:
@@ -136,40 +137,73 @@ struct solve_ctx {
                                    * every mobile and held particle (viscous_solve) */
 };
 
-/* Fill the wall rows of (vx, vz) from their unknown rows (with_constant: the whole mirror map,
- * else its linear part); without a mirror they are P->uvx, P->uvz (with_constant) or 0. */
-static void fill_wall_rows(const struct solve_ctx *c, int with_constant, double *vx, double *vz)
+/* The arguments of a parallel loop of this file (core/team.h): rows or blocks of rows. */
+struct vloop {
+    const struct solve_ctx *c;
+    int with_constant;
+    int in, out, dot, dot2; /* vector indices */
+    int count;
+    const int *a, *b;
+    double k0, k1, k2, k3;  /* the loop's coefficients */
+    double *vx, *vz;
+    int flag;               /* | over the threads */
+};
+
+static void wall_rows_range(void *arg, size_t b, size_t e)
 {
-    const struct particles *P = c->S->P;
-    if (c->M) {
-        walls_mirror_apply(c->M, c->S->G, with_constant, vx, vz, c->S->n_threads);
-        return;
-    }
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++)
+    const struct vloop *L = arg;
+    const struct particles *P = L->c->S->P;
+    const int with_constant = L->with_constant;
+    double *vx = L->vx, *vz = L->vz;
+    for (size_t i = b; i < e; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) {
             vx[i] = with_constant ? P->uvx[i] : 0.0;
             vz[i] = with_constant ? P->uvz[i] : 0.0;
         }
 }
 
+/* Fill the wall rows of (vx, vz) from their unknown rows (with_constant: the whole mirror map,
+ * else its linear part); without a mirror they are P->uvx, P->uvz (with_constant) or 0. */
+static void fill_wall_rows(const struct solve_ctx *c, int with_constant, double *vx, double *vz)
+{
+    if (c->M) {
+        walls_mirror_apply(c->M, c->S->G, with_constant, vx, vz, c->S->n_threads);
+        return;
+    }
+    struct vloop L = {.c = c, .with_constant = with_constant, .vx = vx, .vz = vz};
+    team_for(c->S->n_threads, c->n, wall_rows_range, &L);
+}
+
 /* out = A in on the unknown rows (0 on the others); `in` is zero on the prescribed non-wall rows
  * and gets its wall rows filled (the linear part of the mirror). With dot >= 0, d receives the
  * per-component products (v[dot] . out) and, with dot2 >= 0, (v[dot2] . out) too (d[2], d[3])
  * and (out . out) (d[4], d[5]), summed in fixed blocks. */
+static void apply_a_blocks(void *arg, size_t b0, size_t b1);
 static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2, double d[N_SUMS])
 {
     double **v = c->V->v;
     fill_wall_rows(c, 0, v[in], v[in + 1]);
     if (forces_viscous_apply(c->F, c->S, v[in], v[in + 1], v[out], v[out + 1], NULL) != 0) return -1;
+    const long nb = BLOCKS(c->n);
+    struct vloop L = {.c = c, .in = in, .out = out, .dot = dot, .dot2 = dot2};
+    team_for(c->S->n_threads, (size_t)nb, apply_a_blocks, &L);
+    block_sums(c->V, nb, d);
+    return 0;
+}
+
+/* Blocks [b0, b1) of apply_a after the operator pass. */
+static void apply_a_blocks(void *arg, size_t b0, size_t b1)
+{
+    const struct vloop *L = arg;
+    const struct solve_ctx *c = L->c;
+    double **v = c->V->v;
+    const int in = L->in, out = L->out, dot = L->dot, dot2 = L->dot2;
     const unsigned char *mob = c->V->mobile;
     const double kappa = c->dt;
-    const long nb = BLOCKS(c->n);
     const double *ox = v[out], *oz = v[out + 1];
     const double *ax = v[dot < 0 ? out : dot], *az = v[dot < 0 ? out + 1 : dot + 1];
     const double *bx = v[dot2 < 0 ? out : dot2], *bz = v[dot2 < 0 ? out + 1 : dot2 + 1];
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (long bk = 0; bk < nb; bk++) {
+    for (size_t bk = b0; bk < b1; bk++) {
         BLOCK_RANGE(bk, c->n, i0, i1);
         { /* restrict only here: the dot operands below may be `out` itself */
             double *restrict wx = v[out], *restrict wz = v[out + 1];
@@ -190,21 +224,20 @@ static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2
             t4 += ox[i] * ox[i];
             t5 += oz[i] * oz[i];
         }
-        put_partial(c->V, bk, t0, t1, t2, t3, t4, t5);
+        put_partial(c->V, (long)bk, t0, t1, t2, t3, t4, t5);
     }
-    block_sums(c->V, nb, d);
-    return 0;
 }
 
 /* Per-component dot products over the unknown rows, summed in fixed blocks: d[2k], d[2k+1] are
  * (a_k . b_k) for the x and z parts of the vector pairs (a[k], b[k]), k < count <= 3. */
-static void dots(const struct solve_ctx *c, int count, const int *a, const int *b, double *d)
+static void dots_blocks(void *arg, size_t b0, size_t b1)
 {
+    const struct vloop *L = arg;
+    const struct solve_ctx *c = L->c;
     double **v = c->V->v;
     const unsigned char *mob = c->V->mobile;
-    const long nb = BLOCKS(c->n);
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (long bk = 0; bk < nb; bk++) {
+    const int count = L->count, *a = L->a, *b = L->b;
+    for (size_t bk = b0; bk < b1; bk++) {
         BLOCK_RANGE(bk, c->n, i0, i1);
         double t[N_SUMS] = {0.0};
         for (int k = 0; k < count; k++) {
@@ -221,6 +254,13 @@ static void dots(const struct solve_ctx *c, int count, const int *a, const int *
         }
         for (int k = 0; k < N_SUMS; k++) c->V->partial[N_SUMS * bk + k] = t[k];
     }
+}
+
+static void dots(const struct solve_ctx *c, int count, const int *a, const int *b, double *d)
+{
+    const long nb = BLOCKS(c->n);
+    struct vloop L = {.c = c, .count = count, .a = a, .b = b};
+    team_for(c->S->n_threads, (size_t)nb, dots_blocks, &L);
     double s[N_SUMS];
     block_sums(c->V, nb, s);
     for (int k = 0; k < 2 * count; k++) d[k] = s[k];
@@ -231,15 +271,13 @@ static void dots(const struct solve_ctx *c, int count, const int *a, const int *
  * u0 = v[GX], v[GZ] and its residual r0 = b - A u0 = m (w - u0) - kappa L u_full (u_full: u0 on
  * the unknown rows, the prescribed values and the walls' mirror of u_full elsewhere). Two passes
  * of the operator, one when u_B = 0. */
-static int setup(const struct solve_ctx *c)
+static void setup_first_range(void *arg, size_t b, size_t e)
 {
+    const struct solve_ctx *c = ((const struct vloop *)arg)->c;
     const struct particles *P = c->S->P;
-    struct viscous_solver *V = c->V;
-    double **v = V->v;
-    unsigned char *mob = V->mobile;
-    const double dt = c->dt;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
+    double **v = c->V->v;
+    unsigned char *mob = c->V->mobile;
+    for (size_t i = b; i < e; i++) {
         /* the caller says which velocities are unknowns (the rest, walls aside, stay as they are) */
         mob[i] = c->unknown ? c->unknown[i] : P->state[i] <= MIXSPH_STATE_FIXED;
         v[MASS][i] = P->m[i];
@@ -248,22 +286,25 @@ static int setup(const struct solve_ctx *c)
         v[UX][i] = mob[i] ? v[GX][i] : v[U0X][i];
         v[UZ][i] = mob[i] ? v[GZ][i] : v[U0Z][i];
     }
-    fill_wall_rows(c, 1, v[U0X], v[U0Z]);
-    fill_wall_rows(c, 1, v[UX], v[UZ]);
-    /* L u_B is zero when nothing prescribed moves (walls at rest, grains held fixed): one
-     * operator pass fewer per stage */
-    int prescribed_moving = 0;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads) reduction(| : prescribed_moving)
-    for (size_t i = 0; i < c->n; i++) prescribed_moving |= v[U0X][i] != 0.0 || v[U0Z][i] != 0.0;
-    if (prescribed_moving) {
-        if (forces_viscous_apply(c->F, c->S, v[U0X], v[U0Z], v[BX], v[BZ], NULL) != 0) return -1;
-    } else {
-        memset(v[BX], 0, c->n * sizeof(double));
-        memset(v[BZ], 0, c->n * sizeof(double));
-    }
-    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], v[MINV]) != 0) return -1;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
+}
+
+static void prescribed_moving_range(void *arg, size_t b, size_t e)
+{
+    struct vloop *L = arg;
+    double **v = L->c->V->v;
+    int moving = 0;
+    for (size_t i = b; i < e; i++) moving |= v[U0X][i] != 0.0 || v[U0Z][i] != 0.0;
+    team_or_int(&L->flag, moving);
+}
+
+static void setup_last_range(void *arg, size_t b, size_t e)
+{
+    const struct solve_ctx *c = ((const struct vloop *)arg)->c;
+    const struct particles *P = c->S->P;
+    double **v = c->V->v;
+    const unsigned char *mob = c->V->mobile;
+    const double dt = c->dt;
+    for (size_t i = b; i < e; i++) {
         if (!mob[i]) {
             for (int k = UX; k <= MINV; k++)
                 if (k != U0X && k != U0Z) v[k][i] = 0.0;
@@ -277,6 +318,26 @@ static int setup(const struct solve_ctx *c)
         v[RZ][i] = v[RHZ][i] = m * (v[WZ][i] - v[UZ][i]) - dt * v[RZ][i];
         v[PX][i] = v[PZ][i] = v[VX][i] = v[VZ][i] = 0.0;
     }
+}
+
+static int setup(const struct solve_ctx *c)
+{
+    double **v = c->V->v;
+    struct vloop L = {.c = c};
+    team_for(c->S->n_threads, c->n, setup_first_range, &L);
+    fill_wall_rows(c, 1, v[U0X], v[U0Z]);
+    fill_wall_rows(c, 1, v[UX], v[UZ]);
+    /* L u_B is zero when nothing prescribed moves (walls at rest, grains held fixed): one
+     * operator pass fewer per stage */
+    team_for(c->S->n_threads, c->n, prescribed_moving_range, &L);
+    if (L.flag) {
+        if (forces_viscous_apply(c->F, c->S, v[U0X], v[U0Z], v[BX], v[BZ], NULL) != 0) return -1;
+    } else {
+        memset(v[BX], 0, c->n * sizeof(double));
+        memset(v[BZ], 0, c->n * sizeof(double));
+    }
+    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], v[MINV]) != 0) return -1;
+    team_for(c->S->n_threads, c->n, setup_last_range, &L);
     return 0;
 }
 
@@ -290,12 +351,88 @@ static void coarse_correct(const struct solve_ctx *c, int in, int out)
 
 static double ratio(double a, double b) { return b != 0.0 ? a / b : 0.0; }
 
+/* BiCGSTAB's vector passes over rows [b, e) or blocks [b0, b1) (struct vloop: k0, k1 its
+ * coefficients for the x and z components, k2, k3 the second ones). */
+static void direction_range(void *arg, size_t b, size_t e)
+{
+    /* p = r + beta (p - omega v), y = M^-1 p; k0, k1 = beta, k2, k3 = omega */
+    const struct vloop *L = arg;
+    double **v = L->c->V->v;
+    double *restrict px = v[PX], *restrict pz = v[PZ], *restrict yx = v[YX], *restrict yz = v[YZ];
+    const double *restrict rx = v[RX], *restrict rz = v[RZ], *restrict vx = v[VX], *restrict vz = v[VZ];
+    const double *restrict minv = v[MINV];
+    const double b0 = L->k0, b1 = L->k1, w0 = L->k2, w1 = L->k3;
+#pragma omp simd
+    for (size_t i = b; i < e; i++) {
+        px[i] = rx[i] + b0 * (px[i] - w0 * vx[i]);
+        pz[i] = rz[i] + b1 * (pz[i] - w1 * vz[i]);
+        yx[i] = minv[i] * px[i];
+        yz[i] = minv[i] * pz[i];
+    }
+}
+
+static void half_step_blocks(void *arg, size_t b0, size_t b1)
+{
+    /* u += alpha y, s = r - alpha v, z = M^-1 s, (s, s); k0, k1 = alpha */
+    const struct vloop *L = arg;
+    const size_t n = L->c->n;
+    double **v = L->c->V->v;
+    double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict sx = v[SX], *restrict sz = v[SZ];
+    double *restrict zx = v[ZX], *restrict zz = v[ZZ];
+    const double *restrict yx = v[YX], *restrict yz = v[YZ], *restrict rx = v[RX], *restrict rz = v[RZ];
+    const double *restrict vx = v[VX], *restrict vz = v[VZ], *restrict minv = v[MINV];
+    const double a0 = L->k0, a1 = L->k1;
+    for (size_t bk = b0; bk < b1; bk++) {
+        BLOCK_RANGE(bk, n, i0, i1);
+        double t0 = 0.0, t1 = 0.0;
+#pragma omp simd reduction(+ : t0, t1)
+        for (size_t i = i0; i < i1; i++) {
+            ux[i] += a0 * yx[i];
+            uz[i] += a1 * yz[i];
+            sx[i] = rx[i] - a0 * vx[i];
+            sz[i] = rz[i] - a1 * vz[i];
+            zx[i] = minv[i] * sx[i];
+            zz[i] = minv[i] * sz[i];
+            t0 += sx[i] * sx[i];
+            t1 += sz[i] * sz[i];
+        }
+        put_partial(L->c->V, (long)bk, t0, t1, 0.0, 0.0, 0.0, 0.0);
+    }
+}
+
+static void full_step_blocks(void *arg, size_t b0, size_t b1)
+{
+    /* u += omega z, r = s - omega t, (r, r), (r^, r); k0, k1 = omega */
+    const struct vloop *L = arg;
+    const size_t n = L->c->n;
+    double **v = L->c->V->v;
+    double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict rx = v[RX], *restrict rz = v[RZ];
+    const double *restrict zx = v[ZX], *restrict zz = v[ZZ], *restrict sx = v[SX], *restrict sz = v[SZ];
+    const double *restrict tx = v[TX], *restrict tz = v[TZ], *restrict hx = v[RHX], *restrict hz = v[RHZ];
+    const double w0 = L->k0, w1 = L->k1;
+    for (size_t bk = b0; bk < b1; bk++) {
+        BLOCK_RANGE(bk, n, i0, i1);
+        double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
+#pragma omp simd reduction(+ : t0, t1, t2, t3)
+        for (size_t i = i0; i < i1; i++) {
+            ux[i] += w0 * zx[i];
+            uz[i] += w1 * zz[i];
+            rx[i] = sx[i] - w0 * tx[i];
+            rz[i] = sz[i] - w1 * tz[i];
+            t0 += rx[i] * rx[i];
+            t1 += rz[i] * rz[i];
+            t2 += hx[i] * rx[i];
+            t3 += hz[i] * rz[i];
+        }
+        put_partial(L->c->V, (long)bk, t0, t1, t2, t3, 0.0, 0.0);
+    }
+}
+
 /* BiCGSTAB from the set-up's u0, r0 (= r^_0), right-preconditioned by M^-1; per iteration two
  * operator passes and three vector passes, each with its dot products. Returns the iterations,
  * -1 when out of memory; *r2 receives the final ||r||^2. */
 static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, double *r2)
 {
-    double **v = c->V->v;
     const size_t n = c->n;
     const long nb = BLOCKS(n);
     double d[N_SUMS];
@@ -313,45 +450,16 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
         }
         /* p = r + beta (p - omega v), y = M^-1 p */
         {
-            double *restrict px = v[PX], *restrict pz = v[PZ], *restrict yx = v[YX], *restrict yz = v[YZ];
-            const double *restrict rx = v[RX], *restrict rz = v[RZ], *restrict vx = v[VX], *restrict vz = v[VZ];
-            const double *restrict minv = v[MINV];
-            const double b0 = beta[0], b1 = beta[1], w0 = omega[0], w1 = omega[1];
-#pragma omp parallel for simd schedule(static) num_threads(c->S->n_threads)
-            for (size_t i = 0; i < n; i++) {
-                px[i] = rx[i] + b0 * (px[i] - w0 * vx[i]);
-                pz[i] = rz[i] + b1 * (pz[i] - w1 * vz[i]);
-                yx[i] = minv[i] * px[i];
-                yz[i] = minv[i] * pz[i];
-            }
+            struct vloop L = {.c = c, .k0 = beta[0], .k1 = beta[1], .k2 = omega[0], .k3 = omega[1]};
+            team_for(c->S->n_threads, n, direction_range, &L);
         }
         coarse_correct(c, PX, YX);
         if (apply_a(c, YX, VX, RHX, -1, d) != 0) return -1; /* v = A y, (r^, v) */
         for (int k = 0; k < 2; k++) alpha[k] = ratio(rho[k], d[k]);
         /* u += alpha y, s = r - alpha v, z = M^-1 s, (s, s) */
         {
-            double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict sx = v[SX], *restrict sz = v[SZ];
-            double *restrict zx = v[ZX], *restrict zz = v[ZZ];
-            const double *restrict yx = v[YX], *restrict yz = v[YZ], *restrict rx = v[RX], *restrict rz = v[RZ];
-            const double *restrict vx = v[VX], *restrict vz = v[VZ], *restrict minv = v[MINV];
-            const double a0 = alpha[0], a1 = alpha[1];
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-            for (long bk = 0; bk < nb; bk++) {
-                BLOCK_RANGE(bk, n, i0, i1);
-                double t0 = 0.0, t1 = 0.0;
-#pragma omp simd reduction(+ : t0, t1)
-                for (size_t i = i0; i < i1; i++) {
-                    ux[i] += a0 * yx[i];
-                    uz[i] += a1 * yz[i];
-                    sx[i] = rx[i] - a0 * vx[i];
-                    sz[i] = rz[i] - a1 * vz[i];
-                    zx[i] = minv[i] * sx[i];
-                    zz[i] = minv[i] * sz[i];
-                    t0 += sx[i] * sx[i];
-                    t1 += sz[i] * sz[i];
-                }
-                put_partial(c->V, bk, t0, t1, 0.0, 0.0, 0.0, 0.0);
-            }
+            struct vloop L = {.c = c, .k0 = alpha[0], .k1 = alpha[1]};
+            team_for(c->S->n_threads, (size_t)nb, half_step_blocks, &L);
         }
         block_sums(c->V, nb, d);
         it++;
@@ -365,27 +473,8 @@ static int bicgstab(const struct solve_ctx *c, double tol2, int max_iterations, 
         omega[1] = ratio(d[1], d[5]);
         /* u += omega z, r = s - omega t, (r, r), (r^, r) */
         {
-            double *restrict ux = v[UX], *restrict uz = v[UZ], *restrict rx = v[RX], *restrict rz = v[RZ];
-            const double *restrict zx = v[ZX], *restrict zz = v[ZZ], *restrict sx = v[SX], *restrict sz = v[SZ];
-            const double *restrict tx = v[TX], *restrict tz = v[TZ], *restrict hx = v[RHX], *restrict hz = v[RHZ];
-            const double w0 = omega[0], w1 = omega[1];
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-            for (long bk = 0; bk < nb; bk++) {
-                BLOCK_RANGE(bk, n, i0, i1);
-                double t0 = 0.0, t1 = 0.0, t2 = 0.0, t3 = 0.0;
-#pragma omp simd reduction(+ : t0, t1, t2, t3)
-                for (size_t i = i0; i < i1; i++) {
-                    ux[i] += w0 * zx[i];
-                    uz[i] += w1 * zz[i];
-                    rx[i] = sx[i] - w0 * tx[i];
-                    rz[i] = sz[i] - w1 * tz[i];
-                    t0 += rx[i] * rx[i];
-                    t1 += rz[i] * rz[i];
-                    t2 += hx[i] * rx[i];
-                    t3 += hz[i] * rz[i];
-                }
-                put_partial(c->V, bk, t0, t1, t2, t3, 0.0, 0.0);
-            }
+            struct vloop L = {.c = c, .k0 = omega[0], .k1 = omega[1]};
+            team_for(c->S->n_threads, (size_t)nb, full_step_blocks, &L);
         }
         block_sums(c->V, nb, d);
         *r2 = d[0] + d[1];
@@ -430,13 +519,13 @@ static int stage(const struct solve_ctx *c, double tolerance, int max_iterations
 
 /* The solution into the particles: velocities, the increment over u* (v[USX]) for the next warm
  * start, and the walls' viscous velocity that goes with it. */
-static void store(const struct solve_ctx *c)
+static void store_range(void *arg, size_t b, size_t e)
 {
+    const struct solve_ctx *c = ((const struct vloop *)arg)->c;
     struct particles *P = c->S->P;
     double **v = c->V->v;
     const unsigned char *mob = c->V->mobile;
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (mob[i]) {
             P->visc_dvx[i] = v[UX][i] - v[USX][i];
             P->visc_dvz[i] = v[UZ][i] - v[USZ][i];
@@ -447,14 +536,27 @@ static void store(const struct solve_ctx *c)
             v[UZ][i] = P->state[i] == MIXSPH_STATE_WALL ? 0.0 : P->vz[i];
         }
     }
-    if (!c->M) return;
-    fill_wall_rows(c, 1, v[UX], v[UZ]);
-#pragma omp parallel for schedule(static) num_threads(c->S->n_threads)
-    for (size_t i = 0; i < c->n; i++)
+}
+
+static void store_walls_range(void *arg, size_t b, size_t e)
+{
+    const struct solve_ctx *c = ((const struct vloop *)arg)->c;
+    struct particles *P = c->S->P;
+    double **v = c->V->v;
+    for (size_t i = b; i < e; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) {
             P->uvx[i] = v[UX][i];
             P->uvz[i] = v[UZ][i];
         }
+}
+
+static void store(const struct solve_ctx *c)
+{
+    struct vloop L = {.c = c};
+    team_for(c->S->n_threads, c->n, store_range, &L);
+    if (!c->M) return;
+    fill_wall_rows(c, 1, c->V->v[UX], c->V->v[UZ]);
+    team_for(c->S->n_threads, c->n, store_walls_range, &L);
 }
 
 /* u* = P->vx, P->vz into v[USX], v[USZ] (all rows). */
@@ -512,6 +614,9 @@ int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, 
     return 0;
 }
 
+static void stage1_guess_range(void *arg, size_t b, size_t e);
+static void stage2_guess_range(void *arg, size_t b, size_t e);
+
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                  struct wall_mirror *M, const struct walls *W, double t, double dt,
                  const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report)
@@ -526,29 +631,50 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
     const int max_iterations = vp->max_iterations;
     const struct solve_ctx c = {.V = V, .F = F, .S = S, .M = M, .dt = g * dt, .n = n, .unknown = unknown};
     const struct particles *P = S->P;
-    double **v = V->v;
     const int threads = S->n_threads;
     if (walls_mirror_build(M, W, &S->params.K, S->G, P, n, threads) != 0) return -1;
     load_velocities(&c);
     /* stage 1: w = u*, first guess u* + the first-stage increment extrapolated linearly from
      * the last two steps (closer than the last increment alone where the flow changes smoothly;
      * measured in docs/numerics.md) */
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (size_t i = 0; i < n; i++) {
-        v[WX][i] = v[USX][i];
-        v[WZ][i] = v[USZ][i];
-        v[GX][i] = v[USX][i] + 2.0 * P->visc_d1x[i] - P->visc_d1px[i];
-        v[GZ][i] = v[USZ][i] + 2.0 * P->visc_d1z[i] - P->visc_d1pz[i];
-    }
+    struct vloop L = {.c = &c, .k0 = (1.0 - g) / g};
+    team_for(threads, n, stage1_guess_range, &L);
     walls_mirror_at(M, W, P, t, g * dt, threads);
     if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
     /* stage 2: w = u* + (1 - gamma)/gamma (U1 - u*), first guess U1 + the second stage's own
      * change (U2 - U1 = dv - d1) extrapolated linearly from the last two steps; the increments
      * of the last step become those of the step before */
-    const double a = (1.0 - g) / g;
-    struct particles *Pw = S->P;
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (size_t i = 0; i < n; i++) {
+    team_for(threads, n, stage2_guess_range, &L);
+    walls_mirror_at(M, W, P, t, dt, threads);
+    if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
+    store(&c);
+    return 0;
+}
+
+static void stage1_guess_range(void *arg, size_t b, size_t e)
+{
+    const struct solve_ctx *c = ((const struct vloop *)arg)->c;
+    const struct particles *P = c->S->P;
+    double **v = c->V->v;
+    for (size_t i = b; i < e; i++) {
+        v[WX][i] = v[USX][i];
+        v[WZ][i] = v[USZ][i];
+        v[GX][i] = v[USX][i] + 2.0 * P->visc_d1x[i] - P->visc_d1px[i];
+        v[GZ][i] = v[USZ][i] + 2.0 * P->visc_d1z[i] - P->visc_d1pz[i];
+    }
+}
+
+/* k0 = (1 - gamma) / gamma */
+static void stage2_guess_range(void *arg, size_t b, size_t e)
+{
+    const struct vloop *L = arg;
+    const struct solve_ctx *c = L->c;
+    struct viscous_solver *V = c->V;
+    const struct particles *P = c->S->P;
+    struct particles *Pw = c->S->P;
+    double **v = V->v;
+    const double a = L->k0;
+    for (size_t i = b; i < e; i++) {
         v[WX][i] = v[USX][i] + a * (v[UX][i] - v[USX][i]);
         v[WZ][i] = v[USZ][i] + a * (v[UZ][i] - v[USZ][i]);
         v[GX][i] = v[UX][i] + 2.0 * (P->visc_dvx[i] - P->visc_d1x[i]) - (P->visc_dvpx[i] - P->visc_d1px[i]);
@@ -562,8 +688,4 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
             Pw->visc_d1z[i] = v[UZ][i] - v[USZ][i];
         }
     }
-    walls_mirror_at(M, W, P, t, dt, threads);
-    if (stage(&c, tolerance, max_iterations, report) != 0) return -1;
-    store(&c);
-    return 0;
 }

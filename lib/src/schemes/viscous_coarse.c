@@ -5,6 +5,7 @@
  * groups holding unknowns are numbered 0 .. n_active - 1 ("compact"), and A_c is kept as each
  * compact group's eight neighbours with the weights -A_c(I, J) / A_c(I, I). */
 #include "viscous_coarse.h"
+#include "team.h"
 
 #include <stdint.h>
 #include <stdlib.h>
@@ -127,13 +128,26 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
  *   A_c(I, J) = -kappa sum_{i in I, j in J} w_ij,
  * the couplings to prescribed particles and walls kept in the diagonal as if those were at rest
  * (the walls' mirror is left out: this only preconditions). */
-void viscous_coarse_operator(struct viscous_coarse *K, const double *minv, const unsigned char *unknown,
-                             double kappa, int threads)
+/* The arguments of a parallel loop of this file (core/team.h). */
+struct coarse_loop {
+    struct viscous_coarse *K;
+    const double *minv;
+    const unsigned char *unknown;
+    double kappa;
+    const double *in_x, *in_z;
+    double *out_x, *out_z;
+};
+
+static void operator_range(void *arg, size_t a0, size_t a1)
 {
+    const struct coarse_loop *L = arg;
+    struct viscous_coarse *K = L->K;
+    const double *minv = L->minv;
+    const unsigned char *unknown = L->unknown;
+    const double kappa = L->kappa;
     const long s = K->stride;
     const long off[4] = {1, s - 1, s, s + 1}; /* slots 1..4 of the couplings */
-#pragma omp parallel for schedule(static) num_threads(threads)
-    for (size_t a = 0; a < K->n_active; a++) {
+    for (size_t a = a0; a < a1; a++) {
         double d = 0.0;
         for (size_t i = K->first[a]; i < K->last[a]; i++)
             if (unknown[i]) d += 1.0 / minv[i];
@@ -153,6 +167,13 @@ void viscous_coarse_operator(struct viscous_coarse *K, const double *minv, const
     }
 }
 
+void viscous_coarse_operator(struct viscous_coarse *K, const double *minv, const unsigned char *unknown,
+                             double kappa, int threads)
+{
+    struct coarse_loop L = {.K = K, .minv = minv, .unknown = unknown, .kappa = kappa};
+    team_for(threads, K->n_active, operator_range, &L);
+}
+
 /* One symmetric Gauss-Seidel sweep of A_c e = b for one component. */
 static void sweep(const struct viscous_coarse *K, const double *restrict b, double *restrict e)
 {
@@ -169,34 +190,40 @@ static void sweep(const struct viscous_coarse *K, const double *restrict b, doub
 }
 
 /* P^T sums a group's rows; the two components' sweeps (sequential each) run side by side. */
+static void correct_region(void *arg, int tid, int nth)
+{
+    const struct coarse_loop *L = arg;
+    struct viscous_coarse *K = L->K;
+    const unsigned char *unknown = L->unknown;
+    size_t a0, a1;
+    team_share(K->n_active, tid, nth, &a0, &a1);
+    for (size_t a = a0; a < a1; a++) {
+        double sx = 0.0, sz = 0.0;
+        for (size_t i = K->first[a]; i < K->last[a]; i++) {
+            sx += L->in_x[i];
+            sz += L->in_z[i];
+        }
+        K->b[0][a] = sx;
+        K->b[1][a] = sz;
+        K->e[0][a] = K->e[1][a] = 0.0;
+    }
+    team_barrier();
+    for (int comp = tid; comp < 2; comp += nth)
+        for (int k = 0; k < COARSE_SWEEPS; k++) sweep(K, K->b[comp], K->e[comp]);
+    team_barrier();
+    for (size_t a = a0; a < a1; a++) {
+        const double ex = K->e[0][a], ez = K->e[1][a];
+        for (size_t i = K->first[a]; i < K->last[a]; i++)
+            if (unknown[i]) {
+                L->out_x[i] += ex;
+                L->out_z[i] += ez;
+            }
+    }
+}
+
 void viscous_coarse_correct(struct viscous_coarse *K, const unsigned char *unknown, const double *in_x,
                             const double *in_z, double *out_x, double *out_z, int threads)
 {
-    const size_t n = K->n_active;
-#pragma omp parallel num_threads(threads)
-    {
-#pragma omp for schedule(static)
-        for (size_t a = 0; a < n; a++) {
-            double sx = 0.0, sz = 0.0;
-            for (size_t i = K->first[a]; i < K->last[a]; i++) {
-                sx += in_x[i];
-                sz += in_z[i];
-            }
-            K->b[0][a] = sx;
-            K->b[1][a] = sz;
-            K->e[0][a] = K->e[1][a] = 0.0;
-        }
-#pragma omp for schedule(static, 1)
-        for (int comp = 0; comp < 2; comp++)
-            for (int k = 0; k < COARSE_SWEEPS; k++) sweep(K, K->b[comp], K->e[comp]);
-#pragma omp for schedule(static)
-        for (size_t a = 0; a < n; a++) {
-            const double ex = K->e[0][a], ez = K->e[1][a];
-            for (size_t i = K->first[a]; i < K->last[a]; i++)
-                if (unknown[i]) {
-                    out_x[i] += ex;
-                    out_z[i] += ez;
-                }
-        }
-    }
+    struct coarse_loop L = {.K = K, .unknown = unknown, .in_x = in_x, .in_z = in_z, .out_x = out_x, .out_z = out_z};
+    team_run(threads, correct_region, &L);
 }

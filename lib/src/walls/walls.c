@@ -19,6 +19,7 @@
 
 #include "geometry.h"
 #include "mixsph.h"
+#include "team.h"
 
 void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end)
 {
@@ -344,14 +345,34 @@ static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
     return noslip ? 2.0 * v_wall - v_fluid : v_fluid;
 }
 
-void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K, const struct gather *G, double dx,
-                             struct particles *P, size_t n, int n_threads)
+/* The arguments of a parallel loop of this file (core/team.h). */
+struct wall_loop {
+    const struct walls *W;
+    const struct kernel *K;
+    const struct gather *G;
+    double dx;
+    struct particles *P;
+    const struct particles *cP;
+    struct wall_mirror *M;
+    const struct wall_mirror *cM;
+    const double *vx_wall, *vz_wall;
+    double c;
+    double *vx, *vz;
+};
+static void mirror_weights_range(void *arg, size_t b, size_t e);
+static void mirror_apply_range(void *arg, size_t b, size_t e);
+
+static void extrapolate_range(void *arg, size_t b, size_t e)
 {
+    const struct wall_loop *L = arg;
+    const struct walls *W = L->W;
     const struct wall_state *wstate = W->state;
-    const double g = W->g, vol = dx * dx, rho_alone = W->rho_alone;
+    const struct kernel *K = L->K;
+    const struct gather *G = L->G;
+    struct particles *P = L->P;
+    const double g = W->g, vol = L->dx * L->dx, rho_alone = W->rho_alone;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
         const size_t w = particles_wall_index(P, i);
         const struct wall_state *ws = &wstate[w];
@@ -385,6 +406,13 @@ void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K, cons
         P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
         P->inv_rho[i] = 1.0 / P->rho[i];
     }
+}
+
+void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K, const struct gather *G, double dx,
+                             struct particles *P, size_t n, int n_threads)
+{
+    struct wall_loop L = {.W = W, .K = K, .G = G, .dx = dx, .P = P};
+    team_for(n_threads, n, extrapolate_range, &L);
 }
 
 struct wall_mirror *walls_mirror_create(void) { return calloc(1, sizeof(struct wall_mirror)); }
@@ -435,9 +463,21 @@ int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struc
     M->n_rows = 0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) M->rows[M->n_rows++] = i;
+    struct wall_loop L = {.W = W, .K = K, .G = G, .cP = P, .M = M};
+    team_for(n_threads, M->n_rows, mirror_weights_range, &L);
+    return 0;
+}
+
+static void mirror_weights_range(void *arg, size_t b, size_t e)
+{
+    const struct wall_loop *L = arg;
+    const struct walls *W = L->W;
+    const struct kernel *K = L->K;
+    const struct gather *G = L->G;
+    const struct particles *P = L->cP;
+    struct wall_mirror *M = L->M;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t r = 0; r < M->n_rows; r++) {
+    for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
         double sw = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
@@ -453,7 +493,22 @@ int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struc
             M->sign[i] = 0;
         }
     }
-    return 0;
+}
+
+static void mirror_at_range(void *arg, size_t b, size_t e)
+{
+    const struct wall_loop *L = arg;
+    const struct walls *W = L->W;
+    const struct particles *P = L->cP;
+    struct wall_mirror *M = L->M;
+    const double *vx = L->vx_wall, *vz = L->vz_wall;
+    for (size_t r = b; r < e; r++) {
+        const size_t i = M->rows[r];
+        const size_t w = particles_wall_index(P, i);
+        const int noslip = W->def[w].slip == WALL_NO_SLIP;
+        M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
+        M->cz[i] = M->sign[i] ? mirror_velocity(noslip, vz[w], 0.0) : vz[w];
+    }
 }
 
 void walls_mirror_at(struct wall_mirror *M, const struct walls *W, const struct particles *P, double t_from, double dt,
@@ -467,22 +522,25 @@ void walls_mirror_at(struct wall_mirror *M, const struct walls *W, const struct 
         vz[w] = wstate[w].vz;
         if (mo >= 0 && dt > 0.0) step_end_velocity(&W->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
     }
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t r = 0; r < M->n_rows; r++) {
-        const size_t i = M->rows[r];
-        const size_t w = particles_wall_index(P, i);
-        const int noslip = W->def[w].slip == WALL_NO_SLIP;
-        M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
-        M->cz[i] = M->sign[i] ? mirror_velocity(noslip, vz[w], 0.0) : vz[w];
-    }
+    struct wall_loop L = {.W = W, .cP = P, .M = M, .vx_wall = vx, .vz_wall = vz};
+    team_for(n_threads, M->n_rows, mirror_at_range, &L);
 }
 
 void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
                         double *vz, int n_threads)
 {
-    const double c = with_constant ? 1.0 : 0.0;
-#pragma omp parallel for schedule(static) num_threads(n_threads)
-    for (size_t r = 0; r < M->n_rows; r++) {
+    struct wall_loop L = {.cM = M, .G = G, .c = with_constant ? 1.0 : 0.0, .vx = vx, .vz = vz};
+    team_for(n_threads, M->n_rows, mirror_apply_range, &L);
+}
+
+static void mirror_apply_range(void *arg, size_t b, size_t e)
+{
+    const struct wall_loop *L = arg;
+    const struct wall_mirror *M = L->cM;
+    const struct gather *G = L->G;
+    const double c = L->c;
+    double *vx = L->vx, *vz = L->vz;
+    for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
         double ax = 0.0, az = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
