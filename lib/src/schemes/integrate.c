@@ -159,6 +159,8 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.params.implicit_viscosity = s->cfg.viscosity_implicit;
     S.params.arithmetic_mean = s->cfg.viscosity_arithmetic;
     S.params.stress = (s->law_features & LAW_HAS_STRESS) != 0;
+    S.params.diffusion = s->cfg.density_diffusion;
+    S.params.diffusion_form = s->cfg.density_diffusion_form;
     S.n_threads = SIM_THREADS(s);
     return S;
 }
