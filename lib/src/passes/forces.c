@@ -184,8 +184,9 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * particle: one set of lane sums, reduced once): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
  * and same-medium neighbour counts. With `diffuse`, between particles of one medium (walls
  * excluded) also the density diffusion's sums e_i += V_j psi_ij (-F), e_j -= V_i psi_ij (-F) with
- * psi_ij = rho_j - rho_i - (rho_i + rho_j)/2 hyd_i (z_i - z_j): hyd_i = g / c_i^2 removes the
- * hydrostatic density difference of the linear EOS (d rho/dz = -rho g / c^2), 0 keeps the whole
+ * psi_ij = rho_j - rho_i - hyd_i (z_i - z_j): hyd_i = rho0 g / c^2 of i's medium removes the
+ * hydrostatic density difference of the linear EOS (Fourtakas et al. 2019 with gamma = 1; the
+ * initial state of sim.c, p = rho0 g depth, is left exactly at rest), 0 keeps the whole
  * difference. psi_ji = -psi_ij, so sum_i V_i e_i = 0: the diffusion moves density between
  * particles and creates none. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
@@ -218,7 +219,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             cj[k] = c;
             if (diffuse) {
                 const double one = (tag[j] == ti ? 1.0 : 0.0) * fluid_i; /* F is 0 on masked lanes */
-                const double q = -(rho[j] - rhoi - 0.5 * (rhoi + rho[j]) * hyd_i * rz) * F * one;
+                const double q = -(rho[j] - rhoi - hyd_i * rz) * F * one;
                 dif[k] += vol[j] * q;
                 ej[k] = -voli * q;
             }
@@ -409,10 +410,10 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0, ei = 0.0;
-        double hyd_i = 0.0; /* g / c_i^2 of the hydrostatic form; walls take no diffusion */
+        double hyd_i = 0.0; /* rho0 g / c_i^2 of the hydrostatic form; walls take no diffusion */
         if (diffuse && P->tag[i] >= 0.0) {
             const double c = X->media[P->medium[i]].c;
-            hyd_i = X->diffusion_g / (c * c);
+            hyd_i = X->media[P->medium[i]].rho0 * X->diffusion_g / (c * c);
         }
         continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
                          X->diffusion, hyd_i, wendland, store, diffuse);

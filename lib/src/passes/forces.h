@@ -38,7 +38,7 @@ struct forces_params {
 
 /* What the density diffusion acts on (numerics.density_diffusion_form, docs/numerics.md). */
 enum density_diffusion_form {
-    DENSITY_DIFFUSION_HYDROSTATIC = 0, /* rho_j - rho_i less its hydrostatic part (Fourtakas et al. 2019) */
+    DENSITY_DIFFUSION_HYDROSTATIC = 0, /* rho_j - rho_i less rho0 g (z_i - z_j) / c^2 (Fourtakas et al. 2019) */
     DENSITY_DIFFUSION_MOLTENI = 1      /* rho_j - rho_i (Molteni & Colagrossi 2009) */
 };
 
