@@ -17,7 +17,7 @@ density over the snapshots, relative to its rho0; the mechanical energy of water
 initial value; the grains' deposit at the last snapshot: median height above the flume floor and
 the 50 / 95 / 99 % quantiles of x, and how many grains are higher than 0.05 m above the floor
 (still suspended) beyond the ramp's toe; the largest water elevation at x >= 1 m (monitor
-wave_max). The work of the pushing plate is not an output of the library, so the energy budget
+run_up). The work of the pushing plate is not an output of the library, so the energy budget
 is E(t) - E(0) against nothing but its sign after the push.
 
 Exit status: 0 the run finished; 1 it did not (its numbers up to the failure are still printed);
@@ -115,11 +115,11 @@ def report(out, case_path):
     mon = os.path.join(out, "monitors.csv")
     if os.path.isfile(mon):
         cols = read_monitors(mon)
-        if "wave_max" in cols and len(cols["wave_max"]):
-            w = np.asarray(cols["wave_max"], dtype=float)
+        if "run_up" in cols and len(cols["run_up"]):
+            w = np.asarray(cols["run_up"], dtype=float)
             t = np.asarray(cols["t"], dtype=float)
             k = int(np.nanargmax(w))
-            print(f"  wave_max (x >= 1 m): {w[k] - (FLOOR_Z + 0.3):+.3f} m above still water at t = {t[k]:.3f} s; "
+            print(f"  run_up (largest water elevation at x >= 1 m): {w[k] - (FLOOR_Z + 0.3):+.3f} m above still water at t = {t[k]:.3f} s; "
                   f"monitors to t = {t[-1]:.3f} s")
 
 
