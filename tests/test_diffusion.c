@@ -6,8 +6,8 @@
  * F_ij = W'(r)/r (grad_i W = F (x_i - x_j), kernel.h). Checked:
  * - the case keys, their defaults and their errors;
  * - in a closed box of two fluids with random densities, at rest (so the density rate is the
- *   diffusion alone), every particle's rate against a brute-force sum over all pairs written
- *   from the formula above, in both forms;
+ *   diffusion alone), every particle's rate, and the sum of its pair terms from the test hook,
+ *   against a brute-force sum over all pairs written from the formula above, in both forms;
  * - that it moves density and creates none: sum_i V_i D_i over each medium is 0 to round-off;
  * - that the hydrostatic form leaves the hydrostatic initial state of the tank at rest, where the
  *   whole-difference form does not.
@@ -161,6 +161,15 @@ static void check_against_formula(const char *extra, int hydrostatic)
          * in another order) */
         assert_true(fabs(P->drho[i] - want) <= 1e-12 * a);
         worst = fmax(worst, fabs(P->drho[i] - want) / (a > 0.0 ? a : 1.0));
+        /* the test hook's pair terms (forces_pair_for_test, which test_forces.c checks against
+         * (3a)) add up to the same rate; same tolerance */
+        double hook = 0.0;
+        for (size_t j = 0; j < P->n; j++) {
+            double ax, az, dr;
+            sim_pair_terms(s, i, j, &ax, &az, &dr);
+            hook += dr;
+        }
+        assert_true(fabs(hook - want) <= 1e-12 * a);
         const double vi = P->m[i] / P->rho[i];
         cons[P->medium[i]] += vi * P->drho[i];
         cons_abs[P->medium[i]] += fabs(vi * P->drho[i]);

@@ -404,17 +404,29 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     *azi += tz;
 }
 
+/* hyd_i of continuity_range: rho0 g / c^2 of i's medium with the hydrostatic form of the
+ * diffusion, 0 with Molteni's and for walls (which take no diffusion). */
+FORCES_INLINE double diffusion_hydrostatic(const struct pair_ctx *X, const struct particles *restrict P, size_t i)
+{
+    if (P->tag[i] < 0.0) return 0.0;
+    const struct medium *m = &X->media[P->medium[i]];
+    return m->rho0 * X->diffusion_g / (m->c * m->c);
+}
+
+/* D_i of particle i in medium m from its sum e_i = sum_j V_j psi_ij (-F_ij): [DD] of
+ * docs/numerics.md section 2c, 2 delta h c_i e_i. */
+static inline double diffusion_rate(double delta_h, const struct medium *m, double e_i)
+{
+    return 2.0 * delta_h * m->c * e_i;
+}
+
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
 FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                    size_t b0, size_t b1, const int diffuse, const int wendland, const int store)
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0, ei = 0.0;
-        double hyd_i = 0.0; /* rho0 g / c_i^2 of the hydrostatic form; walls take no diffusion */
-        if (diffuse && P->tag[i] >= 0.0) {
-            const double c = X->media[P->medium[i]].c;
-            hyd_i = X->media[P->medium[i]].rho0 * X->diffusion_g / (c * c);
-        }
+        const double hyd_i = diffuse ? diffusion_hydrostatic(X, P, i) : 0.0;
         continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
                          X->diffusion, hyd_i, wendland, store, diffuse);
         P->drho[i] += di;
@@ -737,8 +749,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
 #pragma omp for schedule(static) reduction(| : bad) nowait
         for (size_t i = 0; i < n; i++) {
             P->drho[i] *= P->rho[i];
-            if (diffusion && P->tag[i] >= 0.0) /* D_i = 2 delta h c_i sum_j V_j psi_ij (-F_ij) */
-                P->drho[i] += 2.0 * delta_h * M[P->medium[i]].c * diffusion[i];
+            if (diffusion && P->tag[i] >= 0.0) P->drho[i] += diffusion_rate(delta_h, &M[P->medium[i]], diffusion[i]);
             P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
             bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
         }
@@ -874,10 +885,9 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     P->az[j] = save[1];
     const double delta_h = S->params.diffusion * X.K.h;
     if (delta_h > 0.0 && P->tag[i] >= 0.0) {
-        const double c = S->media[P->medium[i]].c;
-        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, X.diffusion_g / (c * c), X.wendland, 0,
-                         1);
-        *drho = P->rho[i] * di + 2.0 * delta_h * c * ei;
+        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
+                         X.wendland, 0, 1);
+        *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
     } else {
         continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0);
         *drho = P->rho[i] * di;
