@@ -18,12 +18,13 @@
 #include "sim_passes.h"
 
 /* Two fluids side by side (a cross-medium interface), no gravity, one wall 0.8 m below:
- * far beyond the support 2h = 0.026 m, so every interaction is fluid-fluid. */
+ * far beyond the support 2h = 0.026 m, so every interaction is fluid-fluid. The continuity
+ * equation is checked here as (3) writes it, without density diffusion (tests/test_diffusion.c). */
 static const char *const BOX_CASE =
     "{\n"
     "  \"name\": \"forces_box\",\n"
     "  \"gravity\": 0.0,\n"
-    "  \"numerics\": { \"dx\": 0.01, \"h_over_dx\": 1.3, \"t_end\": 0.1, \"wall_layers\": 3 },\n"
+    "  \"numerics\": { \"dx\": 0.01, \"h_over_dx\": 1.3, \"t_end\": 0.1, \"wall_layers\": 3, \"density_diffusion\": 0 },\n"
     "  \"media\": {\n"
     "    \"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"c\": 30.0, \"mu\": 1.0e-3, \"alpha_m\": 0.1 },\n"
     "    \"oil\": { \"type\": \"fluid\", \"rho\": 800.0, \"c\": 20.0, \"mu\": 0.05, \"alpha_m\": 0.3 }\n"

@@ -12,7 +12,8 @@
  *   the particle positions (no density drift, no gap opening at the walls: a gap of 0.1 dx along
  *   the wetted boundary is 0.8% of the area);
  * - the pressure in layers of height dx (mean over the layer's particles) against
- *   rho0 g (z_s - z), z the layer's mean height. */
+ *   rho0 g (z_s - z), z the layer's mean height.
+ * Run as the case has it and with the density diffusion on (numerics.density_diffusion = 0.1). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -33,13 +34,13 @@
 #define DX 0.01        /* [m] */
 #define NLAYER 32      /* layers of height dx from the floor (the water is 30 deep) */
 
-static void test_hydrostatic_tank(void **state)
+/* The tank as the case has it (no density diffusion), or with the overrides ov. */
+static void run_tank(const mixsph_override *ov, size_t n_ov)
 {
-    (void)state;
     mixsph_sim *s = NULL;
     char err[512] = "";
     const char *path = MIXSPH_SOURCE_DIR "/cases/hydrostatic_tank.json";
-    assert_int_equal(mixsph_sim_create(path, NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_create(path, ov, n_ov, &s, err, sizeof err), MIXSPH_OK);
     assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
     const size_t n = mixsph_sim_particles(s);
     assert_int_equal(n, 1200); /* the case is the one described above: 40 x 30 particles */
@@ -129,10 +130,26 @@ static void test_hydrostatic_tank(void **state)
     mixsph_sim_destroy(s);
 }
 
+static void test_hydrostatic_tank(void **state)
+{
+    (void)state;
+    run_tank(NULL, 0);
+}
+
+/* The same column, references and tolerances with the density diffusion on at its default
+ * coefficient (docs/numerics.md section 2c): it must leave the column at rest. */
+static void test_hydrostatic_tank_diffusion(void **state)
+{
+    (void)state;
+    const mixsph_override ov[] = {{"numerics.density_diffusion", 0.1}};
+    run_tank(ov, 1);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hydrostatic_tank),
+        cmocka_unit_test(test_hydrostatic_tank_diffusion),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

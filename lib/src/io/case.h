@@ -83,6 +83,8 @@ struct case_def {
     double lattice_z0;        /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
     int kernel;               /* enum kernel_type */
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
+    double density_diffusion; /* delta of the density diffusion in the continuity equation (0: off; default 0.1) */
+    int density_diffusion_form; /* numerics.density_diffusion_form: enum density_diffusion_form of forces.h */
     double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
                                  bed; < 0: off (the default) */
     int av_wall;              /* artificial viscosity between fluid and wall particles (default 1) */

@@ -36,6 +36,7 @@ static const struct case_choice wall_placements[] = {{"lattice", 0}, {"aligned",
 static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit", 1}, {NULL, 0}};
 static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
+static const struct case_choice diffusion_forms[] = {{"hydrostatic", 0}, {"molteni", 1}, {NULL, 0}};
 static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
@@ -101,6 +102,15 @@ static const struct case_key numerics_keys[] = {
     {.key = "pressure_smoothing", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0), .unit = "-",
      .field = CASE_FIELD(case_def, pressure_smoothing),
      .meaning = "θ_P of the partial pressure smoothing (below); 0: off"},
+    {.key = "density_diffusion", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0.1), .unit = "-",
+     .field = CASE_FIELD(case_def, density_diffusion),
+     .meaning = "δ of the density diffusion in the continuity equation (delta-SPH, below), between particles of "
+                "one medium; 0: off (the bundled cases of the paper's tables set 0)"},
+    {.key = "density_diffusion_form", .type = CASE_CHOICE, DEF(0), .choices = diffusion_forms, .numeric_choice = 1,
+     .field = CASE_FIELD(case_def, density_diffusion_form),
+     .meaning = "the density difference the diffusion acts on: hydrostatic (less its hydrostatic part, so a column "
+                "at rest is left at rest; Fourtakas et al. 2019) or molteni (the whole difference; Molteni & "
+                "Colagrossi 2009)"},
     {.key = "fixed_bed_speed", .type = CASE_NUMBER, RANGE(-1, 0, 100, 0), DEF(-1), .def_text = "-1 (off)",
      .unit = "m/s", .field = CASE_FIELD(case_def, fixed_bed_speed),
      .meaning = "the fixed bed (below): speed at or below which a grain counts as bed; negative: off"},

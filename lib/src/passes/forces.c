@@ -97,6 +97,7 @@ struct forces {
     double *smooth_sum;       /* smoothing: sum_j B_ij W_ij V_j */
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
     double *wall_sum[WALL_SUMS]; /* momentum pass with stress: each particle's wall sums (above) */
+    double *diffusion_sum;    /* density pass: sum_j V_j psi_ij (-F_ij) of the density diffusion */
     size_t scratch_cap;
     /* implicit viscosity: the viscous coupling w_ij >= 0 of every lane (layout of fk), stored by
      * the momentum pass, so that m_i du_i/dt = -sum_j w_ij (u_i - u_j) */
@@ -119,6 +120,9 @@ struct pair_ctx {
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
+    double *diffusion;    /* the density diffusion's sums (density pass), or NULL: no diffusion */
+    const struct medium *media;
+    double diffusion_g;   /* g with the hydrostatic form of the diffusion, 0 with Molteni's */
     double *sum, *weight;
     double *visc_w;       /* the viscous couplings of the lanes (implicit viscosity), or NULL */
     const double *in_x, *in_z; /* the velocity field a viscous operator is applied to */
@@ -145,6 +149,9 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
+    X->diffusion = NULL;
+    X->media = S->media;
+    X->diffusion_g = fp->diffusion_form == DENSITY_DIFFUSION_HYDROSTATIC ? fp->g : 0.0;
     X->visc_w = NULL;
     X->in_x = X->in_z = NULL;
     X->out_x = X->out_z = X->out_diag = NULL;
@@ -185,19 +192,27 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
 
 /* Continuity between i and its nr ranges of candidates [rng[2r], rng[2r+1]) (one call per
  * particle: one set of lane sums, reduced once): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
- * and same-medium neighbour counts. */
+ * and same-medium neighbour counts. With `diffuse`, between particles of one medium (walls
+ * excluded) also the density diffusion's sums e_i += V_j psi_ij (-F), e_j -= V_i psi_ij (-F) with
+ * psi_ij = rho_j - rho_i - hyd_i (z_i - z_j): hyd_i = rho0 g / c^2 of i's medium removes the
+ * hydrostatic density difference of the linear EOS (Fourtakas et al. 2019 with gamma = 1; the
+ * initial state of sim.c, p = rho0 g depth, is left exactly at rest), 0 keeps the whole
+ * difference. psi_ji = -psi_ij, so sum_i V_i e_i = 0: the diffusion moves density between
+ * particles and creates none. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                    const uint32_t *restrict rng, int nr, double *di, double *ni,
-                                    double *restrict count, double *restrict fk, const int wendland, const int store)
+                                    const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
+                                    double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
+                                    const int wendland, const int store, const int diffuse)
 {
     const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
+    const double rhoi = P->rho[i];
     const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
-    const double *restrict vol = P->vol, *restrict tag = P->tag;
+    const double *restrict vol = P->vol, *restrict tag = P->tag, *restrict rho = P->rho;
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
-    double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0};
+    double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0}, dif[FORCES_CHUNK] = {0};
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
-        double dj[FORCES_CHUNK], cj[FORCES_CHUNK];
+        double dj[FORCES_CHUNK], cj[FORCES_CHUNK], ej[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
@@ -212,14 +227,22 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             cnt[k] += c;
             dj[k] = voli * uf;
             cj[k] = c;
+            if (diffuse) {
+                const double one = (tag[j] == ti ? 1.0 : 0.0) * fluid_i; /* F is 0 on masked lanes */
+                const double q = -(rho[j] - rhoi - hyd_i * rz) * F * one;
+                dif[k] += vol[j] * q;
+                ej[k] = -voli * q;
+            }
         }
         chunk_add(P->drho, jb, m, dj);
         chunk_add(count, jb, m, cj);
+        if (diffuse) chunk_add(diff, jb, m, ej);
         if (store) fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *di += acc[k];
         *ni += cnt[k];
+        if (diffuse) *ei += dif[k];
     }
 }
 
@@ -420,16 +443,34 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         }
 }
 
+/* hyd_i of continuity_range: rho0 g / c^2 of i's medium with the hydrostatic form of the
+ * diffusion, 0 with Molteni's and for walls (which take no diffusion). */
+FORCES_INLINE double diffusion_hydrostatic(const struct pair_ctx *X, const struct particles *restrict P, size_t i)
+{
+    if (P->tag[i] < 0.0) return 0.0;
+    const struct medium *m = &X->media[P->medium[i]];
+    return m->rho0 * X->diffusion_g / (m->c * m->c);
+}
+
+/* D_i of particle i in medium m from its sum e_i = sum_j V_j psi_ij (-F_ij): [DD] of
+ * docs/numerics.md section 2c, 2 delta h c_i e_i. */
+static inline double diffusion_rate(double delta_h, const struct medium *m, double e_i)
+{
+    return 2.0 * delta_h * m->c * e_i;
+}
+
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
 FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                   size_t b0, size_t b1, const int wendland, const int store)
+                                   size_t b0, size_t b1, const int diffuse, const int wendland, const int store)
 {
     for (size_t i = b0; i < b1; i++) {
-        double di = 0.0, ni = 0.0;
-        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, X->count, store ? X->fk + X->fk_off[i] : NULL, wendland,
-                         store);
+        double di = 0.0, ni = 0.0, ei = 0.0;
+        const double hyd_i = diffuse ? diffusion_hydrostatic(X, P, i) : 0.0;
+        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
+                         X->diffusion, hyd_i, wendland, store, diffuse);
         P->drho[i] += di;
         X->count[i] += ni;
+        if (diffuse) X->diffusion[i] += ei;
     }
 }
 
@@ -567,7 +608,8 @@ FORCES_CLONES
 static void continuity_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                             size_t b0, size_t b1)
 {
-    FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1);
+    if (X->diffusion) FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 1);
+    else FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 0);
 }
 
 /* The momentum band walk, one inlined copy with and one without the stress term. */
@@ -609,6 +651,7 @@ void forces_free(struct forces *F)
     free(F->smooth_sum);
     free(F->smooth_weight);
     for (int q = 0; q < WALL_SUMS; q++) free(F->wall_sum[q]);
+    free(F->diffusion_sum);
     aligned_block_free(F->visc_w);
     free(F);
 }
@@ -662,9 +705,9 @@ static int scratch_reserve(struct forces *F, size_t n)
 {
     if (F->scratch_cap >= n) return 0;
     const size_t cap = n + n / 4 + 64;
-    double **a[3 + WALL_SUMS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight};
-    for (int q = 0; q < WALL_SUMS; q++) a[3 + q] = &F->wall_sum[q];
-    for (int k = 0; k < 3 + WALL_SUMS; k++) {
+    double **a[4 + WALL_SUMS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight, &F->diffusion_sum};
+    for (int q = 0; q < WALL_SUMS; q++) a[4 + q] = &F->wall_sum[q];
+    for (int k = 0; k < 4 + WALL_SUMS; k++) {
         double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
         if (!q) return -1;
         memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
@@ -711,6 +754,8 @@ struct pass_region {
     size_t n;                         /* active particles */
     struct velocity_gradient *grad;   /* density pass: the grains' velocity gradient, or NULL */
     const double *count;              /* density pass: the neighbour counts */
+    const double *diffusion;          /* density pass: the density diffusion's sums, or NULL (off) */
+    double delta_h;                   /* density pass: delta h of the density diffusion */
     double g;                         /* momentum pass: gravity */
     const double *const *wall_sums;   /* momentum pass with stress: the walls' sums of the wall friction */
     double theta_dt_over_h;           /* smoothing */
@@ -763,6 +808,7 @@ static void density_region(void *arg, int tid, int nth)
     int bad = 0;
     for (size_t i = b; i < e; i++) {
         P->drho[i] *= P->rho[i];
+        if (R->diffusion && P->tag[i] >= 0.0) P->drho[i] += diffusion_rate(R->delta_h, &M[P->medium[i]], R->diffusion[i]);
         P->nneigh[i] = (uint16_t)(count[i] < 65535.0 ? count[i] : 65535.0);
         bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->drho[i]);
     }
@@ -779,6 +825,12 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
     memset(P->drho, 0, n * sizeof(double));
     memset(F->nbr_count, 0, n * sizeof(double));
     X.count = F->nbr_count;
+    const double delta_h = S->params.diffusion * X.K.h;
+    if (delta_h > 0.0) {
+        memset(F->diffusion_sum, 0, n * sizeof(double));
+        X.diffusion = F->diffusion_sum;
+    }
+    const double *diffusion = X.diffusion;
     F->fk_valid = fcache_layout(F, S->NB, n) == 0;
     if (F->fk_valid) {
         X.fk = F->fk;
@@ -788,6 +840,8 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
     pass_region_init(&R, S, &X, continuity_band, n);
     R.grad = grad;
     R.count = F->nbr_count;
+    R.diffusion = diffusion;
+    R.delta_h = delta_h;
     team_run(S->n_threads, density_region, &R);
     return R.bad;
 }
@@ -968,9 +1022,12 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     pair_ctx_init(S, &X);
     struct particles *P = S->P;
     const double save[3] = {P->ax[j], P->az[j], P->drho[j]};
-    double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0;
+    double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0, ei = 0.0;
     double *count = calloc(j + 1 + FORCES_CHUNK, sizeof(double)); /* the range's neighbour counts */
-    if (!count) {
+    double *diff = calloc(j + 1 + FORCES_CHUNK, sizeof(double));  /* and diffusion sums */
+    if (!count || !diff) {
+        free(count);
+        free(diff);
         *ax = *az = *drho = NAN;
         return;
     }
@@ -980,10 +1037,18 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     *az = sz * P->inv_m[i];
     P->ax[j] = save[0];
     P->az[j] = save[1];
-    continuity_range(&X, P, i, pair, 1, &di, &ni, count, NULL, X.wendland, 0);
-    *drho = P->rho[i] * di;
+    const double delta_h = S->params.diffusion * X.K.h;
+    if (delta_h > 0.0 && P->tag[i] >= 0.0) {
+        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
+                         X.wendland, 0, 1);
+        *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
+    } else {
+        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0);
+        *drho = P->rho[i] * di;
+    }
     P->drho[j] = save[2];
     free(count);
+    free(diff);
 }
 
 /* The partial pressure smoothing of SPHERA (numerics.pressure_smoothing = theta_P > 0; Di Monaco

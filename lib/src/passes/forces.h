@@ -35,6 +35,14 @@ struct forces_params {
                                shear of no-slip walls on elastic-plastic grains (wall friction) */
     double p_background;    /* the equation of state's background pressure [Pa] (not an effective
                                normal stress: left out of the wall friction's bound) */
+    double diffusion;       /* delta of the density diffusion of the continuity pass (0: off) */
+    int diffusion_form;     /* enum density_diffusion_form */
+};
+
+/* What the density diffusion acts on (numerics.density_diffusion_form, docs/numerics.md). */
+enum density_diffusion_form {
+    DENSITY_DIFFUSION_HYDROSTATIC = 0, /* rho_j - rho_i less rho0 g (z_i - z_j) / c^2 (Fourtakas et al. 2019) */
+    DENSITY_DIFFUSION_MOLTENI = 1      /* rho_j - rho_i (Molteni & Colagrossi 2009) */
 };
 
 /* What a pass runs over. Particles 0 .. C->start[C->ncell] are the active ones. */
@@ -57,7 +65,8 @@ struct forces *forces_create(void);
 void forces_free(struct forces *F);
 
 /** Density rate drho of every particle and its count of same-medium neighbours (nneigh) from
- *  the current positions and velocities. Returns 1 if a non-finite value appeared at a mobile
+ *  the current positions and velocities, with params.diffusion > 0 plus the density diffusion
+ *  between particles of one medium (docs/numerics.md). Returns 1 if a non-finite value appeared at a mobile
  *  particle, -1 if a scratch array cannot be allocated, 0 otherwise. */
 int forces_density_rate(struct forces *F, const struct pair_system *S);
 
@@ -106,8 +115,8 @@ void forces_forget_cache(struct forces *F);
 /** Whether the viscous couplings of the last implicit momentum pass are there. */
 int forces_viscous_ready(const struct forces *F);
 
-/** Test hook: the acceleration (without gravity) and the density rate particle j gives i,
- *  evaluated by the same pair code. */
+/** Test hook: the acceleration (without gravity) and the density rate particle j gives i (its
+ *  density diffusion included), evaluated by the same pair code. */
 void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho);
 
 #endif
