@@ -105,7 +105,7 @@ static const struct case_key numerics_keys[] = {
     {.key = "density_diffusion", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0.1), .unit = "-",
      .field = CASE_FIELD(case_def, density_diffusion),
      .meaning = "δ of the density diffusion in the continuity equation (delta-SPH, below), between particles of "
-                "one medium; 0: off (the bundled cases of the paper's tables set 0)"},
+                "one fluid medium (grains take none); 0: off (the bundled cases of the paper's tables set 0)"},
     {.key = "density_diffusion_form", .type = CASE_CHOICE, DEF(0), .choices = diffusion_forms, .numeric_choice = 1,
      .field = CASE_FIELD(case_def, density_diffusion_form),
      .meaning = "the density difference the diffusion acts on: hydrostatic (less its hydrostatic part, so a column "

@@ -192,8 +192,8 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
 
 /* Continuity between i and its nr ranges of candidates [rng[2r], rng[2r+1]) (one call per
  * particle: one set of lane sums, reduced once): d_i += V_j u_ij.x_ij F, d_j += V_i u_ij.x_ij F,
- * and same-medium neighbour counts. With `diffuse`, between particles of one medium (walls
- * excluded) also the density diffusion's sums e_i += V_j psi_ij (-F), e_j -= V_i psi_ij (-F) with
+ * and same-medium neighbour counts. With `diffuse` (i of a fluid: diffuses), between particles of
+ * one medium also the density diffusion's sums e_i += V_j psi_ij (-F), e_j -= V_i psi_ij (-F) with
  * psi_ij = rho_j - rho_i - hyd_i (z_i - z_j): hyd_i = rho0 g / c^2 of i's medium removes the
  * hydrostatic density difference of the linear EOS (Fourtakas et al. 2019 with gamma = 1; the
  * initial state of sim.c, p = rho0 g depth, is left exactly at rest), 0 keeps the whole
@@ -443,6 +443,15 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         }
 }
 
+/* Whether particle i takes density diffusion: fluids do; walls do not (their density is the
+ * fluid's, extrapolated), nor do grains (their density carries their packing and, under the
+ * elastic-plastic law, the elastic pressure of a stress state: diffused, a heap that stands
+ * creeps, docs/numerics.md section 2c). A pair diffuses only within one medium, so i decides. */
+FORCES_INLINE int diffuses(const struct pair_ctx *X, const struct particles *restrict P, size_t i)
+{
+    return P->tag[i] >= 0.0 && X->media[P->medium[i]].law == LAW_NEWTONIAN;
+}
+
 /* hyd_i of continuity_range: rho0 g / c^2 of i's medium with the hydrostatic form of the
  * diffusion, 0 with Molteni's and for walls (which take no diffusion). */
 FORCES_INLINE double diffusion_hydrostatic(const struct pair_ctx *X, const struct particles *restrict P, size_t i)
@@ -465,12 +474,13 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0, ei = 0.0;
-        const double hyd_i = diffuse ? diffusion_hydrostatic(X, P, i) : 0.0;
+        const int diffuse_i = diffuse && diffuses(X, P, i);
+        const double hyd_i = diffuse_i ? diffusion_hydrostatic(X, P, i) : 0.0;
         continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
-                         X->diffusion, hyd_i, wendland, store, diffuse);
+                         X->diffusion, hyd_i, wendland, store, diffuse_i);
         P->drho[i] += di;
         X->count[i] += ni;
-        if (diffuse) X->diffusion[i] += ei;
+        if (diffuse_i) X->diffusion[i] += ei;
     }
 }
 
@@ -1038,7 +1048,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     P->ax[j] = save[0];
     P->az[j] = save[1];
     const double delta_h = S->params.diffusion * X.K.h;
-    if (delta_h > 0.0 && P->tag[i] >= 0.0) {
+    if (delta_h > 0.0 && diffuses(&X, P, i)) {
         continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
                          X.wendland, 0, 1);
         *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
