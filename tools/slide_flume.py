@@ -125,15 +125,18 @@ def report(out, case_path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--speed", type=float, default=2.5)
-    ap.add_argument("--thickness", type=float, default=0.08)
-    ap.add_argument("--dx", type=float, default=0.01)
-    ap.add_argument("--t-end", type=float, default=1.6)
-    ap.add_argument("--threads", type=int, default=2)
-    ap.add_argument("--mixsph", default="build/mixsph")
-    ap.add_argument("--out")
-    ap.add_argument("--reuse", action="store_true")
-    ap.add_argument("--set", action="append", default=[])
+    ap.add_argument("--speed", type=float, default=2.5, help="the plate's speed [m/s] (default 2.5; its stroke "
+                    "stays 0.4 m)")
+    ap.add_argument("--thickness", type=float, default=0.08, help="the slab's thickness normal to the ramp [m] "
+                    "(default 0.08)")
+    ap.add_argument("--dx", type=float, default=0.01, help="particle spacing [m] (default 0.01)")
+    ap.add_argument("--t-end", type=float, default=1.6, help="end time [s] (default 1.6)")
+    ap.add_argument("--threads", type=int, default=2, help="threads of the run (default 2)")
+    ap.add_argument("--mixsph", default="build/mixsph", help="the executable (default build/mixsph)")
+    ap.add_argument("--out", help="output folder (default out/slide_flume/v<speed>_t<thickness>_dx<dx>)")
+    ap.add_argument("--reuse", action="store_true", help="read an existing output folder instead of running")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="an override passed to the run (repeatable), e.g. numerics.density_diffusion=0")
     a = ap.parse_args()
     if not (a.speed > 0 and 0 < a.thickness <= 0.15 and a.dx > 0):
         print("slide_flume: --speed > 0, 0 < --thickness <= 0.15 (the plate's height), --dx > 0", file=sys.stderr)
