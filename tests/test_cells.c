@@ -18,19 +18,7 @@
 #include "neighbours.h"
 #include "particles.h"
 
-/* splitmix64: a fixed, portable random sequence */
-static uint64_t rng_next(uint64_t *s)
-{
-    uint64_t z = (*s += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    return z ^ (z >> 31);
-}
-
-static double rng_uniform(uint64_t *s, double a, double b)
-{
-    return a + (b - a) * (double)(rng_next(s) >> 11) * (1.0 / 9007199254740992.0);
-}
+#include "test_random.h"
 
 struct grid_spec {
     double x_min, x_max, z_min, z_max, size;
@@ -43,33 +31,33 @@ static void make_particles(struct particles *P, const struct cells *C, uint64_t 
     const double X1 = C->x0 + C->nx * C->size, Z1 = C->z0 + C->nz * C->size;
     assert_int_equal(particles_alloc(P, 16), 0);
     for (size_t k = 0; k < n_random; k++) {
-        const double x = rng_uniform(&s, C->x0 - 0.5 * C->size, X1 + 0.5 * C->size);
-        const double z = rng_uniform(&s, C->z0 - 0.5 * C->size, Z1 + 0.5 * C->size);
+        const double x = test_random_uniform(&s, C->x0 - 0.5 * C->size, X1 + 0.5 * C->size);
+        const double z = test_random_uniform(&s, C->z0 - 0.5 * C->size, Z1 + 0.5 * C->size);
         const uint8_t st = k % 17 == 0 ? MIXSPH_STATE_WALL : k % 23 == 0 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
         assert_true(particles_push(P, x, z, 1000.0, 1.0, 0, st) != (size_t)-1);
     }
     /* on every vertical and horizontal cell border (the last ones, x = X1 and z = Z1, are outside) */
     for (int i = 0; i <= C->nx; i++) {
         for (int k = 0; k < 3; k++) {
-            particles_push(P, C->x0 + i * C->size, rng_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, C->x0 + i * C->size, test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
             particles_push(P, C->x0 + i * C->size, C->z0 + (k % C->nz) * C->size, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
         }
     }
     for (int l = 0; l <= C->nz; l++)
         for (int k = 0; k < 3; k++)
-            particles_push(P, rng_uniform(&s, C->x0, X1), C->z0 + l * C->size, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, test_random_uniform(&s, C->x0, X1), C->z0 + l * C->size, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just inside the last column and row, and the far corner */
     for (int k = 0; k < 5; k++) {
-        particles_push(P, nextafter(X1, -INFINITY), rng_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-        particles_push(P, rng_uniform(&s, C->x0, X1), nextafter(Z1, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, nextafter(X1, -INFINITY), test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, test_random_uniform(&s, C->x0, X1), nextafter(Z1, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     }
     particles_push(P, nextafter(X1, -INFINITY), nextafter(Z1, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     particles_push(P, C->x0, C->z0, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just outside the near edges, and not finite */
-    particles_push(P, nextafter(C->x0, -INFINITY), rng_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, rng_uniform(&s, C->x0, X1), nextafter(C->z0, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, NAN, rng_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, rng_uniform(&s, C->x0, X1), INFINITY, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, nextafter(C->x0, -INFINITY), test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, test_random_uniform(&s, C->x0, X1), nextafter(C->z0, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, NAN, test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, test_random_uniform(&s, C->x0, X1), INFINITY, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* already lost before the build, inside the grid: stays lost, not counted again */
     particles_push(P, 0.5 * (C->x0 + X1), 0.5 * (C->z0 + Z1), 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
     for (size_t i = 0; i < P->n; i++) {
@@ -222,8 +210,8 @@ static void run_grid(const struct grid_spec *g, uint64_t seed, size_t n_random)
     for (size_t k = 0; k < n; k++) {
         const uint32_t id = P.id[k];
         if (P.state[k] != MIXSPH_STATE_LOST) {
-            P.x[k] += rng_uniform(&s, -0.3, 0.3) * C.size;
-            P.z[k] += rng_uniform(&s, -0.3, 0.3) * C.size;
+            P.x[k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
+            P.z[k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
             P.vx[k] = 1.0 + (double)id;
         }
         x[id] = P.x[k];
@@ -334,7 +322,7 @@ static void test_neighbour_ranges(void **state)
         uint64_t seed = 99u + (uint64_t)kx;
         for (int i = 0; i < 2500; i++) {
             const uint8_t st = i % 7 == 0 ? MIXSPH_STATE_WALL : MIXSPH_STATE_MOBILE;
-            particles_push(&P, rng_uniform(&seed, 0.01, 0.49), rng_uniform(&seed, 0.01, 0.29), 1000.0, 1.0, 0, st);
+            particles_push(&P, test_random_uniform(&seed, 0.01, 0.49), test_random_uniform(&seed, 0.01, 0.29), 1000.0, 1.0, 0, st);
         }
         /* particles on column and row borders */
         for (int k = 0; k < 40; k++)
@@ -364,7 +352,7 @@ static void test_neighbour_ranges(void **state)
         }
         /* move every particle by less than skin / 2 */
         for (size_t i = 0; i < n; i++) {
-            const double a = rng_uniform(&seed, 0.0, 6.283185307179586), d = rng_uniform(&seed, 0.0, 0.4999 * skin);
+            const double a = test_random_uniform(&seed, 0.0, 6.283185307179586), d = test_random_uniform(&seed, 0.0, 0.4999 * skin);
             P.x[i] += d * cos(a);
             P.z[i] += d * sin(a);
         }

@@ -26,6 +26,7 @@
 #include "kernel.h"
 #include "mixsph.h"
 #include "sim_passes.h"
+#include "test_random.h"
 
 #define G_ACC 9.81
 #define DX 0.01
@@ -51,14 +52,7 @@ static const char *const TANK_PATH = MIXSPH_SOURCE_DIR "/cases/hydrostatic_tank.
 
 static uint64_t rng_state;
 
-static double uniform(double a, double b)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return a + (b - a) * (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double uniform(double a, double b) { return test_random_uniform(&rng_state, a, b); }
 
 static mixsph_status create_box(const char *extra, mixsph_sim **s, char *err, size_t len)
 {

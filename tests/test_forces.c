@@ -16,6 +16,7 @@
 #include "eos.h"
 #include "mixsph.h"
 #include "sim_passes.h"
+#include "test_random.h"
 
 /* Two fluids side by side (a cross-medium interface), no gravity, one wall 0.8 m below:
  * far beyond the support 2h = 0.026 m, so every interaction is fluid-fluid. The continuity
@@ -38,14 +39,7 @@ static const char *const BOX_CASE =
 
 static uint64_t rng_state;
 
-static double uniform(double a, double b)
-{
-    uint64_t z = (rng_state += 0x9E3779B97F4A7C15ull);
-    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
-    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
-    z ^= z >> 31;
-    return a + (b - a) * (double)(z >> 11) * (1.0 / 9007199254740992.0);
-}
+static double uniform(double a, double b) { return test_random_uniform(&rng_state, a, b); }
 
 /* The box with every fluid particle displaced by up to 0.3 dx and given random velocity,
  * density (hence pressure, through the EOS), mass and viscosity; the cell list rebuilt.

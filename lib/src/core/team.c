@@ -68,6 +68,9 @@ struct thread_state {
     int on_heap;
 };
 
+/* The one process-wide item: the key under which each host thread finds its own state, created
+ * once (pthread_once) and never changed; two simulations (or FMU instances) share the key, not a
+ * team: a team belongs to the thread that steps them, and they step one at a time on it. */
 static pthread_key_t state_key;
 static int state_key_ok;
 static pthread_once_t state_key_once = PTHREAD_ONCE_INIT;
