@@ -227,6 +227,9 @@ static mixsph_status create_laws(mixsph_sim *s)
             const int wall = P->state[i] == MIXSPH_STATE_WALL;
             const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
             P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
+            P->wall_nx[i] = P->wall_nz[i] = 0.0;
+            if (wall && w->slip == WALL_FREE_SLIP)
+                walls_normal(&s->phys.walls, particles_wall_index(P, i), P->x[i], P->z[i], &P->wall_nx[i], &P->wall_nz[i]);
             P->wall_friction[i] = !wall ? 0.0 : isnan(w->friction_deg) ? -1.0 : tan(w->friction_deg * GEOM_PI / 180.0);
         }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)

@@ -264,6 +264,19 @@ def test_mixsph_validate_dispatches_to_the_scripts(capsys):
         assert e.value.code == 2 and f"mixsph-validate {case}: error: {message}" in capsys.readouterr().err
 
 
+def test_every_script_is_installed():
+    # pyproject.toml installs tools/'s scripts as top-level modules (py-modules): one left out
+    # runs from the source tree (as these tests do) but not through mixsph-validate in .venv.
+    import glob
+    import tomllib
+    from mixsph_tools import validate
+    with open(os.path.join(ROOT, "pyproject.toml"), "rb") as f:
+        listed = set(tomllib.load(f)["tool"]["setuptools"]["py-modules"])
+    scripts = {os.path.basename(p)[:-3] for p in glob.glob(os.path.join(ROOT, "tools", "*.py"))}
+    assert scripts - listed == set() and listed - scripts == set()
+    assert {module for module, _ in validate.CASES.values()} <= listed
+
+
 def test_against_compares_each_run_with_the_same_run_of_another_folder(tmp_path):
     # --against DIR: each run beside the run of the same number and dx in DIR. Run 6 at dx 0.04 to
     # t = 0.5 s (the comparison time) with the implicit scheme against the explicit one: finite,

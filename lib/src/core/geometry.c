@@ -17,10 +17,17 @@ int geom_inside_polygon(const struct polyline *poly, double x, double z)
     return inside;
 }
 
-double geom_signed_distance(const struct polyline *line, int side, double x, double z, int *at_end)
+/* The point of an open polyline nearest to (x, z): its distance; the left normal there (unit on a
+ * segment, at a shared vertex the sum of both segments' unit normals); the side of the line
+ * (x, z) is on (+1 left, -1 right); and whether the point is one of the two open ends. */
+struct nearest {
+    double distance, nx, nz, left;
+    int at_end;
+};
+
+static struct nearest nearest_on_polyline(const struct polyline *line, double x, double z)
 {
-    double best = INFINITY, sign = 1.0;
-    int end = 0;
+    struct nearest r = {.distance = INFINITY, .nx = 0.0, .nz = 0.0, .left = 1.0, .at_end = 0};
     for (size_t k = 0; k + 1 < line->n; k++) {
         const double ax = line->x[k], az = line->z[k];
         const double ex = line->x[k + 1] - ax, ez = line->z[k + 1] - az;
@@ -30,9 +37,8 @@ double geom_signed_distance(const struct polyline *line, int side, double x, dou
         if (t > 1.0) t = 1.0;
         const double px = ax + t * ex, pz = az + t * ez;
         const double d = hypot(x - px, z - pz);
-        if (d < best - 1e-14) {
-            best = d;
-            /* side of the segment's line; at a shared vertex use the mean of both normals */
+        if (d < r.distance - 1e-14) {
+            r.distance = d;
             double nx = -ez / sqrt(len2), nz = ex / sqrt(len2); /* left normal */
             int is_end = 0;
             if (t <= 0.0 && k > 0) {
@@ -49,12 +55,28 @@ double geom_signed_distance(const struct polyline *line, int side, double x, dou
                 is_end = 1;
             }
             const double dot = (x - px) * nx + (z - pz) * nz;
-            sign = (dot >= 0.0 ? 1.0 : -1.0) * (double)side;
-            end = is_end;
+            r.nx = nx;
+            r.nz = nz;
+            r.left = dot >= 0.0 ? 1.0 : -1.0;
+            r.at_end = is_end;
         }
     }
-    if (at_end) *at_end = end;
-    return sign * best;
+    return r;
+}
+
+double geom_signed_distance(const struct polyline *line, int side, double x, double z, int *at_end)
+{
+    const struct nearest r = nearest_on_polyline(line, x, z);
+    if (at_end) *at_end = r.at_end;
+    return r.left * (double)side * r.distance;
+}
+
+void geom_side_normal(const struct polyline *line, int side, double x, double z, double *nx, double *nz)
+{
+    const struct nearest r = nearest_on_polyline(line, x, z);
+    const double len = hypot(r.nx, r.nz);
+    *nx = len > 0.0 ? (double)side * r.nx / len : 0.0;
+    *nz = len > 0.0 ? (double)side * r.nz / len : 0.0;
 }
 
 int geom_path_crosses(double ax, double az, double bx, double bz, double cx, double cz, double dx,

@@ -20,6 +20,10 @@ int geom_inside_polygon(const struct polyline *poly, double x, double z);
  *  open ends (the point lies beyond the polyline, not beside it). */
 double geom_signed_distance(const struct polyline *line, int side, double x, double z, int *at_end);
 
+/** The unit normal of an open polyline toward its side `side` at the point nearest to (x, z) (at a
+ *  shared vertex, the mean direction of both segments' normals). */
+void geom_side_normal(const struct polyline *line, int side, double x, double z, double *nx, double *nz);
+
 /** Does the path a->b cross segment c->d? On a crossing returns 1 and the fraction s in [0,1]
  *  of the path at which it happens. */
 int geom_path_crosses(double ax, double az, double bx, double bz, double cx, double cz, double dx,

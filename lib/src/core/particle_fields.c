@@ -83,7 +83,11 @@ const struct particle_field particle_fields[] = {
     {.name = "szz", COMPONENTS1(szz), .unit = "Pa", .description = "deviatoric stress, zz (tension positive)",
      .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
     {.name = "wall_rough", COMPONENTS1(wall_rough), .unit = "1",
-     .description = "a wall particle that takes the stress of the solid it meets (no-slip wall)",
+     .description = "1 for a particle of a no-slip wall (its friction applies), 0 for the others",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+    {.name = "wall_normal", COMPONENTS2(wall_nx, wall_nz), .unit = "1",
+     .description = "a free-slip wall particle's unit normal toward the solid, across which it mirrors "
+                    "the solid's stress (0 for the others)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
     {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
      .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi))",

@@ -34,10 +34,13 @@ struct particles {
                                     * linear extrapolation) [m/s] */
     double *visc_d1px, *visc_d1pz; /* visc_d1 of the step before the last [m/s] */
     double *sxx, *sxz, *szz; /* deviatoric stress in the plane [Pa] (tension positive; laws with
-                              * LAW_HAS_STRESS, 0 elsewhere); walls: their neighbours' (walls.c) */
+                              * LAW_HAS_STRESS, 0 elsewhere and on walls) */
     double *syy;          /* its out-of-plane component (plane strain) [Pa] */
-    double *wall_rough;   /* wall particles: 1 where the wall takes the stress of the solid it meets (a
-                           * no-slip wall), 0 where it takes none (free-slip); 0 for the others [-] */
+    double *wall_rough;   /* wall particles: 1 on a no-slip wall, 0 on a free-slip one; 0 for the
+                           * others [-] (a wall's friction applies to rough walls only) */
+    double *wall_nx, *wall_nz; /* free-slip wall particles: their wall's unit normal toward the solid,
+                                * across which they mirror the stress of the solid they meet (no
+                                * shear); 0 for the others (a no-slip wall takes the stress as it is) */
     double *wall_friction; /* wall particles: tan(delta) of their wall's friction angle, or -1 where
                             * the wall takes the friction angle of the grains it meets; 0 for the
                             * others [-] (docs/model.md [DP-W]) */

@@ -340,7 +340,11 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict sxx = P->sxx, *restrict sxz = P->sxz, *restrict szz = P->szz;
     const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
     const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
+    const double *restrict wall_nx = P->wall_nx, *restrict wall_nz = P->wall_nz;
     const double roughi = stress ? wall_rough[i] : 0.0, mu_wi = stress ? wall_mu[i] : 0.0;
+    /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
+    const double mbi = stress ? wall_nx[i] * wall_nx[i] - wall_nz[i] * wall_nz[i] : 0.0;
+    const double mai = stress ? wall_nx[i] * wall_nz[i] : 0.0;
     const struct pair_ctx Xl = *X;
     double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
     double ws[WALL_SUMS][FORCES_CHUNK] = {{0}};            /* i's wall sums (stress), per lane */
@@ -389,11 +393,19 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 fx = F * (fr * rx + fv * (uvxi - uvx[j]));
                 fz = F * (fr * rz + fv * (uvzi - uvz[j]));
             }
-            if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W; a wall holds none,
-                           * and a rough (no-slip) wall takes the stress of the particle it meets */
-                const double ci = 1.0 + wall_rough[j], cj = 1.0 + roughi;
-                const double txx = vv * (ci * sxxi + cj * sxx[j]), txz = vv * (ci * sxzi + cj * sxz[j]);
-                const double tzz = vv * (ci * szzi + cj * szz[j]);
+            if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W. A wall holds none of
+                           * its own: a wall particle takes the stress s of the particle it meets, as
+                           * it is on a no-slip wall, mirrored across the wall on a free-slip one
+                           * (its shear s_nt reversed: s' = s - 2 s_nt (n t + t n), t = (-n_z, n_x),
+                           * s_nt = a (s_zz - s_xx) + b s_xz with a = n_x n_z, b = n_x^2 - n_z^2),
+                           * so that the pair transmits the normal stress and no shear. */
+                const double ci = 1.0 + wallj, cj = 1.0 + walli;
+                const double maj = wall_nx[j] * wall_nz[j], mbj = wall_nx[j] * wall_nx[j] - wall_nz[j] * wall_nz[j];
+                const double snt_i = maj * (szzi - sxxi) + mbj * sxzi;       /* i's shear on j's mirror */
+                const double snt_j = mai * (szz[j] - sxx[j]) + mbi * sxz[j];      /* j's on i's */
+                const double d_normal = 4.0 * (maj * snt_i + mai * snt_j), d_shear = 2.0 * (mbj * snt_i + mbi * snt_j);
+                const double txx = vv * (ci * sxxi + cj * sxx[j] + d_normal), txz = vv * (ci * sxzi + cj * sxz[j] - d_shear);
+                const double tzz = vv * (ci * szzi + cj * szz[j] - d_normal);
                 fx += F * (txx * rx + txz * rz);
                 fz += F * (txz * rx + tzz * rz);
                 /* the wall sums of the wall friction: i's from a rough wall particle j, j's from

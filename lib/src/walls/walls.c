@@ -27,6 +27,12 @@ void walls_signed_distance(const struct walls *W, size_t w, double x, double z, 
     *d = geom_signed_distance(&wl->line, wl->side, x - W->state[w].ox, z - W->state[w].oz, at_end);
 }
 
+void walls_normal(const struct walls *W, size_t w, double x, double z, double *nx, double *nz)
+{
+    const struct wall *wl = &W->def[w];
+    geom_side_normal(&wl->line, wl->side, x - W->state[w].ox, z - W->state[w].oz, nx, nz);
+}
+
 void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
                 int placement, double lattice_z0, double g, double rho_alone)
 {
@@ -345,6 +351,17 @@ static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
     return noslip ? 2.0 * v_wall - v_fluid : v_fluid;
 }
 
+/* A free-slip wall particle's velocity seen by a solid, which has a stress: besides the fluid's
+ * tangential velocity, its normal velocity mirrored about the wall's, so that a solid pressing
+ * on the wall is strained by it (its velocity gradient) as by its mirror image. (nx, nz) = 0
+ * leaves (*vx, *vz) as they are. */
+static inline void mirror_normal_velocity(double nx, double nz, double vx_wall, double vz_wall, double *vx, double *vz)
+{
+    const double vn = (*vx - vx_wall) * nx + (*vz - vz_wall) * nz;
+    *vx -= 2.0 * vn * nx;
+    *vz -= 2.0 * vn * nz;
+}
+
 /* The arguments of a parallel loop of this file (core/team.h). */
 struct wall_loop {
     const struct walls *W;
@@ -396,6 +413,8 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
             P->p[i] = pw > 0.0 ? pw : 0.0;
             P->uvx[i] = mirror_velocity(noslip, ws->vx, svx / sw);
             P->uvz[i] = mirror_velocity(noslip, ws->vz, svz / sw);
+            if (P->wall_nx && !noslip) /* a wall that mirrors a solid's stress (particles.h) */
+                mirror_normal_velocity(P->wall_nx[i], P->wall_nz[i], ws->vx, ws->vz, &P->uvx[i], &P->uvz[i]);
             P->rho[i] = srho / sw;
         } else {
             P->p[i] = 0.0;

@@ -67,6 +67,9 @@ long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *in
 void walls_signed_distance(const struct walls *W, size_t w, double x, double z,
                            double *d, int *at_end);
 
+/** The unit normal of wall w toward its fluid at the point of the wall nearest to (x, z). */
+void walls_normal(const struct walls *W, size_t w, double x, double z, double *nx, double *nz);
+
 /** Move the walls and their particles from t_from by dt. */
 void walls_move(struct walls *W, struct particles *P, double t_from, double dt);
 
