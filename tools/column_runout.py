@@ -172,8 +172,8 @@ def plot(path, results):
 OPTIONS = campaign.CaseOptions(
     description="Dry granular columns of several aspect ratios against the run-out and final-height laws of "
                 "Lube et al. (2005), and whether their deposits rest at 5 sqrt(H0/g).",
-    runs="", known=(), dx=0.01, out="column_runout", case="column_collapse.json", t_end="the case's, 1.5 s",
-    dx_help="particle spacing [m] (default 0.01)", set_example="media.sand.law=1", twin_help=None, sphera=(),
+    runs="", known=(), dx=0.01, out="column_runout", case="column_collapse.json", t_end="1.5 s",
+    dx_help="particle spacing [m] (default 0.01)", set_example="media.sand.phi=30", twin_help=None, sphera=(),
     progress=120.0,
     own=(("--aspects", dict(default="0.5,1,2", help="aspect ratios H0 / L0 (default 0.5,1,2)")),))
 

@@ -43,8 +43,8 @@ OPTIONS = campaign.CaseOptions(
     description="A case at its default time step and at smaller ones, each with gravity-perturbed twins: "
                 "do the results move more than the twins' own spread?",
     runs="", known=(), dx=0.01, dx_help="particle spacing [m] of every run (default 0.01)",
-    out="step", case="column_collapse.json", t_end="the case's numerics.t_end",
-    set_example="media.sand.law=1", twin_help=None, sphera=(), progress=60.0,
+    out="step", case="column_collapse.json", t_end="its numerics.t_end",
+    set_example="media.sand.phi=30", twin_help=None, sphera=(), progress=60.0,
     own=(("--factors", dict(default="1,0.5,0.25", help="time-step factors: each scales numerics.cfl and "
                             "cfl_visc (default 1,0.5,0.25; 1 is the reference)")),
          ("--twins", dict(type=int, default=3, help="runs per setting, twin k with gravity g (1 + k REL) "

@@ -57,3 +57,33 @@ def test_tiny_run(tmp_path):
     assert rows[0]["5T s"] == "0.505"
     assert rows[0]["at 5T at rest"] in ("yes", "no")
     assert (out / "column_runout.png").stat().st_size > 0
+
+
+def test_law_option_runs_the_case_with_that_law(tmp_path):
+    # --law elastic_plastic: the run's case is OUT/case_elastic_plastic.json, the column's sand with
+    # that law and without the paper law's keys (mu_thr, mu0); the run's summary names the case
+    # file. A case with no granular medium is refused.
+    import json
+    import mixsph_tools as mt
+    with open(COLUMN) as f:
+        case = json.load(f)
+    ep = mt.with_law(case, "elastic_plastic", "column")
+    sand = ep["media"]["sand"]
+    assert sand["law"] == "elastic_plastic" and "mu_thr" not in sand and "mu0" not in sand
+    assert sand["phi"] == case["media"]["sand"]["phi"] and "law" not in case["media"]["sand"]   # a copy
+    back = mt.with_law(dict(ep, media={"sand": dict(sand, cohesion=10.0)}), "paper", "column")
+    assert back["media"]["sand"]["law"] == "paper" and "cohesion" not in back["media"]["sand"]
+    with open(os.path.join(ROOT, "cases", "dambreak_water.json")) as f:
+        water = json.load(f)
+    with pytest.raises(mt.ToolError, match="no granular medium"):
+        mt.with_law(water, "elastic_plastic", "dambreak")
+    out = tmp_path / "runout"
+    cmd = script_command("column_runout.py", "--case", COLUMN, "--law", "elastic_plastic", "--dx", "0.04",
+                         "--aspects", "0.5", "--t-end", "0.6", "--threads", "1", "--out", str(out))
+    r = subprocess.run(cmd, capture_output=True, text=True, env=ENV, timeout=300)
+    assert r.returncode == 0, r.stdout + r.stderr
+    with open(out / "case_elastic_plastic.json") as f:
+        assert json.load(f)["media"]["sand"]["law"] == "elastic_plastic"
+    with open(out / "column_runout.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == 1 and rows[0]["status"] == "ok"

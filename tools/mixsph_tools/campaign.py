@@ -29,7 +29,7 @@ from dataclasses import dataclass
 from .readers import ToolError, checkpoint_time, last_time, read_monitors, read_summary, run_particle_steps_per_s, \
     run_wall_time, summary_value, tail
 from .report import fmt, fmt_duration, num, show
-from .runs import case_digest, launch, parse_sets, plan_reuse, twin_gravity
+from .runs import GRANULAR_LAWS, case_digest, launch, parse_sets, plan_reuse, twin_gravity, with_law
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))   # the repository
 EXIT_MEANINGS = {2: "bad usage or input", 3: "unstable run", 4: "out of memory or output failure"}
@@ -92,6 +92,9 @@ def add_options(ap, o):
     ap.add_argument("--mixsph", default=os.path.join(ROOT, "build", "mixsph"),
                     help="mixsph executable (default build/mixsph)")
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", o.case), help=f"case file (default cases/{o.case})")
+    ap.add_argument("--law", choices=GRANULAR_LAWS, help="the material law of the case's granular media (default: "
+                    "the case's); the run's case is then OUT/case_LAW.json, the case with that law and without the "
+                    "keys of the other (the new law's own keys at their defaults)")
     ap.add_argument("--t-end", type=float, help=f"end time [s] of every run (default: the case's, {o.t_end}); "
                     "for short tests")
     ap.add_argument("--progress", type=float, default=o.progress, help="print the simulated time of the running "
@@ -180,7 +183,7 @@ def usable_cores():
 def settings(args, prog, o, n_runs):
     """Settings of the parsed shared options (add_options); n_runs: the campaign's runs besides
     twins (--jobs more than that gain nothing). Raises ToolError on a bad option or input;
-    creates nothing."""
+    creates nothing but, with --law, the output folder and the case of that law in it."""
     _check_numbers(args)
     twin = getattr(args, "twin", None)
     extra = (list(o.sphera) if getattr(args, "sphera", False) else []) + parse_sets(args.sets, o.set_example)
@@ -189,6 +192,14 @@ def settings(args, prog, o, n_runs):
         raise ToolError(f"{show(mixsph)}: no mixsph executable there (build it: ./tools/do build)")
     case = os.path.abspath(args.case)
     case_json, case_sha = _read_case(case)
+    if getattr(args, "law", None):
+        case_json = with_law(case_json, args.law, show(case))
+        case = os.path.join(os.path.abspath(args.out), f"case_{args.law}.json")
+        os.makedirs(os.path.dirname(case), exist_ok=True)
+        with open(case, "w") as f:
+            json.dump(case_json, f, indent=2)
+            f.write("\n")
+        case_sha = case_digest(case)
     t_end = args.t_end if args.t_end is not None else float(case_json.get("numerics", {}).get("t_end", math.nan))
     if not math.isfinite(t_end):
         raise ToolError(f"{show(case)}: no numerics.t_end (give --t-end)")
