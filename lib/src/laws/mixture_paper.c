@@ -57,8 +57,8 @@ static const struct case_key granular_keys[] = {
      .field = CASE_FIELD(medium, law), .meaning = "\"granular\": a mixture at the packing limit"},
     {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices, .numeric_choice = CASE_CHOICE_BY_POSITION,
      SCHEMA_DEF(LAW_MIXTURE_PAPER), .field = CASE_FIELD(medium, law),
-     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next); the other law's keys "
-                "are checked and not used (below)"},
+     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next); chosen by its number "
+                "(a case parameter), the medium may hold the other law's keys too (below)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
      .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
