@@ -6,11 +6,15 @@
  *
  * How the parameters reach the case (docs/fmu.md, docs/cases.md):
  *   - the physical ones (reservoir_level, phi, mu0, mu_thr, saturated, porosity, grain_density,
- *     tension_cutoff, plate_duration_scale, plate_stroke_scale) are overrides "parameters.NAME"
+ *     tension_cutoff, plate_duration_scale, plate_stroke_scale, rheology, grain_bulk_modulus, nu,
+ *     cohesion) are overrides "parameters.NAME"
  *     of the case's `parameters` block: a case declares there the names it lets a host set and
  *     uses them as "$NAME" values, so any case file that declares them works, whatever its
  *     media, bodies and walls are called. One the host sets and the case does not declare is an
- *     fmi2Error naming it (the glue checks);
+ *     fmi2Error naming it (the glue checks). rheology, an Enumeration, reaches the case as its
+ *     item's value, the number of the granular law in the case (media.NAME.law: 0 paper, 1
+ *     elastic_plastic, docs/cases.md), which then ignores the parameters of the law it does not
+ *     use (mu_thr, mu0, tension_cutoff, or nu, cohesion);
  *   - the numerical ones (dx, output_interval, pressure_smoothing, av_wall, implicit_viscosity) override the
  *     numerics and output keys every case has; threads is the library's thread count.
  * A parameter the host never sets gets no override: it keeps the case file's value, so an
@@ -50,6 +54,9 @@ enum {
     P_DX,
     P_OUTPUT_INTERVAL,
     P_PRESSURE_SMOOTHING,
+    P_GRAIN_BULK_MODULUS,
+    P_NU,
+    P_COHESION,
     N_REAL_PARAMS
 };
 static const struct real_param real_params[N_REAL_PARAMS] = {
@@ -64,6 +71,9 @@ static const struct real_param real_params[N_REAL_PARAMS] = {
     [P_DX] = KEY_PARAM(dx, "numerics.dx"),
     [P_OUTPUT_INTERVAL] = KEY_PARAM(output_interval, "output.monitor_interval"),
     [P_PRESSURE_SMOOTHING] = KEY_PARAM(pressure_smoothing, "numerics.pressure_smoothing"),
+    [P_GRAIN_BULK_MODULUS] = CASE_PARAM(grain_bulk_modulus),
+    [P_NU] = CASE_PARAM(nu),
+    [P_COHESION] = CASE_PARAM(cohesion),
 };
 
 /* Boolean parameters: passed to the case as 0/1 overrides of `key` when the host sets them. */
@@ -80,6 +90,22 @@ static const struct {
                               START_implicit_viscosity},
 };
 
+/* Enumeration parameters: passed to the case as their item's value when the host sets them. The
+ * items' names (for messages) from MIN to MAX, as modelDescription.xml lists them. */
+static const char *const rheology_items[] = {"paper", "elastic_plastic"};
+_Static_assert(sizeof rheology_items / sizeof rheology_items[0] == MAX_rheology - MIN_rheology + 1,
+               "rheology_items must name the Rheology items of modelDescription.xml");
+enum { E_RHEOLOGY, N_ENUM_PARAMS };
+static const struct {
+    fmi2ValueReference vr;
+    const char *name, *key;
+    int start, min, max;
+    const char *const *items;
+} enum_params[N_ENUM_PARAMS] = {
+    [E_RHEOLOGY] = {VR_rheology, "rheology", "parameters.rheology", START_rheology, MIN_rheology, MAX_rheology,
+                    rheology_items},
+};
+
 /* Outputs read from the library by name. */
 enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, O_KE_WATER, N_OUTS };
 static const char *const out_names[N_OUTS] = {
@@ -92,6 +118,7 @@ struct landslide_data {
     double real[N_REAL_PARAMS];
     int real_set[N_REAL_PARAMS]; /* set by the host: passed to the case as an override */
     int flag[N_BOOL_PARAMS], flag_set[N_BOOL_PARAMS];
+    int item[N_ENUM_PARAMS], item_set[N_ENUM_PARAMS];
     int threads;
     char case_file[FMU_PATH_LEN];
     double push_velocity; /* [m/s] along the moving wall's direction of travel */
@@ -123,11 +150,19 @@ static int bool_param_index(fmi2ValueReference vr)
     return -1;
 }
 
+static int enum_param_index(fmi2ValueReference vr)
+{
+    for (int k = 0; k < N_ENUM_PARAMS; k++)
+        if (enum_params[k].vr == vr) return k;
+    return -1;
+}
+
 static void set_defaults(void *data)
 {
     struct landslide_data *d = data;
     for (int k = 0; k < N_REAL_PARAMS; k++) d->real[k] = real_params[k].start;
     for (int k = 0; k < N_BOOL_PARAMS; k++) d->flag[k] = bool_params[k].start;
+    for (int k = 0; k < N_ENUM_PARAMS; k++) d->item[k] = enum_params[k].start;
     d->threads = START_threads;
     snprintf(d->case_file, sizeof d->case_file, "%s", START_case_file);
     d->push_velocity = START_push_velocity;
@@ -138,7 +173,8 @@ static void set_defaults(void *data)
 /* ---- the simulation ----------------------------------------------------------------------- */
 
 /* every parameter set at once fits in one request */
-_Static_assert(N_REAL_PARAMS + N_BOOL_PARAMS <= FMU_MAX_OVERRIDES, "FMU_MAX_OVERRIDES too small for the parameters");
+_Static_assert(N_REAL_PARAMS + N_BOOL_PARAMS + N_ENUM_PARAMS <= FMU_MAX_OVERRIDES,
+               "FMU_MAX_OVERRIDES too small for the parameters");
 
 static void request(const struct fmu_instance *in, struct fmu_sim_request *req)
 {
@@ -150,6 +186,9 @@ static void request(const struct fmu_instance *in, struct fmu_sim_request *req)
     for (int k = 0; k < N_BOOL_PARAMS; k++)
         if (d->flag_set[k])
             req->ov[req->n_ov++] = (struct fmu_override){bool_params[k].name, {bool_params[k].key, d->flag[k] ? 1.0 : 0.0}};
+    for (int k = 0; k < N_ENUM_PARAMS; k++)
+        if (d->item_set[k])
+            req->ov[req->n_ov++] = (struct fmu_override){enum_params[k].name, {enum_params[k].key, (double)d->item[k]}};
 }
 
 static fmi2Status attach(struct fmu_instance *in)
@@ -258,6 +297,11 @@ static fmi2Status get_integer(struct fmu_instance *in, fmi2ValueReference vr, fm
         *value = data_of(in)->threads;
         return fmi2OK;
     }
+    const int e = enum_param_index(vr);
+    if (e >= 0) {
+        *value = data_of(in)->item[e];
+        return fmi2OK;
+    }
     if (vr != VR_fixed_particles && vr != VR_lost_particles && vr != VR_steps)
         return fmu_reject(in, "fmi2GetInteger: no Integer variable with value reference %u", vr);
     if (fmu_need_simulation(in) != fmi2OK) return fmi2Error;
@@ -310,8 +354,29 @@ static fmi2Status set_real(struct fmu_instance *in, fmi2ValueReference vr, fmi2R
     return fmu_reject(in, "fmi2SetReal: no settable Real variable with value reference %u", vr);
 }
 
+/* An Enumeration parameter: one of its items' values. */
+static fmi2Status set_enum(struct fmu_instance *in, int e, fmi2Integer v)
+{
+    if (fmu_parameter_settable(in, enum_params[e].name) != fmi2OK) return fmi2Error;
+    if (v < enum_params[e].min || v > enum_params[e].max) {
+        char items[256];
+        size_t at = 0;
+        items[0] = '\0';
+        for (int k = enum_params[e].min; k <= enum_params[e].max && at < sizeof items; k++)
+            at += (size_t)snprintf(items + at, sizeof items - at, "%s%d (%s)", k > enum_params[e].min ? ", " : "", k,
+                                   enum_params[e].items[k - enum_params[e].min]);
+        return fmu_reject(in, "%s = %d is not one of its items: %s", enum_params[e].name, (int)v, items);
+    }
+    struct landslide_data *d = data_of(in);
+    d->item[e] = v;
+    d->item_set[e] = 1;
+    return fmi2OK;
+}
+
 static fmi2Status set_integer(struct fmu_instance *in, fmi2ValueReference vr, fmi2Integer v)
 {
+    const int e = enum_param_index(vr);
+    if (e >= 0) return set_enum(in, e, v);
     if (vr != VR_threads) return fmu_reject(in, "fmi2SetInteger: no settable Integer variable with value reference %u", vr);
     if (fmu_parameter_settable(in, "threads") != fmi2OK) return fmi2Error;
     if (v < MIN_threads || v > MAX_threads)

@@ -694,6 +694,59 @@ static void test_d50_refused(void **state)
     case_free(&c);
 }
 
+/* A granular medium's law chosen by its number (its place in the list: 0 paper, 1 elastic_plastic,
+ * as a case parameter or an override gives it): the medium may hold both laws' keys, those of the
+ * law not chosen checked (type, range) and not used; named, the other law's keys are refused. */
+static void test_granular_law_by_number(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    char *j = with_sand(", \"law\": 1, \"nu\": 0.25, \"cohesion\": 10.0, \"mu0\": 5e3, \"tension_cutoff\": true");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    free(j);
+    const struct medium *m = &c.media[1];
+    assert_int_equal(m->law, LAW_ELASTIC_PLASTIC);
+    assert_true(m->poisson == 0.25 && m->cohesion == 10.0);
+    assert_true(m->mu_thr == 0.0 && m->mu0 == 0.0 && m->tension_cutoff == 0); /* the paper's keys: not used */
+    case_free(&c);
+    j = with_sand(", \"law\": 0, \"nu\": 0.25, \"cohesion\": 10.0");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    m = &c.media[1];
+    assert_int_equal(m->law, LAW_MIXTURE_PAPER);
+    assert_true(m->mu_thr == 320e3 && m->poisson == 0.0 && m->cohesion == 0.0);
+    case_free(&c);
+    /* an override of the number chooses the other law */
+    const mixsph_override to_ep = {"media.sand.law", 1.0};
+    assert_int_equal(case_parse(j, ORIGIN, &to_ep, 1, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(c.media[1].law, LAW_ELASTIC_PLASTIC);
+    case_free(&c);
+    free(j);
+    /* the other law's keys are checked: a value out of its range, a key of no granular law, a
+     * number that is no law's */
+    j = with_sand(", \"law\": 1, \"mu0\": -5");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, ORIGIN ": media.sand.mu0: -5 is out of range",
+                              (const char *)NULL));
+    free(j);
+    j = with_sand(", \"law\": 0, \"nu\": 0.6");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.nu: 0.6 is out of range", (const char *)NULL));
+    free(j);
+    j = with_sand(", \"law\": 1, \"bogus\": 1");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.bogus: unknown key", (const char *)NULL));
+    free(j);
+    j = with_sand(", \"law\": 2");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.law: 2 is not the number of a choice",
+                              "(or 0, 1)", (const char *)NULL));
+    free(j);
+    /* named: the paper's mu_thr is refused by the elastic-plastic table, nu by the paper's */
+    j = with_sand(", \"law\": \"elastic_plastic\"");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.mu_thr: unknown key", (const char *)NULL));
+    free(j);
+    j = with_sand(", \"law\": \"paper\", \"nu\": 0.3");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.nu: unknown key", (const char *)NULL));
+    free(j);
+}
+
 /* Every table row is well formed: a key once per section, a meaning, a field only where the
  * type has one, choices for a choice, a finite default inside the range. */
 static void test_table_rows(void **state)
@@ -772,6 +825,7 @@ int main(void)
         cmocka_unit_test(test_table_variants),
         cmocka_unit_test(test_table_defaults),
         cmocka_unit_test(test_d50_refused),
+        cmocka_unit_test(test_granular_law_by_number),
         cmocka_unit_test(test_table_rows),
         cmocka_unit_test(test_parameters),
     };

@@ -39,6 +39,7 @@ enum {
     VR_FRONT = 33,
     VR_KE = 34,
     VR_STEPS = 39,
+    VR_RHEOLOGY = 50,
 };
 
 static const char *const all_functions[] = {
@@ -147,6 +148,52 @@ static void step_to(fmi2Component c, double t0, double t1, double h)
 
 /* ---- tests -------------------------------------------------------------------------------- */
 
+/* The granular law through fmi2SetInteger (rheology is an Enumeration): a value that is no item's
+ * is an fmi2Error with a message naming the parameter, the instance stays usable; elastic_plastic
+ * runs another trajectory than the default paper law, and its state (the grains' stresses
+ * included) restores to the same continuation. */
+static void test_rheology(void **state)
+{
+    (void)state;
+    char uri[4200];
+    resource_uri(uri, sizeof uri, "file://", "");
+    struct log_counts lc = {0};
+    const fmi2ValueReference vr = VR_RHEOLOGY;
+    fmi2Component paper = instantiate("paper", uri, &lc);
+    assert_non_null(paper);
+    start(paper, 35.0, &lc);
+    step_to(paper, 0.0, 0.1, 0.02);
+    const struct out ref = outputs(paper);
+    SYM(fmi2FreeInstance)(paper);
+
+    fmi2Component c = instantiate("ep", uri, &lc);
+    assert_non_null(c);
+    const fmi2Integer bad = 2, ep = 1;
+    assert_int_equal(SYM(fmi2SetInteger)(c, &vr, 1, &bad), fmi2Error);
+    assert_int_equal(lc.n[fmi2Error], 1);
+    assert_non_null(strstr(lc.last, "rheology = 2 is not one of its items"));
+    fmi2Integer got = -1;
+    assert_int_equal(SYM(fmi2GetInteger)(c, &vr, 1, &got), fmi2OK);
+    assert_int_equal(got, 0); /* unchanged: the paper law */
+    assert_int_equal(SYM(fmi2SetInteger)(c, &vr, 1, &ep), fmi2OK);
+    start(c, 35.0, &lc);
+    step_to(c, 0.0, 0.06, 0.02);
+    fmi2FMUstate s = NULL;
+    assert_int_equal(SYM(fmi2GetFMUstate)(c, &s), fmi2OK);
+    step_to(c, 0.06, 0.1, 0.02);
+    const struct out first = outputs(c);
+    assert_true(first.steps != ref.steps); /* the elastic law's P-wave time step */
+    assert_true(first.r[2] != ref.r[2]);   /* another landslide front */
+    assert_int_equal(SYM(fmi2SetFMUstate)(c, s), fmi2OK);
+    step_to(c, 0.06, 0.1, 0.02);
+    assert_same(first, outputs(c));
+    assert_int_equal(SYM(fmi2GetInteger)(c, &vr, 1, &got), fmi2OK);
+    assert_int_equal(got, 1);
+    assert_int_equal(SYM(fmi2FreeFMUstate)(c, &s), fmi2OK);
+    assert_int_equal(lc.n[fmi2Error], 1);
+    SYM(fmi2FreeInstance)(c);
+}
+
 static void test_every_fmi2_function_resolves(void **state)
 {
     (void)state;
@@ -176,7 +223,7 @@ static void test_value_references_match_the_model_description(void **state)
     } vars[] = {{"phi", VR_PHI}, {"mu0", VR_MU0}, {"dx", VR_DX}, {"case_file", VR_CASE_FILE},
                 {"push_velocity", VR_PUSH_VELOCITY}, {"push_external", VR_PUSH_EXTERNAL}, {"run_up", VR_RUN_UP},
                 {"max_run_up", VR_MAX_RUN_UP}, {"landslide_front", VR_FRONT}, {"kinetic_energy", VR_KE},
-                {"steps", VR_STEPS}};
+                {"steps", VR_STEPS}, {"rheology", VR_RHEOLOGY}};
     for (size_t k = 0; k < sizeof vars / sizeof vars[0]; k++) {
         char want[128];
         snprintf(want, sizeof want, "name=\"%s\" valueReference=\"%d\"", vars[k].name, vars[k].vr);
@@ -431,6 +478,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_interleaved_instances_match_solo_runs),
         cmocka_unit_test(test_errors_are_logged_not_fatal),
         cmocka_unit_test(test_second_case_through_case_file),
+        cmocka_unit_test(test_rheology),
     };
     /* no dlclose: the library stays mapped so that a leak report (ASan) can name its functions */
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -27,7 +27,7 @@ COARSE = {"dx": 0.03, "mu0": 1000.0}
 # The FMU's physical parameters reach a case through its `parameters` block (override
 # "parameters.NAME"), the numerical ones through keys every case has (fmu/landslide_model.c).
 PHYSICAL = ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "tension_cutoff", "porosity", "grain_density",
-            "plate_duration_scale", "plate_stroke_scale"]
+            "plate_duration_scale", "plate_stroke_scale", "rheology", "grain_bulk_modulus", "nu", "cohesion"]
 CASE_KEYS = {
     **{name: f"parameters.{name}" for name in PHYSICAL},
     "dx": "numerics.dx",
@@ -114,7 +114,7 @@ def set_params(fmu, params):
         t = types[name]
         if t == "Real":
             fmu.setReal([v[name]], [float(value)])
-        elif t == "Integer":
+        elif t in ("Integer", "Enumeration"):
             fmu.setInteger([v[name]], [int(value)])
         elif t == "Boolean":
             fmu.setBoolean([v[name]], [bool(value)])

@@ -329,3 +329,29 @@ def test_sweep_on_an_existing_cluster_without_the_repository(tmp_path):
                 p.wait(timeout=30)
             except subprocess.TimeoutExpired:
                 os.killpg(p.pid, signal.SIGKILL)
+
+
+def test_the_granular_law_is_swept_by_its_item_name_and_is_a_binary_emulator_input(tmp_path):
+    # rheology (an Enumeration of the FMU) given by item names: the scenario table, its ids and
+    # the results hold the items' values (0 paper, 1 elastic_plastic), each run is the FMU's own
+    # with that value, and the emulator takes the column as a two-level input like saturated
+    from fmpy import simulate_fmu
+    from tools.dss import emulator as E
+    fmu = fmu_path()
+    out = tmp_path / "sweep"
+    stop = 0.4
+    dss("sweep", out, "--fmu", fmu, "--grid", "rheology=paper,elastic_plastic", "--set", "nu=0.3", *COARSE,
+        "--stop-time", stop, "--step", 0.05, "--workers", 1, "--no-report", "--quiet")
+    df = ResultStore(str(out)).latest().sort_values("rheology")
+    assert list(df["rheology"]) == [0, 1] and (df["status"] == "ok").all(), df.get("error")
+    for rec in df.to_dict(orient="records"):
+        r = simulate_fmu(fmu, start_values={"rheology": rec["rheology"], "nu": 0.3, "dx": 0.05, "threads": 1},
+                         stop_time=stop, output_interval=0.05, output=["max_run_up"])
+        assert rec["max_run_up"] == pytest.approx(float(r[-1]["max_run_up"]), rel=1e-12, abs=1e-12)
+    assert df["max_run_up"].iloc[0] != df["max_run_up"].iloc[1]
+    names, kinds = E.choose_inputs(df)
+    assert names == ["rheology"] and kinds == ["binary"]
+    # an item the FMU does not have: a usage error that lists its items, before any run
+    p = dss("sweep", tmp_path / "bad", "--fmu", fmu, "--set", "rheology=bingham", *COARSE, "--stop-time", 0.1,
+            check=False)
+    assert p.returncode == 2 and "paper (0), elastic_plastic (1)" in p.stderr, p.stderr

@@ -33,7 +33,7 @@ def test_validate_fmu_finds_no_problem():
     names = {v.name: v for v in md.modelVariables}
     for p in ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "dx", "plate_duration_scale",
               "plate_stroke_scale", "porosity", "grain_density", "output_interval", "case_file", "tension_cutoff",
-              "pressure_smoothing", "av_wall"]:
+              "pressure_smoothing", "av_wall", "rheology", "grain_bulk_modulus", "nu", "cohesion"]:
         assert names[p].causality == "parameter", p
     for o in H.OUT_REAL + H.OUT_INT:
         assert names[o].causality == "output" and names[o].start is None, o
@@ -383,4 +383,101 @@ def test_invalid_parameters_give_fmi2error_and_a_logged_message(tmp_path):
         fn.argtypes, fn.restype = [ctypes.c_void_p], ctypes.c_int
         assert fn(f.component) == 3
     assert len(log.errors()) == n + 2 and "co-simulation" in log.errors()[-1]
+    f.freeInstance()
+
+
+# ---- the granular law: rheology and the elastic-plastic law's parameters -----------------------
+
+def test_rheology_is_an_enumeration_of_the_case_laws_numbers():
+    # the items' values are the numbers by which a case chooses a granular medium's law
+    # (media.NAME.law: "paper" or "elastic_plastic" (or 0, 1), docs/cases.md, generated from the
+    # key tables), so the FMU passes the value through unchanged
+    import re
+    md = H.model_description()
+    v = {x.name: x for x in md.modelVariables}["rheology"]
+    assert v.type == "Enumeration" and v.causality == "parameter" and v.variability == "fixed"
+    items = {it.name: int(it.value) for it in v.declaredType.items}
+    assert items == {"paper": 0, "elastic_plastic": 1}
+    assert int(v.start) == items["paper"]  # the default: the paper's law
+    docs = (H.ROOT / "docs" / "cases.md").read_text()
+    row = re.search(r'^\| `law` \| string \| no \| `"paper"` \| ([^|]*)\|', docs, re.M)
+    assert row and row.group(1).strip() == '`"paper"` or `"elastic_plastic"` (or 0, 1)', row
+    # the paper law's parameters say that the elastic-plastic law ignores them, and conversely
+    for name in ("mu0", "mu_thr", "tension_cutoff"):
+        d = {x.name: x for x in md.modelVariables}[name].description
+        assert "ignored with elastic_plastic" in d, name
+    for name in ("nu", "cohesion"):
+        d = {x.name: x for x in md.modelVariables}[name].description
+        assert "ignored with paper" in d, name
+
+
+EP_STOP = 0.6  # the slide has entered the reservoir and the wave runs (run-up 0.50-0.55 m)
+
+
+@pytest.fixture(scope="module")
+def fmu_run_ep():
+    from fmpy import simulate_fmu
+    return simulate_fmu(H.fmu_path(), start_values={**RUN, "rheology": 1}, stop_time=EP_STOP, output_interval=0.02)
+
+
+def test_elastic_plastic_rheology_matches_the_executable_and_differs_from_paper(fmu_run_ep, fmu_run_phi35,
+                                                                                  tmp_path):
+    # rheology = elastic_plastic reaches the case as parameters.rheology = 1: the FMU's run is the
+    # executable's with that override (identical with one thread), with the P-wave time step of
+    # the elastic law (more steps than the paper law's acoustic one) and no held grains
+    res = fmu_run_ep
+    cli = H.run_mixsph({**RUN, "rheology": 1}, tmp_path / "cli", t_end=EP_STOP)
+    assert res["max_run_up"][-1] == cli["outputs"]["run_up"]["max"]
+    assert res["steps"][-1] == cli["steps"]
+    assert np.all(res["fixed_particles"] == 0)
+    paper = H.run_mixsph(RUN, tmp_path / "paper", t_end=EP_STOP)
+    assert res["max_run_up"][-1] != paper["outputs"]["run_up"]["max"]
+    assert res["steps"][-1] > paper["steps"]
+    assert np.isfinite(res["landslide_front"][-1]) and res["lost_particles"][-1] == 0
+
+
+def test_elastic_plastic_parameters_act_on_their_law_only(fmu_run_ep, fmu_run_phi35):
+    from fmpy import simulate_fmu
+    # with the paper's law (the default) nu, cohesion are ignored: the default run bit for bit
+    paper = simulate_fmu(H.fmu_path(), start_values={**RUN, "nu": 0.45, "cohesion": 500.0}, stop_time=STOP,
+                         output_interval=0.02)
+    assert paper["max_run_up"][-1] == fmu_run_phi35["max_run_up"][-1]
+    assert paper["steps"][-1] == fmu_run_phi35["steps"][-1]
+    # with elastic_plastic they change the run, and mu_thr, mu0 do not
+    ep = dict(RUN, rheology=1)
+    soft = simulate_fmu(H.fmu_path(), start_values={**ep, "nu": 0.45}, stop_time=EP_STOP, output_interval=0.02)
+    assert soft["max_run_up"][-1] != fmu_run_ep["max_run_up"][-1]
+    assert soft["steps"][-1] < fmu_run_ep["steps"][-1]  # nu -> 0.5: G -> 0, a slower P wave
+    cohesive = simulate_fmu(H.fmu_path(), start_values={**ep, "cohesion": 500.0}, stop_time=EP_STOP,
+                            output_interval=0.02)
+    assert cohesive["landslide_front"][-1] != fmu_run_ep["landslide_front"][-1]
+    viscous = simulate_fmu(H.fmu_path(), start_values={**ep, "mu_thr": 1e4, "mu0": 10.0}, stop_time=EP_STOP,
+                           output_interval=0.02)
+    assert viscous["max_run_up"][-1] == fmu_run_ep["max_run_up"][-1]
+    assert viscous["steps"][-1] == fmu_run_ep["steps"][-1]
+
+
+def test_bad_rheology_values_give_fmi2error_and_a_logged_message():
+    v = H.vrs()
+    log = H.Logger()
+    f = H.instance("rheology", logger=log)
+    _expect_error(log, f.setInteger, [v["rheology"]], [2],
+                  text="rheology = 2 is not one of its items: 0 (paper), 1 (elastic_plastic)")
+    _expect_error(log, f.setInteger, [v["rheology"]], [-1], text="rheology = -1")
+    _expect_error(log, f.setReal, [v["nu"]], [0.5], text="nu = 0.5 is out of range [0, 0.49]")
+    _expect_error(log, f.setReal, [v["cohesion"]], [-1.0], text="cohesion = -1 is out of range")
+    _expect_error(log, f.setReal, [v["grain_bulk_modulus"]], [0.0], text="grain_bulk_modulus = 0 is out of range")
+    # the instance stays usable, with the value it had
+    assert f.getInteger([v["rheology"]]) == [0]
+    H.start(f, {**H.COARSE, "rheology": 1})
+    assert f.getInteger([v["rheology"]]) == [1]
+    f.doStep(currentCommunicationPoint=0.0, communicationStepSize=0.01)
+    _expect_error(log, f.setInteger, [v["rheology"]], [0], text="fixed parameter")
+    f.freeInstance()
+    # a case that does not declare rheology (slope_tank.json, a resource): an error naming it
+    f = H.instance("rheology_case", logger=log)
+    f.setupExperiment(startTime=0.0)
+    f.enterInitializationMode()
+    H.set_params(f, {"case_file": "slope_tank.json", "rheology": 1})
+    _expect_error(log, f.exitInitializationMode, text="rheology")
     f.freeInstance()

@@ -70,6 +70,51 @@ def model_params(fmu_path: str):
     return md, {v.name: v for v in md.modelVariables}
 
 
+def enumeration_items(var) -> dict:
+    """The FMU's Enumeration parameters: name -> {item name: value} (LandslideWave's rheology:
+    paper 0, elastic_plastic 1)."""
+    return {n: {it.name: int(it.value) for it in v.declaredType.items}
+            for n, v in var.items() if v.type == "Enumeration" and v.causality == "parameter"
+            and v.declaredType is not None}
+
+
+def item_value(name: str, value, items: dict):
+    """value of parameter `name` with an Enumeration's item name replaced by its value (a sweep's
+    tables, its scenario ids and the emulator hold numbers); other values as they are."""
+    its = items.get(name)
+    if its is None or not isinstance(value, str):
+        return value
+    if value in its:
+        return its[value]
+    try:
+        return int(float(value)) if float(value).is_integer() else value
+    except ValueError:
+        raise UsageError(f"{name} = {value!r} is not one of its items: "
+                         + ", ".join(f"{k} ({v})" for k, v in its.items())) from None
+
+
+def item_values(params: dict, items: dict) -> dict:
+    """params with item names replaced by their values (item_value)."""
+    return {k: item_value(k, v, items) for k, v in params.items()}
+
+
+def item_choices(dists, items: dict):
+    """The choices of choice distributions of Enumeration parameters as their items' values (in
+    place); the distributions."""
+    for d in dists:
+        if getattr(d, "kind", None) == "choice":
+            d.choices = [item_value(d.name, c, items) for c in d.choices]
+    return dists
+
+
+def fmu_items(fmu_path: str | None) -> dict:
+    """enumeration_items of the FMU at fmu_path; {} when it cannot be read (numbers only then)."""
+    try:
+        return enumeration_items(model_params(fmu_path)[1]) if fmu_path and os.path.isfile(fmu_path) else {}
+    except Exception:
+        return {}
+
+
 def common_cluster_args(p):
     g = p.add_argument_group("cluster")
     g.add_argument("--scheduler", metavar="ADDR",
@@ -129,6 +174,7 @@ def resolve_run(args, saved=None):
     fixed = dict(saved.get("fixed", {})) if not args.set else {}
     fixed.update(parse_sets(args.set))
     md, var = model_params(fmu)
+    fixed = item_values(fixed, enumeration_items(var))
     if stop is None:
         de = md.defaultExperiment
         stop = float(de.stopTime) if de is not None and de.stopTime else None

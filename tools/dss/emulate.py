@@ -43,8 +43,9 @@ import numpy as np
 import pandas as pd
 
 from . import emulator as E
-from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, parse_box, parse_dists,
-                  parse_sets, parse_value, resolve_run, save_json)
+from .cli import (UsageError, common_cluster_args, common_run_args, default_fmu, enumeration_items, fmu_items,
+                  item_choices, item_value, item_values, parse_box, parse_dists, parse_sets, parse_value,
+                  resolve_run, save_json)
 
 
 def _load(args):
@@ -318,10 +319,11 @@ def _scenarios_from_args(em, args) -> pd.DataFrame:
         df = pd.read_csv(args.csv)
     else:
         cols = {}
+        items = fmu_items(args.fmu or default_fmu())  # rheology=elastic_plastic: its value
         for it in args.set:
             from .scenarios import split_assignment
             k, v = split_assignment(it)
-            cols[k] = [float(x) for x in v.split(",")]
+            cols[k] = [float(item_value(k, x.strip(), items)) for x in v.split(",")]
         if not cols:
             raise UsageError("give the scenarios: --set NAME=VALUE ... or --csv FILE")
         lens = {len(v) for v in cols.values()}
@@ -424,8 +426,10 @@ def cmd_risk(args):
             output = next(iter(em.models))
         else:
             raise UsageError(f"no emulator of {output!r} ({', '.join(em.models)})")
+    items = fmu_items(args.fmu or default_fmu())
     dists = parse_dists(args.dist)
-    fixed = parse_sets(args.set)
+    item_choices(dists.values(), items)
+    fixed = item_values(parse_sets(args.set), items)
     if not dists:
         raise UsageError("give the inputs' distributions with --dist NAME=SPEC")
     t0 = time.perf_counter()
@@ -558,7 +562,7 @@ def cmd_design(args):
     if args.criterion and args.crest is not None:
         raise UsageError(f"--criterion {args.criterion} applies without --crest only (with a "
                          f"crest the picks are at the largest p(1 - p))")
-    dists = [Distribution(*split_assignment(it)) for it in args.dist]
+    dists = item_choices([Distribution(*split_assignment(it)) for it in args.dist], enumeration_items(var))
     for d_ in dists:
         if d_.name not in var or var[d_.name].causality != "parameter":
             raise UsageError(f"{d_.name!r} is not a parameter of the FMU")

@@ -181,7 +181,8 @@ def cmd_mf_design(args, quiet_summary=False):
     bad = [x for x in levels if not lo <= x <= hi]
     if bad:
         raise UsageError(f"--levels: dx {bad} outside the FMU's range {lo:g}..{hi:g}")
-    dists = [Distribution(*split_assignment(it)) for it in args.dist]
+    from .cli import enumeration_items, item_choices
+    dists = item_choices([Distribution(*split_assignment(it)) for it in args.dist], enumeration_items(var))
     for d_ in dists:
         if d_.name not in var or var[d_.name].causality != "parameter":
             raise UsageError(f"{d_.name!r} is not a parameter of the FMU")

@@ -52,11 +52,14 @@ NOISE_MODES = ("floor", "fixed")
 MODES = ("product", "binary", "separate")
 
 # the FMU's physical parameters and the numerical ones an emulator may take as inputs when a
-# sweep varies them; never inputs: threads, file names, output settings
+# sweep varies them; never inputs: threads, file names, output settings. rheology (the granular
+# law, 0 paper / 1 elastic_plastic) is a two-level input like saturated; mu0, mu_thr and
+# tension_cutoff are the paper law's, nu and cohesion the elastic-plastic law's; the grains' bulk
+# modulus is the weakly compressible stiffness (numerical, as dx)
 PHYSICAL = ("reservoir_level", "phi", "saturated", "porosity", "grain_density",
-            "plate_duration_scale", "plate_stroke_scale")
-NUMERICAL = ("dx", "mu0", "mu_thr", "pressure_smoothing", "tension_cutoff", "av_wall",
-             "implicit_viscosity")
+            "plate_duration_scale", "plate_stroke_scale", "nu", "cohesion")
+NUMERICAL = ("dx", "rheology", "mu0", "mu_thr", "pressure_smoothing", "tension_cutoff", "av_wall",
+             "implicit_viscosity", "grain_bulk_modulus")
 NOT_INPUTS = ("threads", "case_file", "output_interval")
 DEFAULT_OUTPUTS = ("max_run_up", "time_of_max_run_up", "max_run_up_Z", "landslide_front")
 

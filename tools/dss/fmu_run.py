@@ -94,12 +94,19 @@ def _check_value(v, value):
             raise ValueError(f"{v.name} = {value!r} outside [{v.min}, {v.max}] of the model description")
         return x
     if t in ("Integer", "Enumeration"):
+        items = {it.name: int(it.value) for it in v.declaredType.items} \
+            if t == "Enumeration" and v.declaredType is not None else {}
+        if isinstance(value, str) and value.strip() in items:  # an item by name: its value
+            return items[value.strip()]
         x = float(value)
         if not x.is_integer():
             raise ValueError(f"{v.name} = {value!r} is not an integer")
         x = int(x)
         if (v.min is not None and x < int(v.min)) or (v.max is not None and x > int(v.max)):
             raise ValueError(f"{v.name} = {value!r} outside [{v.min}, {v.max}] of the model description")
+        if items and x not in items.values():
+            raise ValueError(f"{v.name} = {value!r} is not one of its items: "
+                             + ", ".join(f"{k} ({i})" for k, i in items.items()))
         return x
     if t == "Boolean":
         if isinstance(value, str):

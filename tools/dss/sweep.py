@@ -7,7 +7,7 @@ import os
 import sys
 import uuid
 
-from .cli import UsageError, load_settings, resolve_run, save_json
+from .cli import UsageError, enumeration_items, item_values, load_settings, resolve_run, save_json
 
 
 def cmd_sweep(args):
@@ -39,7 +39,8 @@ def cmd_sweep(args):
         specs += [x for x in (grid_sc, samp_sc) if x]
     if args.csv:
         specs.append(S.from_csv(args.csv, fixed))
-    new = [s for spec in specs for s in spec]
+    items = enumeration_items(var)  # rheology=elastic_plastic: the item's value
+    new = [item_values(s, items) for spec in specs for s in spec]
     if not new and args.set and not os.path.isfile(os.path.join(args.out, "scenarios.csv")):
         new = [dict(fixed)]                          # a single scenario
     if "dx" in var and var["dx"].causality == "parameter":

@@ -36,6 +36,14 @@ struct case_choice {
     int value;
 };
 
+/* How a number selects a choice of a CASE_CHOICE key (its numeric_choice). */
+enum case_numeric_choice {
+    CASE_CHOICE_NAME_ONLY = 0, /* a string only */
+    CASE_CHOICE_BY_VALUE = 1,  /* a number equal to the choice's value */
+    CASE_CHOICE_BY_POSITION = 2 /* a number equal to the choice's place in the list, from 0: for choices whose
+                                   values are internal ids (a granular medium's law) */
+};
+
 struct case_key {
     const char *key;
     enum case_type type;
@@ -52,8 +60,8 @@ struct case_key {
     size_t field;             /* CASE_FIELD(struct, member) of the field it fills, 0: none */
     const struct case_choice *choices; /* CASE_CHOICE: NULL-terminated */
     unsigned only;            /* sections with variants: the variants (bits) it belongs to, 0 = all */
-    int numeric_choice;       /* CASE_CHOICE: a number equal to a choice's value selects it too (so that a
-                                 numeric override such as --set numerics.viscosity=1 can) */
+    int numeric_choice;       /* CASE_CHOICE: a number selects a choice too (enum case_numeric_choice), so that
+                                 a numeric override (--set numerics.viscosity=1) or parameter can */
 };
 
 /* A key a case file may no longer use, and why. */

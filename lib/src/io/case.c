@@ -252,9 +252,41 @@ static double entry_number(const void *entry, const char *key)
     return cJSON_IsNumber(v) ? v->valuedouble : NAN;
 }
 
+/* A medium whose law is chosen by a number (a case parameter, "law": "$rheology": the FMU's
+ * rheology) may also hold the keys of its type's other laws, so that one case file runs with
+ * either law (docs/cases.md): each such key is checked by its own law's row (type, range) and not
+ * used. A medium that names its law gets them refused by its law's table, as any unknown key.
+ * *own: a copy of the entry without them, which the chosen law's table reads (a key that no law
+ * of the type has stays, and that table refuses it). */
+static mixsph_status drop_other_laws_keys(const struct case_reader *r, const cJSON *it, const char *path, int law,
+                                          cJSON **own)
+{
+    *own = cJSON_Duplicate(it, 1);
+    if (!*own) return status_set(r->err, r->err_len, MIXSPH_ERR_NOMEM, "out of memory");
+    for (cJSON *k = (*own)->child, *next; k; k = next) {
+        next = k->next;
+        if (case_schema_key(law_get(law)->keys, k->string)) continue;
+        const struct case_key *row = NULL;
+        for (int id = 0; id < LAW_COUNT && !row; id++)
+            if (id != law && strcmp(law_get(id)->type, law_get(law)->type) == 0)
+                row = case_schema_key(law_get(id)->keys, k->string);
+        if (!row) continue;
+        struct medium unused;
+        memset(&unused, 0, sizeof unused);
+        const mixsph_status st = case_schema_read_key(r, *own, path, row, &unused);
+        if (st != MIXSPH_OK) {
+            cJSON_Delete(*own);
+            *own = NULL;
+            return st;
+        }
+        cJSON_Delete(cJSON_DetachItemViaPointer(*own, k));
+    }
+    return MIXSPH_OK;
+}
+
 /* A medium: its type selects its material law (laws/law_registry.h), whose key table it is read
  * by; a law with both K and c takes exactly one of them; then the law's own rules (finish). */
-static mixsph_status read_medium(const struct case_reader *r, const cJSON *it, const char *path, struct case_def *c,
+static mixsph_status read_medium(const struct case_reader *r, const cJSON *entry, const char *path, struct case_def *c,
                                  struct medium *md)
 {
     struct case_choice types[LAW_COUNT + 1]; /* each type once, with its first law */
@@ -267,19 +299,25 @@ static mixsph_status read_medium(const struct case_reader *r, const cJSON *it, c
     types[n_types] = (struct case_choice){NULL, 0};
     const struct case_key type_key = {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = types,
                                       .field = CASE_FIELD(medium, law)};
-    TRY(case_schema_read_key(r, it, path, &type_key, md));
+    TRY(case_schema_read_key(r, entry, path, &type_key, md));
     /* a type with several laws: its key `law` (a row of each of their tables) chooses one */
     const struct case_key *law_key = case_schema_key(law_get(md->law)->keys, "law");
-    if (law_key) TRY(case_schema_read_key(r, it, path, law_key, md));
+    if (law_key) TRY(case_schema_read_key(r, entry, path, law_key, md));
     const struct material_law *law = law_get(md->law);
-    TRY(case_schema_read(r, it, path, law->keys, 0, md));
-    if (case_schema_key(law->keys, "K") && case_schema_key(law->keys, "c") && !item(it, "K") == !item(it, "c"))
-        return FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
+    cJSON *own = NULL; /* the entry without the other laws' keys, when a number chose the law */
+    if (cJSON_IsNumber(item(entry, "law"))) TRY(drop_other_laws_keys(r, entry, path, md->law, &own));
+    const cJSON *it = own ? own : entry;
+    mixsph_status st = case_schema_read(r, it, path, law->keys, 0, md);
+    if (st == MIXSPH_OK && case_schema_key(law->keys, "K") && case_schema_key(law->keys, "c") &&
+        !item(it, "K") == !item(it, "c"))
+        st = FAIL(r, "%s: %s: expected exactly one of K (bulk modulus, Pa) or c (sound speed, m/s)", r->origin, path);
     md->features = law->features;
     const struct law_finish_ctx ctx = {.media = c->media, .n_media = c->n_media + 1, .given = entry_given,
                                        .text = entry_text, .number = entry_number, .entry = it, .origin = r->origin,
                                        .path = path, .err = r->err, .err_len = r->err_len};
-    return law->finish ? law->finish(md, &ctx) : MIXSPH_OK;
+    if (st == MIXSPH_OK && law->finish) st = law->finish(md, &ctx);
+    cJSON_Delete(own);
+    return st;
 }
 
 static mixsph_status read_media(const struct case_reader *r, const cJSON *root, struct case_def *c)

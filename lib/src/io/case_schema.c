@@ -359,7 +359,8 @@ void case_schema_range_text(const struct case_key *k, int unicode, char *buf, si
                                    c == k->choices ? "" : c[1].name ? ", " : " or ", c->name);
         if (k->numeric_choice)
             for (const struct case_choice *c = k->choices; c->name && at < len; c++)
-                at += (size_t)snprintf(buf + at, len - at, "%s%d%s", c == k->choices ? " (or " : ", ", c->value,
+                at += (size_t)snprintf(buf + at, len - at, "%s%d%s", c == k->choices ? " (or " : ", ",
+                                       k->numeric_choice == CASE_CHOICE_BY_POSITION ? (int)(c - k->choices) : c->value,
                                        c[1].name ? "" : ")");
         break;
     }
@@ -541,7 +542,8 @@ mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj
     case CASE_NAME:
         if (k->type == CASE_CHOICE && k->numeric_choice && cJSON_IsNumber(it)) {
             for (const struct case_choice *c = k->choices; c->name; c++)
-                if (it->valuedouble == (double)c->value) {
+                if (it->valuedouble == (double)(k->numeric_choice == CASE_CHOICE_BY_POSITION ? (int)(c - k->choices)
+                                                                                             : c->value)) {
                     if (f) *(int *)f = c->value;
                     return MIXSPH_OK;
                 }

@@ -59,7 +59,8 @@ struct law_step {
 };
 
 /* The laws of type "granular": the choices of media.<name>.law, a row of each of their key tables
- * (the first, the paper's, is the default). */
+ * (the first, the paper's, is the default). A number chooses by place in this list (0 paper, 1
+ * elastic_plastic), so that a case parameter can choose the law (the FMU's `rheology`). */
 static const struct case_choice law_granular_choices[] = {
     {"paper", LAW_MIXTURE_PAPER}, {"elastic_plastic", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
 

@@ -55,9 +55,10 @@ static const struct case_choice granular_type[] = {{"granular", LAW_MIXTURE_PAPE
 static const struct case_key granular_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_type,
      .field = CASE_FIELD(medium, law), .meaning = "\"granular\": a mixture at the packing limit"},
-    {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices,
+    {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices, .numeric_choice = CASE_CHOICE_BY_POSITION,
      SCHEMA_DEF(LAW_MIXTURE_PAPER), .field = CASE_FIELD(medium, law),
-     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next)"},
+     .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next); chosen by its number "
+                "(a case parameter), the medium may hold the other law's keys too (below)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
      .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
