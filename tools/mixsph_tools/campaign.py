@@ -93,8 +93,8 @@ def add_options(ap, o):
                     help="mixsph executable (default build/mixsph)")
     ap.add_argument("--case", default=os.path.join(ROOT, "cases", o.case), help=f"case file (default cases/{o.case})")
     ap.add_argument("--law", choices=GRANULAR_LAWS, help="the material law of the case's granular media (default: "
-                    "the case's); the run's case is then OUT/case_LAW.json, the case with that law and without the "
-                    "keys of the other (the new law's own keys at their defaults)")
+                    "the case's); the run's case is then OUT/case_LAW.json, the case with that law (the other law's "
+                    "keys kept, unused; the law's own keys not in the case at their defaults)")
     ap.add_argument("--t-end", type=float, help=f"end time [s] of every run (default: the case's, {o.t_end}); "
                     "for short tests")
     ap.add_argument("--progress", type=float, default=o.progress, help="print the simulated time of the running "

@@ -30,29 +30,24 @@ def parse_sets(texts, example):
     return out
 
 
-# The keys of a granular medium that only one of its material laws takes (docs/cases.md, the
-# tables media.granular and media.granular.elastic_plastic); the others they share.
+# The material laws of a granular medium, in the order whose place a case's "law" may give instead
+# of the name (docs/cases.md): so chosen, the medium may keep the other law's keys, unused.
 GRANULAR_LAWS = ("paper", "elastic_plastic")
-LAW_ONLY_KEYS = {"paper": ("mu_thr", "mu0", "mu1", "tension_cutoff", "hold_fixed", "alpha_m"),
-                 "elastic_plastic": ("cohesion", "dilatancy", "nu")}
 
 
 def with_law(case_json, law, case_name):
     """A copy of a case whose granular media all use the material law ``law`` ("paper" or
-    "elastic_plastic"): their "law" set and the keys only another law takes removed (the law's
-    own keys then take their defaults). Raises ToolError for another law or a case without a
-    granular medium."""
+    "elastic_plastic"), given by its number so that the keys of the other law stay (unused; the
+    law's own keys not in the case take their defaults). Raises ToolError for another law or a
+    case without a granular medium."""
     if law not in GRANULAR_LAWS:
         raise ToolError(f"--law {law}: expected one of {', '.join(GRANULAR_LAWS)}")
     out = json.loads(json.dumps(case_json))
     granular = [m for m in out.get("media", {}).values() if isinstance(m, dict) and m.get("type") == "granular"]
     if not granular:
         raise ToolError(f"{case_name}: --law {law}: the case has no granular medium")
-    others = {k for other, keys in LAW_ONLY_KEYS.items() if other != law for k in keys}
     for m in granular:
-        for k in others:
-            m.pop(k, None)
-        m["law"] = law
+        m["law"] = GRANULAR_LAWS.index(law)
     return out
 
 
