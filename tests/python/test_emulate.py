@@ -639,3 +639,14 @@ def test_design_on_the_fmu_end_to_end_and_a_foreign_guid_is_refused(tmp_path):
         E.load(str(out / "emulator.json"), str(other))
     # the same emulator loads against its own FMU
     assert E.load(str(out / "emulator.json"), fmu).inputs == ["reservoir_level", "phi"]
+
+
+def test_jitter_takes_item_names_at_its_point(tmp_path):
+    # emulate jitter --at rheology=NAME: an Enumeration's item by its name, as sweep and predict
+    # take it; a name that is no item is a usage error (exit 2) naming the items, before any run.
+    fmu = fmu_path()
+    p = emulate("jitter", tmp_path / "j", "--fmu", fmu, "--at", "reservoir_level=0.46", "--at", "rheology=granite",
+                check=False)
+    assert p.returncode == 2, p.stderr
+    assert "rheology = 'granite' is not one of its items: paper (0), elastic_plastic (1)" in p.stderr
+    assert not (tmp_path / "j").exists()

@@ -643,9 +643,10 @@ def cmd_jitter(args):
     fmu, fixed, opts, md, var, dx = resolve_run(args, {})
     dx = float(fixed.get("dx", dx))
     axes = {}
+    items = enumeration_items(var)  # rheology=elastic_plastic: its value
     for it in args.at:
         k, v = split_assignment(it)
-        axes[k] = [parse_value(x) for x in v.split(",")]
+        axes[k] = [item_value(k, parse_value(x), items) for x in v.split(",")]
     points = [dict(zip(axes, c)) for c in itertools.product(*axes.values())]
     perturb = {}
     for it in args.perturb or [f"reservoir_level={dx / 2!r}"]:
