@@ -73,9 +73,8 @@ def model_params(fmu_path: str):
 def enumeration_items(var) -> dict:
     """The FMU's Enumeration parameters: name -> {item name: value} (LandslideWave's rheology:
     paper 0, elastic_plastic 1)."""
-    return {n: {it.name: int(it.value) for it in v.declaredType.items}
-            for n, v in var.items() if v.type == "Enumeration" and v.causality == "parameter"
-            and v.declaredType is not None}
+    from .fmu_run import enumeration_items_of
+    return {n: items for n, v in var.items() if v.causality == "parameter" and (items := enumeration_items_of(v))}
 
 
 def item_value(name: str, value, items: dict):

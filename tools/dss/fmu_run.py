@@ -83,6 +83,13 @@ def unzipped(fmu: dict) -> FmuFiles:
     return entry
 
 
+def enumeration_items_of(v) -> dict:
+    """An Enumeration variable's items, name -> value ({} for another type)."""
+    if v.type != "Enumeration" or v.declaredType is None:
+        return {}
+    return {it.name: int(it.value) for it in v.declaredType.items}
+
+
 def _check_value(v, value):
     """The value converted for the variable's type; ValueError if it cannot be."""
     t = v.type
@@ -94,8 +101,7 @@ def _check_value(v, value):
             raise ValueError(f"{v.name} = {value!r} outside [{v.min}, {v.max}] of the model description")
         return x
     if t in ("Integer", "Enumeration"):
-        items = {it.name: int(it.value) for it in v.declaredType.items} \
-            if t == "Enumeration" and v.declaredType is not None else {}
+        items = enumeration_items_of(v)
         if isinstance(value, str) and value.strip() in items:  # an item by name: its value
             return items[value.strip()]
         x = float(value)
