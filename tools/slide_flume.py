@@ -17,8 +17,9 @@ density over the snapshots, relative to its rho0; the mechanical energy of water
 initial value; the grains' deposit at the last snapshot: median height above the flume floor and
 the 50 / 95 / 99 % quantiles of x, and how many grains are higher than 0.05 m above the floor
 (still suspended) beyond the ramp's toe; the largest water elevation at x >= 1 m (monitor
-run_up). The work of the pushing plate is not an output of the library, so the energy budget
-is E(t) - E(0) against nothing but its sign after the push.
+run_up). The energy budget: E(t) - E(0) against the work W(t) the plate has done on the water and
+the grains (monitor plate_work, interpolated to the snapshot's time): E(t) - E(0) - W(t) is what
+the run has dissipated, never above 0 in a sound run.
 
 Exit status: 0 the run finished; 1 it did not (its numbers up to the failure are still printed);
 2 bad usage.
@@ -98,11 +99,15 @@ def report(out, case_path):
         if math.isfinite(lo[k]):
             print(f"  {name:8s} density {lo[k]:8.1f} .. {hi[k]:8.1f} kg/m3 = rho0 x ({lo[k] / rho0:.3f} .. "
                   f"{hi[k] / rho0:.3f}) over {len(snaps)} snapshots")
+    mon = os.path.join(out, "monitors.csv")
+    cols = read_monitors(mon) if os.path.isfile(mon) else {}
     if energy:
         e0 = energy[0][1] + energy[0][2]
-        print("  t [s]   kinetic [J/m]  potential [J/m]  E - E(0) [J/m]")
+        work = (lambda t: float(np.interp(t, cols["t"], cols["plate_work"]))) if "plate_work" in cols else None
+        print("  t [s]   kinetic [J/m]  potential [J/m]  E - E(0) [J/m]  plate work W [J/m]  E - E(0) - W [J/m]")
         for t, ke, pe in energy:
-            print(f"  {t:5.2f}  {ke:13.2f}  {pe:15.2f}  {ke + pe - e0:+14.2f}")
+            w = work(t) if work else math.nan
+            print(f"  {t:5.2f}  {ke:13.2f}  {pe:15.2f}  {ke + pe - e0:+14.2f}  {w:18.2f}  {ke + pe - e0 - w:+18.2f}")
     if last is not None:
         live = last["state"] < 2
         g = live & (last["medium"].astype(int) == 1)
@@ -112,9 +117,7 @@ def report(out, case_path):
               f"x quantiles 50 % {np.quantile(x, 0.5):.3f}, 95 % {np.quantile(x, 0.95):.3f}, "
               f"99 % {np.quantile(x, 0.99):.3f} m; {int(np.sum(beyond & (z > 0.05)))} of {int(np.sum(beyond))} "
               f"beyond the toe higher than 0.05 m")
-    mon = os.path.join(out, "monitors.csv")
-    if os.path.isfile(mon):
-        cols = read_monitors(mon)
+    if cols:
         if "run_up" in cols and len(cols["run_up"]):
             w = np.asarray(cols["run_up"], dtype=float)
             t = np.asarray(cols["t"], dtype=float)

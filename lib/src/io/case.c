@@ -431,13 +431,15 @@ static mixsph_status read_monitors(const struct case_reader *r, const cJSON *roo
         c->n_monitors++;
         md->medium = md->wall = -1;
         md->at_max_of = -1;
+        md->x_min = md->z_min = -INFINITY; /* everywhere: the region of a monitor that takes none (wall_work) */
+        md->x_max = md->z_max = INFINITY;
         /* the type first: it says which keys the monitor takes */
         TRY(case_schema_read_key(r, it, path, case_schema_key(sec, "type"), md));
         if (md->kind == MONITOR_PROFILE) md->bin = c->dx;
         TRY(case_schema_read(r, it, path, sec, 1u << md->kind, md));
         if (!(md->x_max > md->x_min) || !(md->z_max > md->z_min))
             return FAIL(r, "%s: %s: expected x_min < x_max and z_min < z_max", r->origin, path);
-        if (md->kind == MONITOR_WALL_PRESSURE) {
+        if (md->kind == MONITOR_WALL_PRESSURE || md->kind == MONITOR_WALL_WORK) {
             const char *wall = item(it, "wall")->valuestring;
             md->wall = find_wall(c, wall);
             if (md->wall < 0) return FAIL(r, "%s: %s.wall: '%s' is not one of the walls", r->origin, path, wall);

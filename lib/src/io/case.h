@@ -30,14 +30,15 @@ enum monitor_kind {
     MONITOR_MAX_ELEVATION = 1,
     MONITOR_PROFILE = 2,
     MONITOR_WALL_PRESSURE = 3,
-    MONITOR_KINETIC_ENERGY = 4
+    MONITOR_KINETIC_ENERGY = 4,
+    MONITOR_WALL_WORK = 5
 };
 
 struct monitor_def {
     char name[CASE_NAME_LEN];
     int kind;                 /* enum monitor_kind */
-    int medium;               /* index into media (-1 for wall_pressure) */
-    int wall;                 /* wall_pressure: index into walls */
+    int medium;               /* index into media (-1 for wall_pressure and wall_work) */
+    int wall;                 /* wall_pressure, wall_work: index into walls */
     int direction;            /* front: +1 largest x, -1 smallest x */
     double x_min, x_max;      /* region [m] (infinite when not given) */
     double z_min, z_max;

@@ -46,6 +46,7 @@ static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
                                                    {"kinetic_energy", MONITOR_KINETIC_ENERGY},
                                                    {"profile", MONITOR_PROFILE},
                                                    {"wall_pressure", MONITOR_WALL_PRESSURE},
+                                                   {"wall_work", MONITOR_WALL_WORK},
                                                    {NULL, 0}};
 
 /* ---- the tables ------------------------------------------------------------------------------ */
@@ -211,25 +212,27 @@ static const struct case_key motion_keys[] = {
 
 #define PARTICLE_MONITORS (V(MONITOR_FRONT) | V(MONITOR_MAX_ELEVATION) | V(MONITOR_PROFILE))
 #define MEDIUM_MONITORS (PARTICLE_MONITORS | V(MONITOR_KINETIC_ENERGY))
+#define WALL_MONITORS (V(MONITOR_WALL_PRESSURE) | V(MONITOR_WALL_WORK))
+#define REGION_MONITORS (MEDIUM_MONITORS | V(MONITOR_WALL_PRESSURE)) /* (a wall's work is the whole wall's) */
 static const struct case_key monitor_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = monitor_types,
      .field = CASE_FIELD(monitor_def, kind), .meaning = "what the monitor measures (below)"},
     {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .only = MEDIUM_MONITORS,
      .meaning = "name of one of the media"},
-    {.key = "wall", .type = CASE_NAME, .need = CASE_REQUIRED, .only = V(MONITOR_WALL_PRESSURE),
+    {.key = "wall", .type = CASE_NAME, .need = CASE_REQUIRED, .only = WALL_MONITORS,
      .meaning = "name of one of the walls"},
     {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions, .only = V(MONITOR_FRONT),
      .field = CASE_FIELD(monitor_def, direction), .meaning = "\"+x\": the largest x of the medium, \"-x\": the smallest"},
     {.key = "min_neighbours", .type = CASE_INTEGER, RANGE(0, 0, 100, 0), DEF(3), .unit = "-", .only = PARTICLE_MONITORS,
      .field = CASE_FIELD(monitor_def, min_neighbours),
      .meaning = "a particle counts only with at least this many neighbours of its own medium within 2h (not spray)"},
-    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, DEF(-INFINITY),
+    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY),
      .unit = "m", .field = CASE_FIELD(monitor_def, x_min), .meaning = "region the monitor looks at: left end"},
-    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, DEF(INFINITY),
+    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY),
      .unit = "m", .field = CASE_FIELD(monitor_def, x_max), .meaning = "right end, > x_min"},
-    {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_min),
+    {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_min),
      .meaning = "bottom"},
-    {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_max),
+    {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_max),
      .meaning = "top, > z_min"},
     {.key = "bin", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .def_text = "dx", .unit = "m", .only = V(MONITOR_PROFILE),
      .field = CASE_FIELD(monitor_def, bin), .meaning = "width of the x bins"},

@@ -4,6 +4,7 @@
  *   max_elevation  - the highest z of a medium's particles in the region (the run-up when the
  *                    region covers the opposite slope);
  *   wall_pressure  - the highest pressure of the first layer of a wall's particles in the region;
+ *   wall_work      - the work a wall has done on the particles since t = 0 (walls.h, walls_move);
  *   profile        - at given times, the top of a medium (highest particle centre + dx/2) in bins
  *                    of x, written to profile_<name>_<k>.csv (free surface, landslide surface,
  *                    mixture-water interface).
@@ -103,6 +104,7 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
         }
         return best;
     }
+    if (md->kind == MONITOR_WALL_WORK) return s->phys.walls.state[md->wall].work;
     if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
         double e = 0.0;
         for (size_t i = 0; i < P->n; i++)

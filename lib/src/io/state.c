@@ -4,7 +4,7 @@
  * Layout (native byte order, checked by a marker): a header "MIXSPHST", format version, byte
  * order marker; the case text, origin and overrides the simulation was created from; the
  * scalar state (time, step, time step, counters, output extremes and schedule); the walls'
- * displacement, velocity and external drive; the particle fields the particle-field table marks
+ * displacement, velocity, external drive and work; the particle fields the particle-field table marks
  * PF_STATE and the simulation has, in table order, each as its name, component count, element
  * size and component arrays (a state of a build with other fields is refused naming the first
  * that differs); the neighbour lists' build positions; a 64-bit FNV-1a checksum of
@@ -21,10 +21,10 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 6u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
+#define STATE_VERSION 7u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
                             4: the increments of the implicit step's first stage; 5: those of the
                             step before (the warm starts' extrapolation); 6: the particle fields of
-                            the particle-field table, each named */
+                            the particle-field table, each named; 7: the walls' work */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
@@ -164,7 +164,7 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
     put_u64(w, s->cfg.n_walls);
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
         const struct wall_state *ws = &s->phys.walls.state[k];
-        const double v[8] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz};
+        const double v[9] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz, ws->work};
         put(w, v, sizeof v);
         put_u64(w, (uint64_t)ws->ext);
     }
@@ -307,7 +307,7 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
     if (get_u64(r) != s->cfg.n_walls) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: wall count differs from the case's");
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
         struct wall_state *ws = &s->phys.walls.state[k];
-        double v[8];
+        double v[9];
         get(r, v, sizeof v);
         ws->ox = v[0];
         ws->oz = v[1];
@@ -317,6 +317,7 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
         ws->az = v[5];
         ws->ext_vx = v[6];
         ws->ext_vz = v[7];
+        ws->work = v[8];
         ws->ext = get_u64(r) != 0;
     }
     struct particles *P = &s->phys.P;

@@ -940,7 +940,8 @@ static void momentum_region(void *arg, int tid, int nth)
     team_share(R->n, tid, nth, &b, &e);
     int bad = 0;
     for (size_t i = b; i < e; i++) {
-        if (R->wall_sums && P->state[i] != MIXSPH_STATE_WALL && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
+        if (P->state[i] == MIXSPH_STATE_WALL) continue; /* keeps the force on it: its wall's work (walls_move) */
+        if (R->wall_sums && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
             const double s = M[P->medium[i]].sin_phi;
             wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, &P->ax[i], &P->az[i]);
         }

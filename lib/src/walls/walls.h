@@ -19,6 +19,7 @@ struct wall_state {
     double ax, az;   /* current acceleration [m/s2] */
     int ext;         /* driven by an external velocity (ext_vx, ext_vz) instead of its motion law */
     double ext_vx, ext_vz; /* [m/s] */
+    double work;     /* the work it has done on the particles since t = 0 [J/m] (walls_move) */
 };
 
 /* numerics.wall_placement: where the wall particles sit (docs/model.md section 8). */
