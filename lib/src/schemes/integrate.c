@@ -335,6 +335,27 @@ static void unknowns_range(void *arg, size_t b, size_t e)
                                  mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
 }
 
+/* The viscous force of the solved velocities on the wall particles of moving walls, -(L u)_j,
+ * added to the force the momentum pass left in their accelerations (which leaves out the viscous
+ * force in this scheme), so that a wall's work (walls_move) counts it. One operator pass, only
+ * with a moving wall. Returns -1 when out of memory. */
+static int viscous_wall_forces(mixsph_sim *s, const struct pair_system *S)
+{
+    const struct walls *W = &s->phys.walls;
+    int moving = 0;
+    for (size_t w = 0; w < W->n; w++) moving |= W->def[w].motion >= 0;
+    if (!moving) return 0;
+    const double *lx, *lz;
+    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
+    struct particles *P = &s->phys.P;
+    for (size_t i = 0; i < active_particles(s); i++) {
+        if (P->state[i] != MIXSPH_STATE_WALL || W->def[particles_wall_index(P, i)].motion < 0) continue;
+        P->ax[i] -= lx[i];
+        P->az[i] -= lz[i];
+    }
+    return 0;
+}
+
 static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judge_dt)
 {
     if (!s->work.viscous && !(s->work.viscous = viscous_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -370,6 +391,7 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     int failed = viscous_step(s->work.viscous, s->work.forces, &S, s->work.wall_mirror, &s->phys.walls, s->phys.t, dt,
                               s->work.viscous_unknown, vp, rep);
     if (!failed && rigid && judge_dt > 0.0) failed = held_grain_kicks(s, &S, judge_dt);
+    if (!failed) failed = viscous_wall_forces(s, &S);
     s->work.viscous_wall_s += clock_monotonic_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
     s->work.viscous_iterations += (uint64_t)rep->iterations;
