@@ -47,11 +47,11 @@ def load(folder):
 
 # ---- variants: fit(U_levels, y_levels) -> predict(U) -> (mean, sd) at the finest level -----------
 
-def ar1(levels=(0, 1, 2), jitter_floor=True, restarts=1, kernel=None):
+def ar1(levels=(0, 1, 2), jitter_floor=True, restarts=1, kernel=None, family="ard"):
     def fit(U, y):
         Ul = [U[i] for i in levels]
         yl = [y[i] for i in levels]
-        m = M.OutputMF(OUT, [DXS[i] for i in levels], 3, None, jitter_floor)
+        m = M.OutputMF(OUT, [DXS[i] for i in levels], 3, None, jitter_floor, family)
         if kernel is not None:
             old = M.DeltaGP.kernel
             M.DeltaGP.kernel = kernel
@@ -93,7 +93,7 @@ def iso_kernel(self):
 
 
 def coarse_gp(U, y, restarts=1):
-    g = M.DeltaGP(3).fit(U, y, restarts, 0)
+    g = M.DeltaGP(3, kernel_family="ard").fit(U, y, restarts, 0)
     return g
 
 
@@ -149,7 +149,7 @@ def nargp(levels=(0, 1, 2), restarts=1, n_mc=0, floor=True):
 
     def fit(U, y):
         gs = []
-        g0 = M.DeltaGP(3).fit(U[levels[0]], y[levels[0]], restarts, 0)
+        g0 = M.DeltaGP(3, kernel_family="ard").fit(U[levels[0]], y[levels[0]], restarts, 0)
         nv0 = g0.noise_var()
 
         def pred_chain(Ut, upto):
@@ -268,7 +268,7 @@ class _Proj(Kernel):
 
 def sf(level=2):
     def fit(U, y):
-        g = M.DeltaGP(3).fit(U[level], y[level], 1, 0)
+        g = M.DeltaGP(3, kernel_family="ard").fit(U[level], y[level], 1, 0)
         return lambda Ut: (g.predict(Ut)[0], np.sqrt(g.predict(Ut)[1] + g.noise_var()))
     return fit
 
@@ -423,6 +423,8 @@ VARIANTS["shared_kappa_only"] = shared(intercept=False)
 VARIANTS["regress_on_m04_m03"] = shared(free=True)
 VARIANTS["shared_kappa_intercept_iso"] = shared(kind="iso52")
 
+VARIANTS["ar1_3lev_iso (the code's kernel_family='iso')"] = ar1(family="iso")
+VARIANTS["T1_ar1_iso (the code's kernel_family='iso')"] = ar1(levels=(0, 1), family="iso")
 VARIANTS["T1_ar1_ard52 (current)"] = ar1(levels=(0, 1))
 VARIANTS["T1_ar1_all_iso52"] = ar1k("iso52", levels=(0, 1), coarse_kind="iso52")
 VARIANTS["T1_ar1_fine_iso52"] = ar1k("iso52", levels=(0, 1))
