@@ -95,9 +95,9 @@ def add_parsers(sub):
                    help="no lower bound on the finer levels' noise (default: the coarsest "
                         "level's fitted noise variance times (dx / dx_coarsest)^2)")
     f.add_argument("--kernel", choices=M.KERNELS, default=M.DEFAULT_KERNEL,
-                   help=f"the discrepancy GPs' kernel: Matern 5/2 with one length scale (iso) or "
-                        f"one per input (ard) (default {M.DEFAULT_KERNEL}, chosen by "
-                        f"cross-validation: docs/dss.md)")
+                   help=f"the GPs' kernel: Matern 5/2 with a length scale per input (ard) or "
+                        f"one for all (iso) (default {M.DEFAULT_KERNEL}; docs/dss.md, 'Choosing "
+                        f"the model by cross-validation')")
     f.add_argument("-o", "--out", required=True, help="the emulator file")
     f.add_argument("--fmu", help="the FMU of the runs (default: the first folder's sweep.json)")
 
