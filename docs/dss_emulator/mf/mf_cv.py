@@ -318,7 +318,9 @@ VARIANTS = {
 
 def main():
     target = int(sys.argv[1]) if len(sys.argv) > 1 else 2
-    sel = sys.argv[2:] if len(sys.argv) > 2 else list(VARIANTS)
+    # the variants named T1_ are of the two coarser levels (target 1), the others of all three
+    sel = sys.argv[2:] if len(sys.argv) > 2 else [
+        k for k in VARIANTS if k.startswith("T1_") == (target == 1)]
     out = {}
     for name in sel:
         v = VARIANTS[name]
@@ -433,6 +435,34 @@ VARIANTS["T1_offset+trend"] = linear_link((0, 1), rho_fixed=1.0, trend=True)
 VARIANTS["T1_offset"] = linear_link((0, 1), rho_fixed=1.0)
 VARIANTS["T1_nofloor"] = ar1(levels=(0, 1), jitter_floor=False)
 VARIANTS["T1_nargp"] = nargp(levels=(0, 1))
+
+
+def rho1(levels=(0, 2), family="ard"):
+    """rho = 1 fixed: the finest level is the coarsest's mean plus a discrepancy GP of the
+    differences (noise floored by the coarsest level's noise x (dx ratio)^2)."""
+    def fit(U, y):
+        g0 = M.DeltaGP(3, kernel_family=family).fit(U[levels[0]], y[levels[0]], 1, 0)
+        chain = [(g0, 0)]
+        for li in levels[1:]:
+            m_prev = _chain_mean(chain, U[li])
+            floor = g0.noise_var() * (DXS[li] / DXS[levels[0]]) ** 2
+            chain.append((M.DeltaGP(3, floor, family).fit(U[li], y[li] - m_prev, 1, 0), li))
+
+        def pred(Ut):
+            m = _chain_mean(chain, Ut)
+            v = sum(g.predict(Ut)[1] for g, _ in chain) + chain[-1][0].noise_var()
+            return m, np.sqrt(v)
+        return pred
+    return fit
+
+
+def _chain_mean(chain, Ut):
+    return sum(g.predict(Ut)[0] for g, _ in chain)
+
+
+VARIANTS["rho1_gp_2lev_04_02"] = rho1()
+VARIANTS["rho1_gp_3lev"] = rho1(levels=(0, 1, 2))
+VARIANTS["T1_rho1_gp"] = rho1(levels=(0, 1))
 
 
 main()
