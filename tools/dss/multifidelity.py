@@ -8,12 +8,13 @@ the levels ordered from the coarsest (largest dx) to the finest,
 
 where delta_l are independent Gaussian processes and rho_l a constant. Each delta_l is a
 scikit-learn GaussianProcessRegressor (kernel ConstantKernel * Matern(nu = 2.5) + WhiteKernel,
-the noise term absorbing the FMU's lattice jitter) fitted on the level-l runs with f_{l-1} replaced by the level-(l-1)
-posterior mean at those runs; rho_l maximises the profile likelihood (delta_l's hyperparameters
-fitted by maximum marginal likelihood at each rho; delta_l's constant mean the residuals'
-mean). The recursion is exact for nested designs (the runs of a level a subset of those of the
-level below, which the design makes; Le Gratiet 2013, Stat. Comput.). Prediction at level l: mean rho_l m_{l-1} + m_delta_l, latent variance
-rho_l^2 v_{l-1} + v_delta_l, plus the level's fitted noise for the interval of a new run.
+the noise term absorbing the FMU's lattice jitter) fitted on the level-l runs with f_{l-1}
+replaced by the level-(l-1) posterior mean at those runs; rho_l maximises the profile likelihood
+(delta_l's hyperparameters fitted by maximum marginal likelihood at each rho; delta_l's constant
+mean the residuals' mean). The recursion is exact for nested designs (the runs of a level a
+subset of those of the level below, which the design makes; Le Gratiet 2013, Stat. Comput.).
+Prediction at level l: mean rho_l m_{l-1} + m_delta_l, latent variance rho_l^2 v_{l-1} +
+v_delta_l, plus the level's fitted noise for the interval of a new run.
 
 The kernel family (KERNELS): 'ard' (the default), a length scale per input of the unit box (the
 single-fidelity emulator's), or 'iso', one for all inputs: fewer hyperparameters for a level of
@@ -55,9 +56,10 @@ to narrow intervals on. The hold-out runs never enter it.
 
 Saved as JSON (schema mixsph-mf-emulator, version 2; version 1, before the kernel family was
 saved, is read as 'ard'): the levels' dx, the inputs and their box, per output the kernel
-family, per output and level the training runs, rho, the delta GP's standardisation and hyperparameters
-(theta), the calibration and the order of convergence; the FMU's GUID and SHA-256. Loading
-rebuilds every GP with optimizer=None (the same predictions) and refuses an FMU of another GUID.
+family, per output and level the training runs, rho, the delta GP's standardisation and
+hyperparameters (theta), the calibration and the order of convergence; the FMU's GUID and
+SHA-256. Loading rebuilds every GP with optimizer=None (the same predictions) and refuses an FMU
+of another GUID.
 """
 
 from __future__ import annotations
@@ -74,7 +76,7 @@ from . import emulator as E
 SCHEMA = "mixsph-mf-emulator"
 SCHEMA_VERSION = 2
 READABLE_VERSIONS = (1, 2)           # version 1 files have the ARD kernel
-KERNELS = ("iso", "ard")             # the delta GPs' kernel family (module doc)
+KERNELS = ("ard", "iso")             # the delta GPs' kernel family (module doc)
 DEFAULT_KERNEL = "ard"
 Z95 = E.Z95
 EXTRAPOLATED = "extrapolated"       # the name of the dx -> 0 level
@@ -91,6 +93,11 @@ class MFError(E.EmulatorError):
     pass
 
 
+def _check_kernel_family(family):
+    if family not in KERNELS:
+        raise MFError(f"unknown kernel family {family!r} ({', '.join(KERNELS)})")
+
+
 # ---- one level's discrepancy GP ---------------------------------------------------------------------
 
 class DeltaGP:
@@ -98,8 +105,7 @@ class DeltaGP:
     the level itself), standardised by its own mean and sd."""
 
     def __init__(self, d, noise=None, kernel_family=DEFAULT_KERNEL):
-        if kernel_family not in KERNELS:
-            raise MFError(f"unknown kernel family {kernel_family!r} ({', '.join(KERNELS)})")
+        _check_kernel_family(kernel_family)
         self.d = d
         self.noise = noise          # a measured noise variance (output units^2) as the floor
         self.kernel_family = kernel_family
@@ -217,8 +223,7 @@ class OutputMF:
     """The recursive model of one output over the levels (coarse to fine)."""
 
     def __init__(self, name, dxs, d, noise=None, jitter_floor=True, kernel_family=DEFAULT_KERNEL):
-        if kernel_family not in KERNELS:
-            raise MFError(f"unknown kernel family {kernel_family!r} ({', '.join(KERNELS)})")
+        _check_kernel_family(kernel_family)
         self.kernel_family = kernel_family
         self.name = name
         self.dxs = list(dxs)
@@ -562,8 +567,9 @@ class MFEmulator:
         if doc.get("schema") != SCHEMA:
             raise MFError(f"not a {SCHEMA} file (schema {doc.get('schema')!r})")
         if doc.get("schema_version") not in READABLE_VERSIONS:
+            readable = ", ".join(map(str, READABLE_VERSIONS))
             raise MFError(f"multi-fidelity emulator schema version {doc.get('schema_version')} is "
-                          f"not one this code reads ({', '.join(map(str, READABLE_VERSIONS))}): refit it")
+                          f"not one this code reads ({readable}): refit it")
         inp = doc["inputs"]
         lv = doc["levels"]
         em = cls([i["name"] for i in inp], [(i["lo"], i["hi"]) for i in inp],
