@@ -52,3 +52,22 @@ for fam in ("ard", "iso"):
         print(f"[{fam}] {n:2d} fine runs: rho=1 + GP discrepancy {1e3*np.sqrt(np.mean((yh-p)**2)):.2f} mm"
               f" ({100*np.sqrt(np.mean((yh-p)**2))/0.1682:.2f} %); linear discrepancy "
               f"{1e3*np.sqrt(np.mean((yh-pl)**2)):.2f} mm; constant {1e3*np.sqrt(np.mean((yh-m4h-np.mean(yt[idx]-m4t))**2)):.2f} mm")
+
+print("--- the criterion's ratio on the 20 hold-out runs: paired bootstrap over the runs")
+import json
+sf_path = os.path.join(RUNS, "sf02_10", "holdout.json")
+for name in ("study2/mf_emulator", "study2/mf_iso", "mflhs/mf_emulator"):
+    mf_path = os.path.join(RUNS, name + "_holdout.json")
+    if not (os.path.isfile(sf_path) and os.path.isfile(mf_path)):
+        print(f"  ({mf_path} or {sf_path} missing: made by analysis.sh's validate --json)")
+        continue
+    sf, mf = json.load(open(sf_path)), json.load(open(mf_path))
+    ys, y = np.array(sf["y"]), np.array(mf["y"])
+    o1, o2 = np.argsort(ys), np.argsort(y)      # the same runs, matched by their value
+    assert np.allclose(ys[o1], y[o2])
+    a, b = (ys - np.array(sf["mean"]))[o1], (y - np.array(mf["mean"]))[o2]
+    rng = np.random.default_rng(0)
+    i = rng.integers(0, len(a), (20000, len(a)))
+    r = np.sqrt(np.mean(b[i] ** 2, axis=1) / np.mean(a[i] ** 2, axis=1))
+    print(f"  {name}: RMSE ratio to the single-fidelity emulator {np.sqrt(np.mean(b**2) / np.mean(a**2)):.3f},"
+          f" 95 % bootstrap {np.quantile(r, 0.025):.2f}-{np.quantile(r, 0.975):.2f}, P(ratio <= 0.5) {np.mean(r <= 0.5):.2f}")
