@@ -157,6 +157,39 @@ def test_save_and_load_give_identical_predictions_and_versions_are_checked(tmp_p
         M.load(str(tmp_path / "v99.json"), check_fmu=False)
 
 
+def test_the_kernel_family_is_fitted_saved_and_a_version_1_file_reads_as_ard(tmp_path):
+    """'iso' has one length scale per delta GP, 'ard' one per input; each survives its JSON;
+    a file of schema version 1 (before the family was saved; its kernels were ARD) loads as ARD
+    with the predictions it was saved with."""
+    rng = np.random.default_rng(5)
+    U1 = rng.random((16, 2))
+    X = [U1, U1[:8], U1[:4]]
+    Y = [{"y": ladder(x, d)} for x, d in zip(X, DXS)]
+    ems = {}
+    for fam in M.KERNELS:
+        em = M.MFEmulator(["a", "b"], [(0, 1), (0, 1)], DXS, X, Y)
+        em.fit_output("y", restarts=0, kernel_family=fam)
+        n_ls = [np.size(g.gp.kernel_.k1.k2.length_scale) for g in em.models["y"].levels]
+        assert n_ls == ([1, 1, 1] if fam == "iso" else [2, 2, 2]), (fam, n_ls)
+        p = tmp_path / f"{fam}.json"
+        em.save(str(p))
+        em2 = M.load(str(p), check_fmu=False)
+        assert em2.models["y"].kernel_family == fam
+        U = rng.random((20, 2))
+        assert np.array_equal(em.predict(U, "y")[0], em2.predict(U, "y")[0])
+        ems[fam] = (em, p, U)
+    em, p, U = ems["ard"]
+    doc = json.loads(p.read_text())
+    doc["schema_version"] = 1
+    del doc["outputs"]["y"]["kernel_family"]
+    (tmp_path / "v1.json").write_text(json.dumps(doc))
+    em1 = M.load(str(tmp_path / "v1.json"), check_fmu=False)
+    assert em1.models["y"].kernel_family == "ard"
+    assert np.array_equal(em.predict(U, "y")[1], em1.predict(U, "y")[1])
+    with pytest.raises(M.MFError, match="kernel family"):
+        M.MFEmulator(["a", "b"], [(0, 1), (0, 1)], DXS, X, Y).fit_output("y", kernel_family="rbf")
+
+
 def _fake_fmu(path, guid):
     """A zip with the repository's modelDescription.xml under another GUID: what
     emulator.fmu_identity reads (no binary needed)."""

@@ -94,6 +94,10 @@ def add_parsers(sub):
     f.add_argument("--no-jitter-floor", action="store_true",
                    help="no lower bound on the finer levels' noise (default: the coarsest "
                         "level's fitted noise variance times (dx / dx_coarsest)^2)")
+    f.add_argument("--kernel", choices=M.KERNELS, default=M.DEFAULT_KERNEL,
+                   help=f"the GPs' kernel: Matern 5/2 with a length scale per input (ard) or "
+                        f"one for all (iso) (default {M.DEFAULT_KERNEL}; docs/dss.md, 'Choosing "
+                        f"the model by cross-validation')")
     f.add_argument("-o", "--out", required=True, help="the emulator file")
     f.add_argument("--fmu", help="the FMU of the runs (default: the first folder's sweep.json)")
 
@@ -236,7 +240,8 @@ def _print_summary(em: M.MFEmulator):
     for name, m in em.models.items():
         print(f"  {name}: levels dx " + ", ".join(f"{d:g} ({len(y)} runs)"
                                                for d, y in zip(em.dxs, m.y))
-              + "; rho " + ", ".join(f"{g.rho:.3f}" for g in m.levels[1:]))
+              + "; rho " + ", ".join(f"{g.rho:.3f}" for g in m.levels[1:])
+              + f"; kernel {m.kernel_family}")
         for c in m.calibration:
             print(f"    dx {c['dx']:g}: LOO RMSE {c['loo_rmse']:.4g}, rms z {c['loo_rms_z']:.2f}, "
                   f"coverage {100 * c['loo_coverage95']:.0f} %, interval scale applied "
@@ -325,7 +330,7 @@ def cmd_mf_fit(args):
     t0 = time.perf_counter()
     for o in outs:
         em.fit_output(o, restarts=args.restarts, seed=args.seed, order=_order(args.order),
-                      jitter_floor=not args.no_jitter_floor)
+                      jitter_floor=not args.no_jitter_floor, kernel_family=args.kernel)
     em.save(args.out)
     print(f"emulate mf-fit: {sum(len(x) for x in em.X)} runs at dx "
           + ", ".join(f"{d:g}" for d in em.dxs) + f", fitted in {time.perf_counter() - t0:.1f} s")

@@ -7,14 +7,21 @@ the levels ordered from the coarsest (largest dx) to the finest,
     f_1(x) = delta_1(x),    f_l(x) = rho_l f_{l-1}(x) + delta_l(x)   (l = 2..L)
 
 where delta_l are independent Gaussian processes and rho_l a constant. Each delta_l is a
-scikit-learn GaussianProcessRegressor (kernel ConstantKernel * Matern(nu = 2.5, a length scale
-per input) + WhiteKernel, the noise term absorbing the FMU's lattice jitter, as the
-single-fidelity emulator's) fitted on the level-l runs with f_{l-1} replaced by the level-(l-1)
-posterior mean at those runs; rho_l maximises the profile likelihood (delta_l's hyperparameters
-fitted by maximum marginal likelihood at each rho; delta_l's constant mean the residuals'
-mean). The recursion is exact for nested designs (the runs of a level a subset of those of the
-level below, which the design makes; Le Gratiet 2013, Stat. Comput.). Prediction at level l: mean rho_l m_{l-1} + m_delta_l, latent variance
-rho_l^2 v_{l-1} + v_delta_l, plus the level's fitted noise for the interval of a new run.
+scikit-learn GaussianProcessRegressor (kernel ConstantKernel * Matern(nu = 2.5) + WhiteKernel,
+the noise term absorbing the FMU's lattice jitter) fitted on the level-l runs with f_{l-1}
+replaced by the level-(l-1) posterior mean at those runs; rho_l maximises the profile likelihood
+(delta_l's hyperparameters fitted by maximum marginal likelihood at each rho; delta_l's constant
+mean the residuals' mean). The recursion is exact for nested designs (the runs of a level a
+subset of those of the level below, which the design makes; Le Gratiet 2013, Stat. Comput.).
+Prediction at level l: mean rho_l m_{l-1} + m_delta_l, latent variance rho_l^2 v_{l-1} +
+v_delta_l, plus the level's fitted noise for the interval of a new run.
+
+The kernel family (KERNELS): 'ard' (the default), a length scale per input of the unit box (the
+single-fidelity emulator's), or 'iso', one for all inputs: fewer hyperparameters for a level of
+a handful of runs. On the Vajont campaign's training runs the isotropic kernel cross-validated a
+little better (docs/dss.md, "Choosing the model by cross-validation"), by less than the CV's own
+spread and not on the hold-out; where the runs resolve an anisotropic response (the ladder
+stand-in of the tests) it is clearly worse. So ARD stays the default.
 
 The noise: every level's WhiteKernel takes the FMU's lattice jitter (the lattice is anchored
 at the reservoir level, so the run-up jitters by a fraction of a particle spacing over the
@@ -47,10 +54,12 @@ model was fitted on) widens that level's intervals (and the extrapolation's GP t
 scale below 1 is reported and not applied: with a dozen fine runs its estimate is too uncertain
 to narrow intervals on. The hold-out runs never enter it.
 
-Saved as JSON (schema mixsph-mf-emulator, version 1): the levels' dx, the inputs and their box,
-per output and level the training runs, rho, the delta GP's standardisation and hyperparameters
-(theta), the calibration and the order of convergence; the FMU's GUID and SHA-256. Loading
-rebuilds every GP with optimizer=None (the same predictions) and refuses an FMU of another GUID.
+Saved as JSON (schema mixsph-mf-emulator, version 2; version 1, before the kernel family was
+saved, is read as 'ard'): the levels' dx, the inputs and their box, per output the kernel
+family, per output and level the training runs, rho, the delta GP's standardisation and
+hyperparameters (theta), the calibration and the order of convergence; the FMU's GUID and
+SHA-256. Loading rebuilds every GP with optimizer=None (the same predictions) and refuses an FMU
+of another GUID.
 """
 
 from __future__ import annotations
@@ -65,7 +74,10 @@ import numpy as np
 from . import emulator as E
 
 SCHEMA = "mixsph-mf-emulator"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+READABLE_VERSIONS = (1, 2)           # version 1 files have the ARD kernel
+KERNELS = ("ard", "iso")             # the delta GPs' kernel family (module doc)
+DEFAULT_KERNEL = "ard"
 Z95 = E.Z95
 EXTRAPOLATED = "extrapolated"       # the name of the dx -> 0 level
 ORDER_BOUNDS = (0.25, 6.0)           # the search range of the observed order p
@@ -81,22 +93,35 @@ class MFError(E.EmulatorError):
     pass
 
 
+def _check_kernel_family(family):
+    if family not in KERNELS:
+        raise MFError(f"unknown kernel family {family!r} ({', '.join(KERNELS)})")
+
+
 # ---- one level's discrepancy GP ---------------------------------------------------------------------
 
 class DeltaGP:
     """The GP of one level's discrepancy delta_l = y_l - rho_l m_{l-1} (for the coarsest level,
     the level itself), standardised by its own mean and sd."""
 
-    def __init__(self, d, noise=None):
+    def __init__(self, d, noise=None, kernel_family=DEFAULT_KERNEL):
+        _check_kernel_family(kernel_family)
         self.d = d
         self.noise = noise          # a measured noise variance (output units^2) as the floor
+        self.kernel_family = kernel_family
         self.rho = 0.0              # 0 for the coarsest level
         self.mean, self.std = 0.0, 1.0
         self.gp = None
 
     def kernel(self):
         nv = None if self.noise is None else self.noise / self.std ** 2
-        return E.build_kernel("product", ["continuous"] * self.d, nv, "floor")
+        if self.kernel_family == "ard":
+            return E.build_kernel("product", ["continuous"] * self.d, nv, "floor")
+        from sklearn.gaussian_process.kernels import ConstantKernel, Matern, WhiteKernel
+        n0, nb = E.noise_bounds(nv, "floor")
+        return (ConstantKernel(1.0, E.CONST_BOUNDS)
+                * Matern(length_scale=0.5, length_scale_bounds=E.LENGTH_BOUNDS, nu=2.5)
+                + WhiteKernel(noise_level=n0, noise_level_bounds=nb))
 
     def fit(self, U, t, restarts, seed, theta=None):
         self.mean = float(np.mean(t))
@@ -197,7 +222,9 @@ def richardson_c(p, dxb, dxc, dx=0.0):
 class OutputMF:
     """The recursive model of one output over the levels (coarse to fine)."""
 
-    def __init__(self, name, dxs, d, noise=None, jitter_floor=True):
+    def __init__(self, name, dxs, d, noise=None, jitter_floor=True, kernel_family=DEFAULT_KERNEL):
+        _check_kernel_family(kernel_family)
+        self.kernel_family = kernel_family
         self.name = name
         self.dxs = list(dxs)
         self.d = d
@@ -226,7 +253,7 @@ class OutputMF:
             floor = self.noise.get(self.dxs[li])
             if floor is None and li > 0 and self.jitter_floor:
                 floor = self.levels[0].noise_var() * (self.dxs[li] / self.dxs[0]) ** 2
-            g = DeltaGP(self.d, floor)
+            g = DeltaGP(self.d, floor, self.kernel_family)
             th = thetas[li] if thetas and li < len(thetas) else None
             if li == 0:
                 g.fit(U, y, restarts, seed, th)
@@ -282,7 +309,7 @@ class OutputMF:
         self.y = [np.asarray(v, float) for v in y_levels]
         self.levels = []
         for li, (U, y, doc) in enumerate(zip(self.U, self.y, docs)):
-            g = DeltaGP(self.d, doc.get("noise_floor"))
+            g = DeltaGP(self.d, doc.get("noise_floor"), self.kernel_family)
             t = y if li == 0 else y - doc["rho"] * self.predict_level(U, li - 1, latent=True)[0]
             g.rebuild(U, t, doc["theta"], doc["mean"], doc["std"])
             g.rho = float(doc["rho"])
@@ -415,7 +442,7 @@ class OutputMF:
         return {"levels": [{"dx": dx, **g.to_json(), "n": int(len(y))}
                            for dx, g, y in zip(self.dxs, self.levels, self.y)],
                 "calibration": self.calibration, "scale": self.scale, "order": self.order,
-                "jitter_floor": self.jitter_floor}
+                "jitter_floor": self.jitter_floor, "kernel_family": self.kernel_family}
 
 
 def _mvn(C, n, rng):
@@ -478,14 +505,14 @@ class MFEmulator:
                       f"finest, {EXTRAPOLATED}, or a dx below {self.dxs[-1]:g})")
 
     def fit_output(self, name, restarts=2, seed=0, noise=None, order=None, thetas=None,
-                   rhos=None, jitter_floor=True):
+                   rhos=None, jitter_floor=True, kernel_family=DEFAULT_KERNEL):
         U, y = [], []
         for li in range(len(self.dxs)):
             yy = self.Y[li][name]
             ok = np.isfinite(yy)
             U.append(self.unit(self.X[li][ok]))
             y.append(yy[ok])
-        m = OutputMF(name, self.dxs, len(self.inputs), noise, jitter_floor)
+        m = OutputMF(name, self.dxs, len(self.inputs), noise, jitter_floor, kernel_family)
         m.fit(U, y, restarts=restarts, seed=seed, thetas=thetas, rhos=rhos)
         m.estimate_order(seed=seed, order=order)
         self.models[name] = m
@@ -517,8 +544,9 @@ class MFEmulator:
             **E.file_header(SCHEMA, SCHEMA_VERSION),
             "fmu": self.fmu, "settings": self.settings,
             "model": "recursive autoregressive co-kriging (Kennedy & O'Hagan 2000; Le Gratiet & "
-                     "Garnier 2014); delta GPs ConstantKernel*Matern(nu=2.5, anisotropic)"
-                     "+WhiteKernel; Richardson extrapolation of the three finest levels",
+                     "Garnier 2014); delta GPs ConstantKernel*Matern(nu=2.5; isotropic or "
+                     "anisotropic: each output's kernel_family)+WhiteKernel; Richardson "
+                     "extrapolation of the three finest levels",
             "inputs": [{"name": n, "lo": float(b[0]), "hi": float(b[1])}
                        for n, b in zip(self.inputs, self.box)],
             "levels": [{"dx": dx, "X": X.tolist(),
@@ -538,9 +566,10 @@ class MFEmulator:
     def from_json(cls, doc):
         if doc.get("schema") != SCHEMA:
             raise MFError(f"not a {SCHEMA} file (schema {doc.get('schema')!r})")
-        if doc.get("schema_version") != SCHEMA_VERSION:
+        if doc.get("schema_version") not in READABLE_VERSIONS:
+            readable = ", ".join(map(str, READABLE_VERSIONS))
             raise MFError(f"multi-fidelity emulator schema version {doc.get('schema_version')} is "
-                          f"not the one this code reads ({SCHEMA_VERSION}): refit it")
+                          f"not one this code reads ({readable}): refit it")
         inp = doc["inputs"]
         lv = doc["levels"]
         em = cls([i["name"] for i in inp], [(i["lo"], i["hi"]) for i in inp],
@@ -554,7 +583,9 @@ class MFEmulator:
                 ok = np.isfinite(yy)
                 U.append(em.unit(em.X[li][ok]))
                 y.append(yy[ok])
-            m = OutputMF(name, em.dxs, len(em.inputs), jitter_floor=o.get("jitter_floor", True))
+            # version 1 had the ARD kernel and did not save its family
+            m = OutputMF(name, em.dxs, len(em.inputs), jitter_floor=o.get("jitter_floor", True),
+                         kernel_family=o.get("kernel_family", "ard"))
             m.rebuild(U, y, o["levels"])
             m.calibration, m.scale, m.order = o["calibration"], o["scale"], o["order"]
             em.models[name] = m
