@@ -117,6 +117,14 @@ def report(out, case_path):
               f"x quantiles 50 % {np.quantile(x, 0.5):.3f}, 95 % {np.quantile(x, 0.95):.3f}, "
               f"99 % {np.quantile(x, 0.99):.3f} m; {int(np.sum(beyond & (z > 0.05)))} of {int(np.sum(beyond))} "
               f"beyond the toe higher than 0.05 m")
+        v = np.hypot(last["vx"][g], last["vz"][g])
+        x99 = np.quantile(x, 0.99)
+        far = x >= x99
+        bed = beyond & (z <= 0.05)
+        span = f"x {x[bed].min():.3f} .. {x[bed].max():.3f} m" if bed.any() else "none"
+        print(f"  on the floor (within 0.05 m, beyond the toe): {int(np.sum(bed))} grains, {span}; the farthest 1 % "
+              f"(x >= {x99:.3f} m): {int(np.sum(far))} grains {np.min(z[far]):.3f} .. {np.max(z[far]):.3f} m above "
+              f"the floor; grain speed largest {np.max(v):.3f} m/s, 99 % {np.quantile(v, 0.99):.3f} m/s")
     if cols:
         if "run_up" in cols and len(cols["run_up"]):
             w = np.asarray(cols["run_up"], dtype=float)

@@ -55,6 +55,7 @@ static const struct case_key elastic_plastic_keys[] = {
      .meaning = "pores filled with the pore fluid (else dry): yield on the effective stress of the pore pressure [PW]"},
     {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
      .meaning = "name of a fluid medium defined before this one"},
+    PORE_PRESSURE_KEY,
 };
 
 static const struct case_section elastic_plastic_section = {
@@ -125,7 +126,7 @@ static void plastic_range(void *arg, size_t b, size_t e)
         const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->shear_modulus,
                                                    .alpha_phi = m->alpha_phi, .k_c = m->k_c,
                                                    .alpha_psi = m->alpha_psi};
-        const double pw = m->saturated ? fmax(pore_pressure(pore, m, P->x[i], P->z[i]), 0.0) : 0.0;
+        const double pw = fmax(pore_pressure(pore, m, P->x[i], P->z[i]), 0.0);
         double p_eff = P->p[i] - pb - pw;
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
         if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb + pw; /* the tension cut-off */
@@ -143,7 +144,7 @@ static long elastic_plastic_update(void *state, const struct law_step *step)
 {
     struct pore_columns *pore = state;
     if (!(step->dt > 0.0)) return 0;
-    pore_columns_tops(pore, step->P, step->media); /* (of the saturated media, of any granular law) */
+    pore_columns_tops(pore, step->P, step->media); /* (of the fluids and saturated media, of any law) */
     struct plastic_loop L = {.step = step, .pore = pore};
     team_for(step->n_threads, step->n, plastic_range, &L);
     return L.plastic;

@@ -41,6 +41,7 @@ struct medium {
     int saturated;     /* pores filled with the pore fluid (else dry) */
     int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
     double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */
+    int pore_pressure; /* what the pore pressure is measured from (enum pore_pressure_mode, laws/pore_pressure.h) */
     double eps_f_mu_f; /* eps_f mu_f [Pa s] (0 if dry) */
     double mu_thr;     /* threshold viscosity [Pa s] */
     double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */

@@ -73,6 +73,7 @@ static const struct case_key granular_keys[] = {
      .meaning = "pores filled with the pore fluid (else dry)"},
     {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
      .meaning = "name of a fluid medium defined before this one"},
+    PORE_PRESSURE_KEY,
     {.key = "mu_thr", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "unless mu1", SCHEMA_RANGE(0, 1, 1e12, 0),
      .unit = "Pa s", .field = CASE_FIELD(medium, mu_thr),
      .meaning = "threshold viscosity μ_thr: a grain with μ_app ≥ μ_thr is held fixed"},
@@ -129,7 +130,7 @@ struct mixture {
     const struct medium *media;
     double g, p_background, fixed_bed_speed;
     double x_min, dx, h;
-    struct pore_columns *pore; /* the tops of the saturated granular columns */
+    struct pore_columns *pore; /* the tops of the wet columns (the pore pressure) */
     /* numerics.fixed_bed_speed >= 0 (SPHERA's fixed bed): per column 2h wide, the highest
      * granular particle no faster than that speed (bed_ref, -1 for none) and its z [m] */
     double *bed_z;
@@ -244,7 +245,7 @@ static void mixture_region(void *arg, int tid, int nth)
         double grad[4];
         velocity_gradient_corrected(step->grad, i, grad);
         const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
-        const double pw = m->saturated ? pore_pressure(M->pore, m, P->x[i], P->z[i]) : 0.0;
+        const double pw = pore_pressure(M->pore, m, P->x[i], P->z[i]);
         const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
         const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
         double mu;

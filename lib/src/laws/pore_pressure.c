@@ -16,8 +16,10 @@ struct pore_columns *pore_columns_create(const struct law_setup *setup)
     C->g = setup->g;
     C->nbins = (size_t)ceil((setup->x_max - setup->x_min) / setup->dx) + 1;
     C->ztop = calloc(C->nbins, sizeof(double));
-    if (!C->ztop) {
-        free(C);
+    C->wet_top = calloc(C->nbins, sizeof(double));
+    C->wet_rho = calloc(C->nbins, sizeof(double));
+    if (!C->ztop || !C->wet_top || !C->wet_rho) {
+        pore_columns_free(C);
         return NULL;
     }
     return C;
@@ -27,6 +29,8 @@ void pore_columns_free(struct pore_columns *C)
 {
     if (!C) return;
     free(C->ztop);
+    free(C->wet_top);
+    free(C->wet_rho);
     free(C);
 }
 
@@ -41,27 +45,43 @@ static size_t bin_of(const struct pore_columns *C, double x)
 
 void pore_columns_tops(struct pore_columns *C, const struct particles *P, const struct medium *media)
 {
-    for (size_t b = 0; b < C->nbins; b++) C->ztop[b] = -INFINITY;
+    for (size_t b = 0; b < C->nbins; b++) C->ztop[b] = C->wet_top[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (!media[P->medium[i]].saturated) continue;
+        const struct medium *m = &media[P->medium[i]];
+        const int fluid = m->law == LAW_NEWTONIAN;
+        if (!fluid && !m->saturated) continue;
         const size_t b = bin_of(C, P->x[i]);
         const double top = P->z[i] + 0.5 * C->dx;
-        if (top > C->ztop[b]) C->ztop[b] = top;
+        if (m->saturated && top > C->ztop[b]) C->ztop[b] = top;
+        if (top > C->wet_top[b]) { /* ties: the first in memory order, whatever the threads */
+            C->wet_top[b] = top;
+            C->wet_rho[b] = fluid ? m->rho0 : m->rho_f;
+        }
     }
+}
+
+/* rho_f g (top[b] - z) cos^2(alpha) below the top of column b, alpha the top's slope over the
+ * columns two either side (0 where one of them is empty), 0 above the top. */
+static double hydrostatic_below(const struct pore_columns *C, const double *ztop, size_t b, double rho_f, double z)
+{
+    const double top = ztop[b];
+    if (!(top > z)) return 0.0;
+    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < C->nbins ? b + 2 : C->nbins - 1;
+    double slope = 0.0;
+    if (br > bl && isfinite(ztop[bl]) && isfinite(ztop[br])) slope = (ztop[br] - ztop[bl]) / ((double)(br - bl) * C->dx);
+    const double cos2 = 1.0 / (1.0 + slope * slope);
+    return rho_f * C->g * (top - z) * cos2;
 }
 
 double pore_pressure(const struct pore_columns *C, const struct medium *m, double x, double z)
 {
     const size_t b = bin_of(C, x);
-    const double top = C->ztop[b];
-    if (!(top > z)) return 0.0;
-    const size_t bl = b >= 2 ? b - 2 : 0, br = b + 2 < C->nbins ? b + 2 : C->nbins - 1;
-    double slope = 0.0;
-    if (br > bl && isfinite(C->ztop[bl]) && isfinite(C->ztop[br]))
-        slope = (C->ztop[br] - C->ztop[bl]) / ((double)(br - bl) * C->dx);
-    const double cos2 = 1.0 / (1.0 + slope * slope);
-    return m->rho_f * C->g * (top - z) * cos2;
+    if (m->pore_pressure == PORE_GRANULAR_COLUMN)
+        return m->saturated ? hydrostatic_below(C, C->ztop, b, m->rho_f, z) : 0.0;
+    /* free_surface: a saturated medium's pores hold its own pore fluid, a dry medium's the fluid
+     * it is under */
+    return hydrostatic_below(C, C->wet_top, b, m->saturated ? m->rho_f : C->wet_rho[b], z);
 }
 
 #define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)

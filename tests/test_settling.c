@@ -1,0 +1,182 @@
+/* test_settling.c - grains under water (docs/model.md section 5, [PW] and "Note on the pore
+ * pressure of submerged layers"; issue 45: "Grains that enter water settle").
+ *
+ * (a) A block of dry gravel resting on the floor of a tank of still water, at its hydrostatic
+ * start (sim.c: every particle has the weight of the lattice column above it). Under
+ * pore_pressure = free_surface the pore pressure of a grain is the water's, measured from the free
+ * surface z_s = 0.3 m, and the skeleton carries its buoyant weight only:
+ *     p_w = rho_w g (z_s - z),   sigma' = p - p_w = (rho0 - rho_w) g (z_g - z)
+ * with rho0 = (1 - n) rho_s the dry mixture density (5) and z_g = 0.06 m the block's top (the
+ * note's formula, from the geometry of the case, not from the particles). Tolerance 1e-9 of the
+ * water's pressure at the floor: the two sides add the same terms in another order. Under
+ * granular_column (the paper's) a dry medium has p_w = 0 and sigma' = p, the water's weight
+ * included: the same check then fails by the water's pressure, rho_w g (z_s - z_g) = 2354 Pa at
+ * least.
+ *
+ * (b) The same block released at rest with its bottom 0.06 m above the floor (0.14 m under the
+ * surface) sinks to the bed, under both granular laws: denser than the water (1590 against 1000
+ * kg/m3), it falls through it (no wall or grain below to hold it) and lies on the floor. Criterion
+ * at t = 0.8 s (measured 2026-12-06, dx = 0.01, 2 threads: the lowest grain at z = 0.0088 m
+ * (paper) / 0.0072 m (elastic-plastic), the floor's first row being at dx/2, the highest at
+ * 0.046 / 0.052 m): every grain below where the block's bottom started (the block has
+ * gone down by its own height at least) and the lowest within 1.5 dx of the floor (on it: the
+ * first row of particles above a wall lies at dx/2). Under granular_column the block sinks too (a
+ * submerged block is not held up; what granular_column changes is the strength (a)).
+ *
+ * (c) A value of pore_pressure that is not a choice is refused, naming the key. */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "pore_pressure.h"
+#include "sim.h"
+
+#define G_ACC 9.81
+#define RHO_W 1000.0
+#define RHO_S 2650.0
+#define POR 0.4
+#define Z_SURFACE 0.3 /* the water's free surface [m] */
+
+/* A tank 0.4 m wide of water Z_SURFACE deep, a block of dry gravel (the slide flume's) of width
+ * 0.1 m from x = 0.15 m, between z_lo and z_hi; `extra` is added to the gravel's keys. */
+static const char *tank_json(double z_lo, double z_hi, const char *extra)
+{
+    static char buf[2048];
+    snprintf(buf, sizeof buf,
+             "{ \"name\": \"block_in_water\", \"gravity\": 9.81,"
+             "  \"numerics\": { \"dx\": 0.01, \"t_end\": 1.0, \"viscosity\": \"implicit\" },"
+             "  \"media\": { \"water\": { \"type\": \"fluid\", \"rho\": 1000.0, \"K\": 2.5e6, \"mu\": 1.0e-3,"
+             "                            \"alpha_m\": 0.075 },"
+             "              \"gravel\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.4,"
+             "                          \"phi\": 35.0, \"mu_thr\": 320.0e3, \"mu0\": 5.0e3, \"alpha_m\": 0.0 %s } },"
+             "  \"bodies\": { \"block\": { \"medium\": \"gravel\","
+             "                             \"polygon\": [[0.15, %.9g], [0.25, %.9g], [0.25, %.9g], [0.15, %.9g]] },"
+             "               \"tank\": { \"medium\": \"water\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.4, 0.3], [0.0, 0.3]] } },"
+             "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.5], [0.0, 0.0], [0.4, 0.0], [0.4, 0.5]],"
+             "                        \"fluid_side\": \"left\" } },"
+             "  \"domain\": { \"x_min\": -0.05, \"x_max\": 0.45, \"z_min\": -0.05, \"z_max\": 0.5 } }",
+             extra, z_lo, z_lo, z_hi, z_hi);
+    return buf;
+}
+
+static mixsph_sim *create_ok(const char *json)
+{
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = mixsph_sim_create_from_text(json, "block_in_water", NULL, 0, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    return s;
+}
+
+static int is_grain(const mixsph_sim *s, size_t i)
+{
+    return s->phys.P.state[i] != MIXSPH_STATE_WALL && s->cfg.media[s->phys.P.medium[i]].law == LAW_MIXTURE_PAPER;
+}
+
+/* The largest |sigma' - (rho0 - rho_w) g (z_g - z)| over the grains [Pa], sigma' = p - p_b - p_w
+ * with p_w from laws/pore_pressure.c at the start of the run. */
+static double buoyant_weight_error(const char *extra, double z_g)
+{
+    mixsph_sim *s = create_ok(tank_json(0.0, z_g, extra));
+    const struct particles *P = &s->phys.P;
+    const struct law_setup setup = {.media = s->cfg.media, .n_media = s->cfg.n_media, .cap = P->n,
+                                     .x_min = s->phys.domain[0], .x_max = s->phys.domain[1], .dx = s->phys.dx,
+                                     .h = s->phys.h, .g = s->cfg.g, .p_background = s->cfg.p_background};
+    struct pore_columns *C = pore_columns_create(&setup);
+    assert_non_null(C);
+    pore_columns_tops(C, P, s->cfg.media);
+    const double rho0 = (1.0 - POR) * RHO_S; /* (5), dry: 1590 kg/m3 */
+    double worst = 0.0;
+    long grains = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!is_grain(s, i)) continue;
+        const struct medium *m = &s->cfg.media[P->medium[i]];
+        const double pw = pore_pressure(C, m, P->x[i], P->z[i]);
+        const double sigma = P->p[i] - s->cfg.p_background - pw;
+        const double want = (rho0 - RHO_W) * G_ACC * (z_g - P->z[i]);
+        worst = fmax(worst, fabs(sigma - want));
+        grains++;
+    }
+    assert_int_equal(grains, 60); /* 10 x 6 sites */
+    pore_columns_free(C);
+    mixsph_sim_destroy(s);
+    return worst;
+}
+
+static void test_buoyant_weight(void **state)
+{
+    (void)state;
+    const double z_g = 0.06, tol = 1e-9 * RHO_W * G_ACC * Z_SURFACE;
+    const double e_surface = buoyant_weight_error("", z_g); /* the default: free_surface */
+    const double e_column = buoyant_weight_error(", \"pore_pressure\": \"granular_column\"", z_g);
+    print_message("largest |sigma' - (rho0 - rho_w) g (z_g - z)|: free_surface %.3g Pa (tolerance %.3g), "
+                  "granular_column %.1f Pa\n", e_surface, tol, e_column);
+    assert_true(e_surface <= tol);
+    assert_true(e_column >= RHO_W * G_ACC * (Z_SURFACE - z_g)); /* the water's weight counted as the skeleton's */
+}
+
+/* The block of (b) under granular law number `law` (0 paper, 1 elastic_plastic: by number, so the
+ * gravel keeps the paper law's keys) after t_end: its highest and lowest grain [m]. */
+static void sink(int law, double t_end, double *z_hi, double *z_lo)
+{
+    char extra[128];
+    snprintf(extra, sizeof extra, ", \"law\": %d", law);
+    mixsph_sim *s = create_ok(tank_json(0.06, 0.12, extra));
+    assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_advance_to(s, t_end), MIXSPH_OK);
+    const struct particles *P = &s->phys.P;
+    *z_hi = -INFINITY;
+    *z_lo = INFINITY;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->state[i] == MIXSPH_STATE_WALL || P->medium[i] != 1) continue;
+        assert_true(P->state[i] != MIXSPH_STATE_LOST);
+        *z_hi = fmax(*z_hi, P->z[i]);
+        *z_lo = fmin(*z_lo, P->z[i]);
+    }
+    mixsph_sim_destroy(s);
+}
+
+static void test_block_sinks(void **state)
+{
+    (void)state;
+    const char *laws[] = {"paper", "elastic_plastic"};
+    for (int k = 0; k < 2; k++) {
+        double z_hi, z_lo;
+        sink(k, 0.8, &z_hi, &z_lo);
+        print_message("%s: at t = 0.8 s the grains lie between z = %.4f and %.4f m (started 0.06-0.12 m)\n", laws[k],
+                      z_lo, z_hi);
+        assert_true(z_hi < 0.06);
+        assert_true(z_lo < 1.5 * 0.01);
+    }
+}
+
+static void test_bad_value(void **state)
+{
+    (void)state;
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    assert_int_equal(mixsph_sim_create_from_text(tank_json(0.0, 0.06, ", \"pore_pressure\": \"surface\""),
+                                                 "block_in_water", NULL, 0, &s, err, sizeof err),
+                     MIXSPH_ERR_CASE);
+    assert_null(s);
+    print_message("  refused: %s\n", err);
+    assert_non_null(strstr(err, "media.gravel.pore_pressure"));
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_buoyant_weight),
+        cmocka_unit_test(test_block_sinks),
+        cmocka_unit_test(test_bad_value),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
