@@ -23,7 +23,9 @@ of particles within 6 mm of the sensor's height, at every time step) are read:
 - first peak: the largest sample within PEAK_WINDOW s after the arrival, and its time; also the
   same on the signal averaged over SMOOTH s (a sensor of finite size and bandwidth does not see
   the single-sample spikes of a particle method);
-- the largest sample of the whole run and its time.
+- the largest sample of the whole run and its time;
+- the mean pressure from AFTER[0] to AFTER[1] s after the first peak (the level the signal
+  falls back to after the impact's spike) and the width of the spike at half its height.
 
 --rest also runs the column at rest (a gate wall at x = 0.6 m added to the case) for --rest-time
 seconds, both ways, and gives the rms deviation of the water's pressure from rho0 g (z_s - z)
@@ -58,6 +60,7 @@ ARRIVAL = 0.05       # x rho g H: a sensor counts as wet above this pressure
 PEAK_WINDOW = 0.02   # s after the arrival in which the first peak is sought (about 3 times the
                      # quoted median rise time of an impact, 7 ms)
 SMOOTH = 0.001       # s: the averaging window of the smoothed signal
+AFTER = (0.01, 0.05) # s after the first peak: the window of the level after the spike
 GATE_X = 0.6         # the column's right side [m]
 
 # Peak pressure [mbar] per sensor: (median, 2.5 %, 97.5 %) of about 100 repetitions; None where no
@@ -105,7 +108,7 @@ def sensor_stats(t, p, H):
     """Arrival, first peak (raw and smoothed) and whole-run maximum of one sensor's signal."""
     nan = float("nan")
     s = {"t_arrival": nan, "peak": nan, "t_peak": nan, "peak_smooth": nan, "t_peak_smooth": nan,
-         "max": nan, "t_max": nan}
+         "max": nan, "t_max": nan, "width": nan, "mean_after": nan}
     ok = np.isfinite(p)
     if not ok.any():
         return s
@@ -119,6 +122,16 @@ def sensor_stats(t, p, H):
     win = (t >= ta) & (t <= ta + PEAK_WINDOW)
     j = np.nonzero(win)[0][int(np.nanargmax(p[win]))]
     s["peak"], s["t_peak"] = float(p[j]), float(t[j])
+    half = 0.5 * p[j]
+    lo, hi = j, j
+    while lo > 0 and p[lo] > half:
+        lo -= 1
+    while hi < p.size - 1 and p[hi] > half:
+        hi += 1
+    s["width"] = float(t[hi] - t[lo])
+    after = (t >= t[j] + AFTER[0]) & (t <= t[j] + AFTER[1]) & ok
+    if after.any():
+        s["mean_after"] = float(np.mean(p[after]))
     dt = float(np.median(np.diff(t))) if t.size > 1 else SMOOTH
     n = max(1, int(round(SMOOTH / dt)))
     ps = np.convolve(np.nan_to_num(p), np.ones(n) / n, mode="same")
@@ -166,7 +179,7 @@ def impact_runs(a, status):
 def print_impacts(res):
     print("\nFirst pressure peak at the downstream wall's sensors (Pa; times from the release, s)")
     print(f"{'H [m]':>5s} {'diff':>4s} {'sensor':>6s} {'arrival':>8s} {'first peak':>10s} {'at t':>7s} "
-          f"{'1 ms mean':>9s} {'max run':>9s} {'at t':>7s} {'exp. median':>11s} {'exp. 2.5-97.5 %':>16s} "
+          f"{'1 ms mean':>9s} {'width ms':>8s} {'after':>7s} {'max run':>9s} {'at t':>7s} {'exp. median':>11s} {'exp. 2.5-97.5 %':>16s} "
           f"{'peak/median':>11s}")
     rows = []
     for (H, label), (_, _, stats, info) in sorted(res.items()):
@@ -176,7 +189,8 @@ def print_impacts(res):
             band = f"{ref[1] * MBAR:.0f}-{ref[2] * MBAR:.0f}" if ref and ref[1] is not None else "-"
             ratio = st["peak"] / med if med else None
             print(f"{H:5g} {label:>4s} {s:>6s} {fmt(st['t_arrival'], '8.4f')} {fmt(st['peak'], '10.0f')} "
-                  f"{fmt(st['t_peak'], '7.4f')} {fmt(st['peak_smooth'], '9.0f')} {fmt(st['max'], '9.0f')} "
+                  f"{fmt(st['t_peak'], '7.4f')} {fmt(st['peak_smooth'], '9.0f')} {fmt(1e3 * st['width'], '8.1f')} "
+                  f"{fmt(st['mean_after'], '7.0f')} {fmt(st['max'], '9.0f')} "
                   f"{fmt(st['t_max'], '7.4f')} {fmt(med, '11.0f')} {band:>16s} {fmt(ratio, '11.2f')}")
             rows.append({"H": H, "diffusion": label, "sensor": s, "z_mm": HEIGHTS_MM[s], **st,
                          "exp_median": med, "exp_p2_5": ref[1] * MBAR if ref and ref[1] is not None else None,
