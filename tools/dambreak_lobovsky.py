@@ -90,6 +90,7 @@ def run(cmd, out):
 
 
 def case_sets(a, H, diffusion_sets):
+    """The overrides of one run: the column's height, the spacing, the diffusion's, the user's."""
     return [f"parameters.H={H}", f"numerics.dx={a.dx}"] + diffusion_sets + a.set
 
 
