@@ -33,9 +33,9 @@ over the snapshots (every 0.01 s) and the rms after removing each layer's mean (
 tools/hydrostatic_noise.py measures the hydrostatic tank: the pressure noise of the column before
 it is released.
 
-Prints the tables, writes OUT/dambreak_lobovsky.csv (one row per H, diffusion and sensor) and
-draws OUT/dambreak_lobovsky.png (pressure at each sensor against time, the measured median and
-band). --reuse reads existing output folders instead of running. Exit status 0; 1 when a run
+Prints the tables, writes OUT/dambreak_lobovsky_dx<dx>.csv (one row per H, diffusion and
+sensor) and draws OUT/dambreak_lobovsky_dx<dx>.png (pressure at each sensor against time, the
+measured median and band). --reuse reads existing output folders instead of running. Exit status 0; 1 when a run
 failed (its numbers up to the failure are still given); 2 bad usage.
 """
 
@@ -298,12 +298,13 @@ def main():
     rows = print_impacts(res)
     if rows:
         os.makedirs(a.out, exist_ok=True)
-        with open(os.path.join(a.out, "dambreak_lobovsky.csv"), "w", newline="") as f:
+        base = os.path.join(a.out, f"dambreak_lobovsky_dx{a.dx:g}")
+        with open(base + ".csv", "w", newline="") as f:
             w = csv.DictWriter(f, fieldnames=list(rows[0]))
             w.writeheader()
             w.writerows(rows)
-        plot(res, os.path.join(a.out, "dambreak_lobovsky.png"))
-        print(f"\nwrote {a.out}/dambreak_lobovsky.csv and {a.out}/dambreak_lobovsky.png")
+        plot(res, base + ".png")
+        print(f"\nwrote {base}.csv and {base}.png")
     if a.rest:
         rest_runs(a, status)
     return status[0]
