@@ -93,8 +93,8 @@ static void check_case(const char *file, double dx_factor)
 static void bundled_cases(void **state)
 {
     (void)state;
-    const char *files[] = {"dambreak_water.json", "erosive_dambreak.json", "hydrostatic_tank.json", "slope_tank.json",
-                           "vajont_padua.json"};
+    const char *files[] = {"dambreak_water.json", "dambreak_lobovsky.json", "erosive_dambreak.json",
+                           "hydrostatic_tank.json", "slope_tank.json", "vajont_padua.json"};
     for (size_t k = 0; k < sizeof files / sizeof files[0]; k++) {
         check_case(files[k], 1.0);
         check_case(files[k], 0.5);

@@ -2,7 +2,8 @@
  * message naming the file, the key path and what was expected; numeric overrides
  * (mixsph_override_parse and their application); reading from a file; a good case with an
  * override of numerics.dx gives the expected particle count; the key tables: each range, type,
- * variant and default of a row is what the reader enforces, and d50 is refused. */
+ * variant and default of a row is what the reader enforces, and d50 is refused; the bundled Lobovsky
+ * dam break's pressure monitors sit at the paper's sensors. */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -802,6 +803,56 @@ static void test_parameters(void **state)
     free(j);
 }
 
+/* The bundled Lobovsky dam break (cases/dambreak_lobovsky.json; docs/validation/dambreak_lobovsky.md):
+ * its four wall_pressure monitors P1-P4 sit on the tank's downstream wall (x = 1.61 m) around the
+ * paper's sensor heights, 3, 15, 30 and 80 mm, and at dx = 0.01 and 0.005 each window holds at
+ * least one particle of the wall's first layer (a window without one would read NaN for the whole
+ * run); parameters.H sets the column's height (0.6 x H of water: 1,800 particles at H = 0.3 and
+ * 3,600 at H = 0.6, dx = 0.01). */
+static void test_lobovsky_case(void **state)
+{
+    (void)state;
+    char err[1024], *text = NULL;
+    const char *path = MIXSPH_SOURCE_DIR "/cases/dambreak_lobovsky.json";
+    assert_int_equal(case_read_file(path, &text, err, sizeof err), MIXSPH_OK);
+    struct case_def c;
+    if (case_parse(text, path, NULL, 0, &c, err, sizeof err) != MIXSPH_OK) fail_msg("%s", err);
+    const char *names[] = {"P1", "P2", "P3", "P4"};
+    const double z_sensor[] = {0.003, 0.015, 0.030, 0.080}, x_wall = 1.61;
+    for (size_t k = 0; k < 4; k++) {
+        const struct monitor_def *md = NULL;
+        for (size_t m = 0; m < c.n_monitors; m++)
+            if (strcmp(c.monitors[m].name, names[k]) == 0) md = &c.monitors[m];
+        assert_non_null(md);
+        assert_int_equal(md->kind, MONITOR_WALL_PRESSURE);
+        assert_string_equal(c.walls[md->wall].name, "tank");
+        assert_true(md->z_min < z_sensor[k] && z_sensor[k] < md->z_max);
+        assert_true(md->x_min < x_wall && x_wall < md->x_max);
+    }
+    case_free(&c);
+    free(text);
+    const double dxs[] = {0.01, 0.005};
+    for (size_t d = 0; d < 2; d++) {
+        const mixsph_override ov = {"numerics.dx", dxs[d]};
+        mixsph_sim *s = NULL;
+        if (mixsph_sim_create(path, &ov, 1, &s, err, sizeof err) != MIXSPH_OK) fail_msg("%s", err);
+        for (size_t k = 0; k < 4; k++) {
+            const long o = mixsph_sim_output_find(s, names[k]);
+            assert_true(o >= 0);
+            assert_true(isfinite(mixsph_sim_output_value(s, (size_t)o)));
+        }
+        mixsph_sim_destroy(s);
+    }
+    mixsph_sim *s = NULL;
+    assert_int_equal(mixsph_sim_create(path, NULL, 0, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 1800);
+    mixsph_sim_destroy(s);
+    const mixsph_override tall = {"parameters.H", 0.6};
+    assert_int_equal(mixsph_sim_create(path, &tall, 1, &s, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_particles(s), 3600);
+    mixsph_sim_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -818,6 +869,7 @@ int main(void)
         cmocka_unit_test(test_overrides),
         cmocka_unit_test(test_override_parse),
         cmocka_unit_test(test_create),
+        cmocka_unit_test(test_lobovsky_case),
         cmocka_unit_test(test_full_scale_errors),
         cmocka_unit_test(test_full_scale_map),
         cmocka_unit_test(test_table_ranges),

@@ -35,8 +35,9 @@ RUNS = (("off", ["numerics.density_diffusion=0"]),
         ("molteni 0.1", ["numerics.density_diffusion=0.1", "numerics.density_diffusion_form=1"]))
 
 
-def measure(outdir):
-    """(rms dev, rms noise, max speed, z_s at the end) over the snapshots after t = 0."""
+def measure(outdir, dx=DX):
+    """(rms dev, rms noise, max speed, z_s at the end) over the snapshots after t = 0 of a run of
+    water at rest at particle spacing dx (also used by tools/dambreak_lobovsky.py)."""
     dev2, noise2, count, vmax, zs = 0.0, 0.0, 0, 0.0, float("nan")
     for t, ref in list_snapshots(outdir):
         if t <= 0.0:
@@ -44,10 +45,10 @@ def measure(outdir):
         _, c = read_snapshot(ref)
         water = c["state"] != 2  # not a wall
         z, p = c["z"][water], c["p"][water]
-        top = z > z.max() - 0.5 * DX
-        zs = z[top].mean() + 0.5 * DX
+        top = z > z.max() - 0.5 * dx
+        zs = z[top].mean() + 0.5 * dx
         d = p - RHO0 * G * (zs - z)
-        layer = np.floor(z / DX).astype(int)
+        layer = np.floor(z / dx).astype(int)
         mean = np.bincount(layer, weights=d) / np.maximum(np.bincount(layer), 1)
         dev2 += np.sum(d * d)
         noise2 += np.sum((d - mean[layer]) ** 2)
