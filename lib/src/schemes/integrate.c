@@ -284,7 +284,7 @@ static unsigned char *realloc_unknowns(unsigned char *u, size_t cap)
  * is not of a hold_fixed medium after one explicit step of judge_dt, as the explicit scheme gives
  * it to the grain it judges (mixture_paper.c): its acceleration by the other forces (P->ax, P->az
  * of the last momentum pass) plus the viscous one from the solved velocities around it,
- * -(L u)_i / m_i with u_i = 0. One operator pass. Returns -1 when out of memory. */
+ * -(L u)_i / m_i with u_i = 0; (lx, lz) = L u of the solved field. */
 struct held_kick_loop {
     mixsph_sim *s;
     double judge_dt;
@@ -305,13 +305,10 @@ static void held_kick_range(void *arg, size_t b, size_t e)
     }
 }
 
-static int held_grain_kicks(mixsph_sim *s, const struct pair_system *S, double judge_dt)
+static void held_grain_kicks(mixsph_sim *s, int n_threads, double judge_dt, const double *lx, const double *lz)
 {
-    const double *lx, *lz;
-    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
     struct held_kick_loop L = {.s = s, .judge_dt = judge_dt, .lx = lx, .lz = lz};
-    team_for(S->n_threads, active_particles(s), held_kick_range, &L);
-    return 0;
+    team_for(n_threads, active_particles(s), held_kick_range, &L);
 }
 
 /* The implicit viscous step over dt with the operator of the last momentum pass (at the current
@@ -335,25 +332,25 @@ static void unknowns_range(void *arg, size_t b, size_t e)
                                  mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
 }
 
+static int any_wall_moves(const struct walls *W)
+{
+    for (size_t w = 0; w < W->n; w++)
+        if (W->def[w].motion >= 0) return 1;
+    return 0;
+}
+
 /* The viscous force of the solved velocities on the wall particles of moving walls, -(L u)_j,
  * added to the force the momentum pass left in their accelerations (which leaves out the viscous
- * force in this scheme), so that a wall's work (walls_move) counts it. One operator pass, only
- * with a moving wall. Returns -1 when out of memory. */
-static int viscous_wall_forces(mixsph_sim *s, const struct pair_system *S)
+ * force in this scheme), so that a wall's work (walls_move) counts it. */
+static void viscous_wall_forces(mixsph_sim *s, const double *lx, const double *lz)
 {
     const struct walls *W = &s->phys.walls;
-    int moving = 0;
-    for (size_t w = 0; w < W->n; w++) moving |= W->def[w].motion >= 0;
-    if (!moving) return 0;
-    const double *lx, *lz;
-    if (viscous_solution_operator(s->work.viscous, s->work.forces, S, &lx, &lz) != 0) return -1;
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < active_particles(s); i++) {
         if (P->state[i] != MIXSPH_STATE_WALL || W->def[particles_wall_index(P, i)].motion < 0) continue;
         P->ax[i] -= lx[i];
         P->az[i] -= lz[i];
     }
-    return 0;
 }
 
 static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judge_dt)
@@ -390,8 +387,13 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     const double t0 = clock_monotonic_s();
     int failed = viscous_step(s->work.viscous, s->work.forces, &S, s->work.wall_mirror, &s->phys.walls, s->phys.t, dt,
                               s->work.viscous_unknown, vp, rep);
-    if (!failed && rigid && judge_dt > 0.0) failed = held_grain_kicks(s, &S, judge_dt);
-    if (!failed) failed = viscous_wall_forces(s, &S);
+    const int kicks = rigid && judge_dt > 0.0, walls_work = any_wall_moves(&s->phys.walls);
+    if (!failed && (kicks || walls_work)) { /* one operator pass, L u of the solved field, for both */
+        const double *lx, *lz;
+        failed = viscous_solution_operator(s->work.viscous, s->work.forces, &S, &lx, &lz) != 0;
+        if (!failed && kicks) held_grain_kicks(s, S.n_threads, judge_dt, lx, lz);
+        if (!failed && walls_work) viscous_wall_forces(s, lx, lz);
+    }
     s->work.viscous_wall_s += clock_monotonic_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
     s->work.viscous_iterations += (uint64_t)rep->iterations;

@@ -257,28 +257,16 @@ static void step_end_velocity(const struct motion *m, const struct wall_state *w
     }
 }
 
-/* The force the particles exert on each wall [N/m]: the sum over its particles of what the last
- * momentum pass left in their accelerations (forces_momentum: a wall particle keeps the force). */
-static void wall_forces(const struct walls *W, const struct particles *P, double *fx, double *fz)
-{
-    for (size_t w = 0; w < W->n; w++) fx[w] = fz[w] = 0.0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_WALL) continue;
-        const size_t w = particles_wall_index(P, i);
-        fx[w] += P->ax[i];
-        fz[w] += P->az[i];
-    }
-}
-
 /* Move the walls from t_from by dt: each moving wall translates by its velocity at mid-step
  * (exact for a law linear over the step), then takes the velocity and acceleration at t+dt. Its
- * work on the particles grows by the force it exerts on them (minus theirs on it, at the start of
- * the step) times its displacement. */
+ * work on the particles grows by the force it exerts on them times its displacement: minus the
+ * force on it, the sum over its particles of what the last momentum pass left in their
+ * accelerations (forces_momentum: a wall particle keeps the force). */
 void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
 {
     struct wall_state *wstate = W->state;
     int moving = 0;
-    double dxw[WALLS_MAX] = {0}, dzw[WALLS_MAX] = {0}, fx[WALLS_MAX], fz[WALLS_MAX];
+    double dxw[WALLS_MAX] = {0}, dzw[WALLS_MAX] = {0}, fx[WALLS_MAX] = {0}, fz[WALLS_MAX] = {0};
     for (size_t w = 0; w < W->n; w++) {
         const int mo = W->def[w].motion;
         if (mo < 0) continue;
@@ -301,17 +289,18 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
         moving = 1;
     }
     if (!moving) return;
-    wall_forces(W, P, fx, fz);
-    for (size_t w = 0; w < W->n; w++) wstate[w].work -= fx[w] * dxw[w] + fz[w] * dzw[w];
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
         const size_t w = particles_wall_index(P, i);
         if (W->def[w].motion < 0) continue;
+        fx[w] += P->ax[i];
+        fz[w] += P->az[i];
         P->x[i] += dxw[w];
         P->z[i] += dzw[w];
         P->vx[i] = wstate[w].vx;
         P->vz[i] = wstate[w].vz;
     }
+    for (size_t w = 0; w < W->n; w++) wstate[w].work -= fx[w] * dxw[w] + fz[w] * dzw[w];
 }
 
 void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
