@@ -100,22 +100,21 @@ def coarse_gp(U, y, restarts=1):
 def linear_link(levels=(0, 2), rho_fixed=None, trend=False):
     """y_fine = a + rho m_coarse(x) [+ b.x] + eps by least squares (a parametric discrepancy);
     variance: the regression's prediction variance + rho^2 v_coarse + s^2."""
+    def design(X, m):
+        """The regression's columns at inputs X with the coarse mean m there."""
+        cols = [np.ones(len(X))]
+        if trend:
+            cols += [X[:, j] for j in range(3)]
+        if rho_fixed is None:
+            cols.append(m)
+        return np.column_stack(cols)
+
     def fit(U, y):
         g = coarse_gp(U[levels[0]], y[levels[0]])
-        chain = [g]
-        # middle levels: AR1 as usual (only used when levels has 3 entries)
         Uf, yf = U[levels[-1]], y[levels[-1]]
         mp, vp = g.predict(Uf)
-        cols = [np.ones(len(yf))]
-        if trend:
-            cols += [Uf[:, j] for j in range(3)]
-        if rho_fixed is None:
-            cols.append(mp)
-            F = np.column_stack(cols)
-            t = yf
-        else:
-            F = np.column_stack(cols)
-            t = yf - rho_fixed * mp
+        F = design(Uf, mp)
+        t = yf if rho_fixed is None else yf - rho_fixed * mp
         beta, *_ = np.linalg.lstsq(F, t, rcond=None)
         r = t - F @ beta
         dof = max(len(yf) - F.shape[1], 1)
@@ -127,12 +126,7 @@ def linear_link(levels=(0, 2), rho_fixed=None, trend=False):
 
         def pred(Ut):
             m, v = g.predict(Ut)
-            c = [np.ones(len(Ut))]
-            if trend:
-                c += [Ut[:, j] for j in range(3)]
-            if rho_fixed is None:
-                c.append(m)
-            Ft = np.column_stack(c)
+            Ft = design(Ut, m)
             mu = Ft @ beta + (0 if rho_fixed is None else rho_fixed * m)
             var = s2 * (1 + np.einsum("ij,jk,ik->i", Ft, FtFi, Ft)) + rho ** 2 * v
             return mu, np.sqrt(var)
