@@ -17,6 +17,10 @@ drift of the machine's speed does not favour one), of
        thread count), timed as the process's wall time;
   fmu  fmpy's simulate_fmu of LandslideWave.fmu with case_file the same case, the parameter `dx`
        and `threads` = N, in a child Python process, timed over the simulate_fmu call.
+With --ceiling (exe mode) each pair also runs two 1-thread processes at once, each on the whole
+case: no shared data, no barrier, no serial part. 2 t1 / (the slower of the two) is what a perfectly
+parallel 2-thread step could reach on this host at that moment, its memory and caches shared as
+the two threads share them (somewhat pessimistic: each process holds its own copy of the data).
 It prints each run's wall time with the 1-minute load average before it, each pair's speed-up
 t1 / t2, and per run and mode the speed-up's minimum, median and maximum and how many pairs
 reached the issue's bar (1.7; 1.5 at 10,000 particles). A benchmark (docs/performance.md), not a
@@ -55,15 +59,30 @@ def load1():
         return float("nan")
 
 
+def exe_command(build, case, dx, t_end, threads, out):
+    return [str(build / "mixsph"), "run", str(ROOT / case), "--threads", str(threads), "--fixed-threads",
+            "--quiet", "--no-csv", "--out", out, "--set", f"numerics.dx={dx!r}", "--set", f"numerics.t_end={t_end!r}"]
+
+
 def run_exe(build, case, dx, t_end, threads, out):
-    cmd = [str(build / "mixsph"), "run", str(ROOT / case), "--threads", str(threads), "--fixed-threads",
-           "--quiet", "--no-csv", "--out", out, "--set", f"numerics.dx={dx!r}", "--set", f"numerics.t_end={t_end!r}"]
+    return run_exe_together(build, case, dx, t_end, [(threads, out)])[0]
+
+
+def run_exe_together(build, case, dx, t_end, runs):
+    """Starts one process per (threads, out) at once and returns each one's wall time."""
     t0 = time.perf_counter()
-    done = subprocess.run(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=clean_env())
-    wall = time.perf_counter() - t0
-    if done.returncode != 0:
-        sys.exit(f"bench_threads: {' '.join(cmd)} failed ({done.returncode}): {done.stderr.strip()}")
-    return wall
+    procs = [subprocess.Popen(exe_command(build, case, dx, t_end, th, out), stdout=subprocess.DEVNULL,
+                              stderr=subprocess.PIPE, text=True, env=clean_env()) for th, out in runs]
+    walls = [None] * len(procs)
+    while any(w is None for w in walls):
+        for i, p in enumerate(procs):
+            if walls[i] is None and p.poll() is not None:
+                walls[i] = time.perf_counter() - t0
+        time.sleep(0.005)
+    for p in procs:
+        if p.returncode != 0:
+            sys.exit(f"bench_threads: {' '.join(p.args)} failed ({p.returncode}): {p.stderr.read().strip()}")
+    return walls
 
 
 def run_fmu(build, case, dx, t_end, threads):
@@ -109,6 +128,8 @@ def main(argv=None):
     ap.add_argument("--modes", default="exe,fmu", help="exe, fmu or both, comma-separated")
     ap.add_argument("--t-end", type=float, default=None, help="end time [s] of every run (default: per run, 0.1 s)")
     ap.add_argument("--json", default=None, help="write every run's record to this file")
+    ap.add_argument("--ceiling", action="store_true",
+                    help="exe mode: per pair also run two 1-thread processes at once (the host's ceiling)")
     ap.add_argument("--fmu-child", default=None, help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.fmu_child:
@@ -133,7 +154,7 @@ def main(argv=None):
             case, dx, t_default, bar = RUNS[name]
             t_end = a.t_end if a.t_end is not None else t_default
             for mode in modes:
-                speedups = []
+                speedups, ceilings = [], []
                 for k in range(a.pairs):
                     order = (1, 2) if k % 2 == 0 else (2, 1)
                     wall, load = {}, {}
@@ -148,9 +169,20 @@ def main(argv=None):
                     speedups.append(wall[1] / wall[2])
                     print(f"{name} {mode} pair {k + 1}: 1 thread {wall[1]:.2f} s (load {load[1]:.2f}), "
                           f"2 threads {wall[2]:.2f} s (load {load[2]:.2f}), speed-up {speedups[-1]:.2f}", flush=True)
+                    if a.ceiling and mode == "exe":
+                        both = run_exe_together(build, case, dx, t_end, [(1, f"{tmp}/{name}_a"), (1, f"{tmp}/{name}_b")])
+                        ceilings.append(2.0 * wall[1] / max(both))
+                        records.append({"run": name, "mode": "two_1_thread_processes", "pair": k + 1,
+                                        "wall_s": both, "t_end": t_end, "dx": dx})
+                        print(f"{name} ceiling pair {k + 1}: two 1-thread runs at once {both[0]:.2f} s and "
+                              f"{both[1]:.2f} s, ceiling 2 t1 / max {ceilings[-1]:.2f}", flush=True)
                 print(f"{name} {mode} (dx {dx}, t_end {t_end} s): speed-up min {min(speedups):.2f}, median "
                       f"{statistics.median(speedups):.2f}, max {max(speedups):.2f} over {len(speedups)} pairs; "
                       f"{sum(s >= bar for s in speedups)} of {len(speedups)} at least {bar}", flush=True)
+                if ceilings:
+                    print(f"{name} ceiling (two independent 1-thread processes at once): min {min(ceilings):.2f}, "
+                          f"median {statistics.median(ceilings):.2f}, max {max(ceilings):.2f}; "
+                          f"{sum(c >= bar for c in ceilings)} of {len(ceilings)} at least {bar}", flush=True)
     if a.json:
         pathlib.Path(a.json).write_text(json.dumps({"machine": machine(), "build": str(build), "runs": records},
                                                    indent=1))
