@@ -419,7 +419,7 @@ static void test_pore_pressure(void **state)
     mixsph_sim_destroy(s);
 }
 
-/* ---- (c) tension cut-off (an option, not the paper's model) ------------------------------- */
+/* ---- (c) tension cut-off (the default; the paper's model has none) ------------------------ */
 
 /* Grains stretched 1 % below and compressed 1 % above the mixture density: with the cut-off the
  * stretched ones get the background pressure (0 here) instead of c^2 (rho - rho0) < 0 (linear EOS,
@@ -452,10 +452,10 @@ static void check_tension(const char *media, int cutoff)
 static void test_tension_cutoff(void **state)
 {
     (void)state;
-    check_tension(DRY_SAND, 0); /* default: off */
+    check_tension(DRY_SAND, 1); /* default: on */
     check_tension("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
-                  "\"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": true }",
-                  1);
+                  "\"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": false }",
+                  0); /* the paper's model */
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
                  "\"mu_thr\": 320e3, \"tension_cutoff\": 2 }",
                  "media.sand.tension_cutoff");
