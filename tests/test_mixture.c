@@ -515,6 +515,39 @@ static void test_hold_fixed(void **state)
                  "media.sand.alpha_m");
 }
 
+/* ---- (d2) a grain thrown clear: the density of a particle alone ----------------------------- */
+
+/* The bed's top right grain leaves it at 40 m/s with the density of a grain already far from the
+ * others (1.001 m W(0), W(0) the kernel's value at r = 0). The continuity equation, which has no
+ * self term, takes its density below m W(0) in one step (asserted: the rate times the step), where
+ * the summation density sum_j m_j W_ij cannot go (its own term alone is m W(0)): the step clamps
+ * it there instead of ending the run with a non-positive density (docs/numerics.md 2d). */
+static void test_density_of_a_particle_alone(void **state)
+{
+    (void)state;
+    mixsph_sim *s = create_ok(DRY_SAND);
+    struct particles *P = &s->phys.P;
+    size_t top = P->n;
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i) && (top == P->n || P->x[i] + P->z[i] > P->x[top] + P->z[top])) top = i;
+    const unsigned id = P->id[top];
+    const double floor_rho = P->m[top] * kernel_w(&s->phys.K, 0.0);
+    P->rho[top] = 1.001 * floor_rho;
+    P->vx[top] = P->vz[top] = 40.0 / sqrt(2.0);
+    integrate_pressure_and_derived(s);
+    const double dt = s->phys.dt;
+    assert_int_equal(integrate_step(s), MIXSPH_OK);
+    size_t k = 0;
+    while (P->id[k] != id) k++;
+    print_message("grain %u: rho = %.6g, m W(0) = %.6g, unclamped %.6g (drho %.6g, dt %.3g s)\n", id, P->rho[k],
+                  floor_rho, 1.001 * floor_rho + dt * P->drho[k], P->drho[k], dt);
+    assert_true(1.001 * floor_rho + dt * P->drho[k] < floor_rho); /* the continuity equation alone crosses it */
+    assert_true(P->rho[k] == floor_rho);
+    for (size_t i = 0; i < P->n; i++)
+        if (is_grain(s, i)) assert_true(P->rho[i] >= P->m[i] * kernel_w(&s->phys.K, 0.0));
+    mixsph_sim_destroy(s);
+}
+
 /* ---- (e) fixed bed (numerics.fixed_bed_speed, SPHERA's rule) ------------------------------- */
 
 #define V_FB 0.0125 /* [m/s] the fixed-bed speed of SPHERA's erosive dam-break input */
@@ -652,6 +685,7 @@ int main(void)
         cmocka_unit_test(test_parse_mu1),      cmocka_unit_test(test_parse_errors),
         cmocka_unit_test(test_transitions),    cmocka_unit_test(test_pore_pressure),
         cmocka_unit_test(test_tension_cutoff), cmocka_unit_test(test_hold_fixed),
+        cmocka_unit_test(test_density_of_a_particle_alone),
         cmocka_unit_test(test_fixed_bed),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
