@@ -621,6 +621,14 @@ static void test_table_variants(void **state)
                       ORIGIN ": monitors.front.medium: a wall_pressure monitor does not take this key");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"", "\"type\": \"wall_pressure\"",
                       ORIGIN ": monitors.front.wall: missing (expected a string)");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"", "\"type\": \"wall_work\"",
+                      ORIGIN ": monitors.front.wall: missing (expected a string)");
+    /* a pressure probe takes a wall (a sensor on it) but needs none; it needs its point */
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"pressure_probe\", \"x\": 0.1", ORIGIN ": monitors.front.z: missing (expected a number)");
+    EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
+                      "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"x\": 0.1",
+                      ORIGIN ": monitors.front.x: a wall_pressure monitor does not take this key (only pressure_probe)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"front\", \"direction\": \"+x\"", ORIGIN ": monitors.front.medium: missing (expected a string)");
 }
@@ -807,7 +815,8 @@ static void test_parameters(void **state)
  * its four wall_pressure monitors P1-P4 sit on the tank's downstream wall (x = 1.61 m) around the
  * paper's sensor heights, 3, 15, 30 and 80 mm, and at dx = 0.01 and 0.005 each window holds at
  * least one particle of the wall's first layer (a window without one would read NaN for the whole
- * run); parameters.H sets the column's height (0.6 x H of water: 1,800 particles at H = 0.3 and
+ * run); the pressure probes P1_probe-P4_probe are sensors on that wall at those heights, dry at
+ * t = 0 (the water is 1 m away); parameters.H sets the column's height (0.6 x H of water: 1,800 particles at H = 0.3 and
  * 3,600 at H = 0.6, dx = 0.01). */
 static void test_lobovsky_case(void **state)
 {
@@ -828,6 +837,16 @@ static void test_lobovsky_case(void **state)
         assert_string_equal(c.walls[md->wall].name, "tank");
         assert_true(md->z_min < z_sensor[k] && z_sensor[k] < md->z_max);
         assert_true(md->x_min < x_wall && x_wall < md->x_max);
+        /* and the probe at the sensor: on the same wall, at the sensor's height */
+        char probe[CASE_NAME_LEN];
+        snprintf(probe, sizeof probe, "%s_probe", names[k]);
+        md = NULL;
+        for (size_t m = 0; m < c.n_monitors; m++)
+            if (strcmp(c.monitors[m].name, probe) == 0) md = &c.monitors[m];
+        assert_non_null(md);
+        assert_int_equal(md->kind, MONITOR_PRESSURE_PROBE);
+        assert_string_equal(c.walls[md->wall].name, "tank");
+        assert_true(md->point_x == x_wall && md->point_z == z_sensor[k]);
     }
     case_free(&c);
     free(text);
@@ -840,6 +859,11 @@ static void test_lobovsky_case(void **state)
             const long o = mixsph_sim_output_find(s, names[k]);
             assert_true(o >= 0);
             assert_true(isfinite(mixsph_sim_output_value(s, (size_t)o)));
+            char probe[CASE_NAME_LEN];
+            snprintf(probe, sizeof probe, "%s_probe", names[k]);
+            const long q = mixsph_sim_output_find(s, probe);
+            assert_true(q >= 0);
+            assert_true(mixsph_sim_output_value(s, (size_t)q) == 0.0); /* dry until the front arrives */
         }
         mixsph_sim_destroy(s);
     }

@@ -16,8 +16,10 @@ The numbers below are those found in public transcriptions of the paper (REFEREN
 comes from: docs/validation/dambreak_lobovsky.md); a sensor without one is compared with nothing.
 
 For each H and each density diffusion (off: numerics.density_diffusion = 0; on: the case's
-default) the case is run and its monitors P1-P4 (the highest pressure of the wall's first layer
-of particles within 6 mm of the sensor's height, at every time step) are read:
+default) the case is run and each sensor is read, at every time step, by two monitors: the
+pressure probe <s>_probe (the fluid's pressure interpolated by the kernel at the sensor's height,
+1.5 h from the wall: docs/model.md section 9) and the wall monitor <s> (the highest pressure of
+the wall's first layer of particles within 6 mm of the sensor's height). For each signal:
 
 - arrival: the first sample above ARRIVAL x rho g H (the sensor is wet; before it, 0);
 - first peak: the largest sample within PEAK_WINDOW s after the arrival, and its time; also the
@@ -33,8 +35,8 @@ over the snapshots (every 0.01 s) and the rms after removing each layer's mean (
 tools/hydrostatic_noise.py measures the hydrostatic tank: the pressure noise of the column before
 it is released.
 
-Prints the tables, writes OUT/dambreak_lobovsky_dx<dx>.csv (one row per H, diffusion and
-sensor) and draws OUT/dambreak_lobovsky_dx<dx>.png (pressure at each sensor against time, the
+Prints the tables, writes OUT/dambreak_lobovsky_dx<dx>.csv (one row per H, diffusion,
+sensor and monitor) and draws OUT/dambreak_lobovsky_dx<dx>.png (pressure at each sensor against time, the
 measured median and band). --reuse reads existing output folders instead of running. Exit status 0; 1 when a run
 failed (its numbers up to the failure are still given); 2 bad usage.
 """
@@ -55,6 +57,8 @@ from tools.mixsph_tools.readers import ToolError, read_monitors, read_summary, r
 CASE = "cases/dambreak_lobovsky.json"
 RHO0, G = 1000.0, 9.81
 SENSORS = ("P1", "P2", "P3", "P4")
+# The monitors reading each sensor s: (label, column of monitors.csv)
+MONITORS = (("probe", "{}_probe"), ("wall", "{}"))
 HEIGHTS_MM = {"P1": 3.0, "P2": 15.0, "P3": 30.0, "P4": 80.0}
 ARRIVAL = 0.05       # x rho g H: a sensor counts as wet above this pressure
 PEAK_WINDOW = 0.02   # s after the arrival in which the first peak is sought (about 3 times the
@@ -171,31 +175,40 @@ def impact_runs(a, status):
                 info["steps"] = float(summ.get("steps", float("nan")))
             except ToolError:
                 pass
-            sig = {s: mon[s] for s in SENSORS if s in mon}
-            stats = {s: sensor_stats(mon["t"], sig[s], H) for s in sig}
+            sig = {(kind, s): mon[col.format(s)] for kind, col in MONITORS for s in SENSORS if col.format(s) in mon}
+            stats = {k: sensor_stats(mon["t"], sig[k], H) for k in sig}
             res[(H, label)] = (mon["t"], sig, stats, info)
     return res
 
 
+def in_band(peak, ref):
+    """'yes' / 'no' whether a peak lies in the measured 2.5-97.5 % band, '-' without one."""
+    if not ref or ref[1] is None or not math.isfinite(peak):
+        return "-"
+    return "yes" if ref[1] * MBAR <= peak <= ref[2] * MBAR else "no"
+
+
 def print_impacts(res):
     print("\nFirst pressure peak at the downstream wall's sensors (Pa; times from the release, s)")
-    print(f"{'H [m]':>5s} {'diff':>4s} {'sensor':>6s} {'arrival':>8s} {'first peak':>10s} {'at t':>7s} "
+    print(f"{'H [m]':>5s} {'diff':>4s} {'sensor':>6s} {'monitor':>7s} {'arrival':>8s} {'first peak':>10s} {'at t':>7s} "
           f"{'1 ms mean':>9s} {'width ms':>8s} {'after':>7s} {'max run':>9s} {'at t':>7s} {'exp. median':>11s} {'exp. 2.5-97.5 %':>16s} "
-          f"{'peak/median':>11s}")
+          f"{'peak/median':>11s} {'in band':>7s}")
     rows = []
     for (H, label), (_, _, stats, info) in sorted(res.items()):
-        for s, st in stats.items():
+        for (kind, s), st in sorted(stats.items(), key=lambda kv: (kv[0][1], kv[0][0])):
             ref = REFERENCE.get(H, {}).get(s)
             med = ref[0] * MBAR if ref else None
             band = f"{ref[1] * MBAR:.0f}-{ref[2] * MBAR:.0f}" if ref and ref[1] is not None else "-"
             ratio = st["peak"] / med if med else None
-            print(f"{H:5g} {label:>4s} {s:>6s} {fmt(st['t_arrival'], '8.4f')} {fmt(st['peak'], '10.0f')} "
+            print(f"{H:5g} {label:>4s} {s:>6s} {kind:>7s} {fmt(st['t_arrival'], '8.4f')} {fmt(st['peak'], '10.0f')} "
                   f"{fmt(st['t_peak'], '7.4f')} {fmt(st['peak_smooth'], '9.0f')} {fmt(1e3 * st['width'], '8.1f')} "
                   f"{fmt(st['mean_after'], '7.0f')} {fmt(st['max'], '9.0f')} "
-                  f"{fmt(st['t_max'], '7.4f')} {fmt(med, '11.0f')} {band:>16s} {fmt(ratio, '11.2f')}")
-            rows.append({"H": H, "diffusion": label, "sensor": s, "z_mm": HEIGHTS_MM[s], **st,
+                  f"{fmt(st['t_max'], '7.4f')} {fmt(med, '11.0f')} {band:>16s} {fmt(ratio, '11.2f')} "
+                  f"{in_band(st['peak'], ref):>7s}")
+            rows.append({"H": H, "diffusion": label, "sensor": s, "monitor": kind, "z_mm": HEIGHTS_MM[s], **st,
                          "exp_median": med, "exp_p2_5": ref[1] * MBAR if ref and ref[1] is not None else None,
-                         "exp_p97_5": ref[2] * MBAR if ref and ref[2] is not None else None})
+                         "exp_p97_5": ref[2] * MBAR if ref and ref[2] is not None else None,
+                         "in_band": in_band(st["peak"], ref)})
         print(f"{'':5s} {'':4s} run to t = {info['t_last']:.4f} s, {info['steps']:.0f} steps, "
               f"{info['wall_time']:.1f} s wall time")
     return rows
@@ -255,16 +268,22 @@ def plot(res, path):
                 if (H, label) not in res:
                     continue
                 t, sig, stats, _ = res[(H, label)]
-                if s not in sig:
-                    continue
-                ax.plot(t, sig[s], lw=0.6, color=colours[label], label=f"diffusion {label}")
-                st = stats[s]
-                if math.isfinite(st["peak"]):
-                    ax.plot(st["t_peak"], st["peak"], "o", ms=4, color=colours[label])
-            arrivals = [res[k][2][s]["t_arrival"] for k in res if k[0] == H and s in res[k][2]]
+                for kind, style in (("wall", dict(lw=0.4, alpha=0.45, ls=":")), ("probe", dict(lw=0.7))):
+                    if (kind, s) not in sig:
+                        continue
+                    ax.plot(t, sig[(kind, s)], color=colours[label], label=f"{kind}, diffusion {label}", **style)
+                    st = stats[(kind, s)]
+                    if kind == "probe" and math.isfinite(st["peak"]):
+                        ax.plot(st["t_peak"], st["peak"], "o", ms=4, color=colours[label])
+            arrivals = [res[k][2][("probe", s)]["t_arrival"] for k in res if k[0] == H and ("probe", s) in res[k][2]]
             arrivals = [x for x in arrivals if math.isfinite(x)]
             if arrivals:
                 ax.set_xlim(min(arrivals) - 0.05, min(arrivals) + 0.35)
+            # the scale of the probes and the measured band (the wall monitor's spikes run off it)
+            tops = [res[k][2][("probe", s)]["max"] for k in res if k[0] == H and ("probe", s) in res[k][2]]
+            tops = [x for x in tops if math.isfinite(x)] + ([ref[2] * MBAR] if ref and ref[1] is not None else [])
+            if tops:
+                ax.set_ylim(-0.1 * max(tops), 1.3 * max(tops))
             ax.set_title(f"H = {H:g} m, {s} (z = {HEIGHTS_MM[s]:g} mm)", fontsize=9)
             ax.set_xlabel("t [s]")
             ax.set_ylabel("p [Pa]")

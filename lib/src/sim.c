@@ -310,7 +310,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after the neighbour lists", s->cfg.origin);
     if ((st = integrate_build_gather_lists(s)) != MIXSPH_OK) return st;
     if ((st = integrate_initial_rates(s)) != MIXSPH_OK) return st;
-    monitors_init(s);
+    if ((st = monitors_init(s)) != MIXSPH_OK) return st;
     s->out.next_sample = 0.0;
     s->out.next_snapshot = 0.0;
     return MIXSPH_OK;

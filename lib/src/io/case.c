@@ -439,8 +439,11 @@ static mixsph_status read_monitors(const struct case_reader *r, const cJSON *roo
         TRY(case_schema_read(r, it, path, sec, 1u << md->kind, md));
         if (!(md->x_max > md->x_min) || !(md->z_max > md->z_min))
             return FAIL(r, "%s: %s: expected x_min < x_max and z_min < z_max", r->origin, path);
-        if (md->kind == MONITOR_WALL_PRESSURE || md->kind == MONITOR_WALL_WORK) {
-            const char *wall = item(it, "wall")->valuestring;
+        if (md->kind == MONITOR_WALL_PRESSURE || md->kind == MONITOR_WALL_WORK || md->kind == MONITOR_PRESSURE_PROBE) {
+            const cJSON *w = item(it, "wall");
+            if (!w && md->kind == MONITOR_PRESSURE_PROBE) continue; /* a point in the flow */
+            if (!w) return FAIL(r, "%s: %s.wall: missing (expected a string)", r->origin, path);
+            const char *wall = w->valuestring;
             md->wall = find_wall(c, wall);
             if (md->wall < 0) return FAIL(r, "%s: %s.wall: '%s' is not one of the walls", r->origin, path, wall);
             continue;

@@ -31,14 +31,17 @@ enum monitor_kind {
     MONITOR_PROFILE = 2,
     MONITOR_WALL_PRESSURE = 3,
     MONITOR_KINETIC_ENERGY = 4,
-    MONITOR_WALL_WORK = 5
+    MONITOR_WALL_WORK = 5,
+    MONITOR_PRESSURE_PROBE = 6
 };
 
 struct monitor_def {
     char name[CASE_NAME_LEN];
     int kind;                 /* enum monitor_kind */
-    int medium;               /* index into media (-1 for wall_pressure and wall_work) */
-    int wall;                 /* wall_pressure, wall_work: index into walls */
+    int medium;               /* index into media (-1 for wall_pressure, wall_work and pressure_probe) */
+    int wall;                 /* wall_pressure, wall_work: index into walls; pressure_probe: the wall the
+                                 sensor (point_x, point_z) sits on, -1 for a point in the flow */
+    double point_x, point_z;  /* pressure_probe: the point [m] (on a wall: the sensor, at t = 0) */
     int direction;            /* front: +1 largest x, -1 smallest x */
     double x_min, x_max;      /* region [m] (infinite when not given) */
     double z_min, z_max;

@@ -47,6 +47,7 @@ static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
                                                    {"profile", MONITOR_PROFILE},
                                                    {"wall_pressure", MONITOR_WALL_PRESSURE},
                                                    {"wall_work", MONITOR_WALL_WORK},
+                                                   {"pressure_probe", MONITOR_PRESSURE_PROBE},
                                                    {NULL, 0}};
 
 /* ---- the tables ------------------------------------------------------------------------------ */
@@ -219,8 +220,15 @@ static const struct case_key monitor_keys[] = {
      .field = CASE_FIELD(monitor_def, kind), .meaning = "what the monitor measures (below)"},
     {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .only = MEDIUM_MONITORS,
      .meaning = "name of one of the media"},
-    {.key = "wall", .type = CASE_NAME, .need = CASE_REQUIRED, .only = WALL_MONITORS,
-     .meaning = "name of one of the walls"},
+    {.key = "wall", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "wall_pressure, wall_work",
+     .only = WALL_MONITORS | V(MONITOR_PRESSURE_PROBE),
+     .meaning = "name of one of the walls (pressure_probe: the wall whose sensor the point is; without it the point "
+                "is in the flow)"},
+    {.key = "x", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
+     .field = CASE_FIELD(monitor_def, point_x),
+     .meaning = "the probe's point: with `wall`, the sensor's place on that wall (at t = 0), within dx/2 of it"},
+    {.key = "z", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
+     .field = CASE_FIELD(monitor_def, point_z), .meaning = "height of the probe's point"},
     {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions, .only = V(MONITOR_FRONT),
      .field = CASE_FIELD(monitor_def, direction), .meaning = "\"+x\": the largest x of the medium, \"-x\": the smallest"},
     {.key = "min_neighbours", .type = CASE_INTEGER, RANGE(0, 0, 100, 0), DEF(3), .unit = "-", .only = PARTICLE_MONITORS,

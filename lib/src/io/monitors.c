@@ -5,6 +5,15 @@
  *                    region covers the opposite slope);
  *   wall_pressure  - the highest pressure of the first layer of a wall's particles in the region;
  *   wall_work      - the work a wall has done on the particles since t = 0 (walls.h, walls_move);
+ *   pressure_probe - the fluid's pressure at a point, as SPH codes' gauges read it (DualSPHysics's
+ *                    MeasureTool): the Shepard-normalised kernel interpolation over the non-wall
+ *                    particles j within 2h of the point r,
+ *                        p(r) = sum_j p_j V_j W(r - r_j) / sum_j V_j W(r - r_j),  V_j = m_j / rho_j,
+ *                    and 0 ("dry") while the kernel sum sum_j V_j W(r - r_j) is below
+ *                    PROBE_WET_KERNEL_SUM. A probe on a wall (key `wall`) is a sensor on the
+ *                    wall's face: it reads at the point on the wall nearest to the sensor, moved
+ *                    with the wall and then PROBE_WALL_STANDOFF_OVER_H h into the fluid along the
+ *                    wall's normal (docs/model.md section 9);
  *   profile        - at given times, the top of a medium (highest particle centre + dx/2) in bins
  *                    of x, written to profile_<name>_<k>.csv (free surface, landslide surface,
  *                    mixture-water interface).
@@ -30,6 +39,15 @@
 #include "particle_fields.h"
 
 #include "status.h"
+
+/* A pressure probe on a wall reads 1.5 h from the wall into the fluid, the standoff of the
+ * pressure points of DualSPHysics's dam-break example (0.9 - 0.8779 m = 1.5 h with its
+ * h = sqrt(3) 0.0085 m), where the point's kernel support lies almost wholly on the fluid side
+ * (a point on the wall itself has half its support in the wall and no fluid there). */
+#define PROBE_WALL_STANDOFF_OVER_H 1.5
+/* Kernel sum sum_j V_j W below which a probe is dry and reads 0 (DualSPHysics's MeasureTool:
+ * -kclimit:0.5 -kcusedummy:0 in its examples): half of a full support's sum, 1. */
+#define PROBE_WET_KERNEL_SUM 0.5
 
 /* Diagnostics; the last two (the implicit viscous solve's) only with numerics.viscosity = "implicit". */
 enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_VISC_ITER, OUT_VISC_RES, OUT_N_DIAG };
@@ -58,8 +76,87 @@ static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffi
     memcpy(s->out.name[s->out.n++], name, CASE_NAME_LEN);
 }
 
-void monitors_init(mixsph_sim *s)
+/* The point a pressure probe reads at now [m]: its point in the flow; on a wall, the point of the
+ * wall nearest to the sensor (both moved with the wall), moved into the fluid along the wall's
+ * normal by the standoff. */
+static void probe_point(const mixsph_sim *s, const struct monitor_def *md, double *x, double *z)
 {
+    *x = md->point_x;
+    *z = md->point_z;
+    if (md->wall < 0) return;
+    const struct walls *W = &s->phys.walls;
+    const double xs = md->point_x + W->state[md->wall].ox, zs = md->point_z + W->state[md->wall].oz;
+    double d, nx, nz;
+    int at_end;
+    walls_signed_distance(W, (size_t)md->wall, xs, zs, &d, &at_end);
+    walls_normal(W, (size_t)md->wall, xs, zs, &nx, &nz);
+    const double move = PROBE_WALL_STANDOFF_OVER_H * s->phys.h - d; /* d: the sensor's distance from the wall */
+    *x = xs + move * nx;
+    *z = zs + move * nz;
+}
+
+/* The fluid's pressure at (x, z) [Pa]: the Shepard-normalised kernel interpolation over the
+ * non-wall particles (head of the file), 0 when dry. The candidates are those of the cell
+ * list's stencil around the point: the cells describe the positions of the last build, and no
+ * particle has moved skin/2 since, so every particle now within 2h of the point is in it. */
+static double probe_pressure(const mixsph_sim *s, double x, double z)
+{
+    const struct cells *C = &s->work.C;
+    const struct particles *P = &s->phys.P;
+    const struct kernel *K = &s->phys.K;
+    if (!(x >= C->x0 && z >= C->z0)) return 0.0; /* a moving wall's probe carried off the grid */
+    int ix, iz;
+    cells_coords(C, x, z, &ix, &iz);
+    if (ix >= C->nx || iz >= C->nz) return 0.0;
+    double sw = 0.0, swp = 0.0;
+    for (int row = -1; row <= 1; row++) {
+        const struct range rg = cells_row(C, ix, iz, row);
+        for (size_t j = rg.begin; j < rg.end; j++) {
+            if (P->state[j] > MIXSPH_STATE_FIXED) continue;
+            const double rx = x - P->x[j], rz = z - P->z[j], r2 = rx * rx + rz * rz;
+            if (r2 >= K->r2max) continue;
+            const double w = kernel_w(K, sqrt(r2)) * P->m[j] / P->rho[j];
+            sw += w;
+            swp += w * P->p[j];
+        }
+    }
+    return sw >= PROBE_WET_KERNEL_SUM ? swp / sw : 0.0;
+}
+
+/* A pressure probe's definition against the simulation: a sensor lies on its wall, beside it
+ * (not beyond an open end), and the point read lies inside the domain. */
+static mixsph_status probe_check(mixsph_sim *s, const struct monitor_def *md)
+{
+    const struct case_def *c = &s->cfg;
+    if (md->wall >= 0) {
+        double d;
+        int at_end;
+        const struct wall_state *ws = &s->phys.walls.state[md->wall]; /* the point is given at t = 0 */
+        walls_signed_distance(&s->phys.walls, (size_t)md->wall, md->point_x + ws->ox, md->point_z + ws->oz, &d, &at_end);
+        if (at_end || !(fabs(d) <= 0.5 * s->phys.dx))
+            return SIM_FAIL(s, MIXSPH_ERR_CASE,
+                            "%s: monitors.%s: the point (%g, %g) is not on the wall '%s' (%.3g m from it%s); a "
+                            "pressure_probe with a wall is a sensor on it: its point within dx/2 = %g m of the wall",
+                            c->origin, md->name, md->point_x, md->point_z, c->walls[md->wall].name, fabs(d),
+                            at_end ? ", beyond its end" : "", 0.5 * s->phys.dx);
+    }
+    double x, z;
+    probe_point(s, md, &x, &z);
+    const double *dom = c->has_domain ? c->domain : s->phys.domain;
+    if (!(x >= dom[0] && x < dom[1] && z >= dom[2] && z < dom[3]))
+        return SIM_FAIL(s, MIXSPH_ERR_CASE,
+                        "%s: monitors.%s: the point the probe reads at, (%g, %g), is outside the domain [%g, %g] x "
+                        "[%g, %g]", c->origin, md->name, x, z, dom[0], dom[1], dom[2], dom[3]);
+    return MIXSPH_OK;
+}
+
+mixsph_status monitors_init(mixsph_sim *s)
+{
+    for (size_t k = 0; k < s->cfg.n_monitors; k++)
+        if (s->cfg.monitors[k].kind == MONITOR_PRESSURE_PROBE) {
+            const mixsph_status st = probe_check(s, &s->cfg.monitors[k]);
+            if (st != MIXSPH_OK) return st;
+        }
     s->out.n = 0;
     const size_t n_diag = s->cfg.viscosity_implicit ? OUT_N_DIAG : OUT_VISC_ITER;
     for (size_t k = 0; k < n_diag; k++) {
@@ -82,6 +179,7 @@ void monitors_init(mixsph_sim *s)
         s->out.tmax[k] = s->out.tmin[k] = NAN;
     }
     s->out.n_samples = 0;
+    return MIXSPH_OK;
 }
 
 static int in_region(const struct monitor_def *md, double x, double z)
@@ -105,6 +203,11 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
         return best;
     }
     if (md->kind == MONITOR_WALL_WORK) return s->phys.walls.state[md->wall].work;
+    if (md->kind == MONITOR_PRESSURE_PROBE) {
+        double x, z;
+        probe_point(s, md, &x, &z);
+        return probe_pressure(s, x, z);
+    }
     if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
         double e = 0.0;
         for (size_t i = 0; i < P->n; i++)

@@ -6,8 +6,9 @@
 
 #include "sim_object.h"
 
-/** Names and kinds of the outputs from the case (after creation). */
-void monitors_init(mixsph_sim *s);
+/** Names and kinds of the outputs from the case (after creation); MIXSPH_ERR_CASE, with a
+ *  message, for a pressure probe off its wall or outside the domain. */
+mixsph_status monitors_init(mixsph_sim *s);
 /** Current value of output k. */
 double monitors_value(const mixsph_sim *s, size_t k);
 /** Take a sample of every output (extremes, a row of monitors.csv). */
