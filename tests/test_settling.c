@@ -23,7 +23,10 @@
  * first row of particles above a wall lies at dx/2). Under granular_column the block sinks too (a
  * submerged block is not held up; what granular_column changes is the strength (a)).
  *
- * (c) A value of pore_pressure that is not a choice is refused, naming the key. */
+ * (c) A value of pore_pressure that is not a choice is refused, naming the key.
+ *
+ * (d) A single grain released at the free surface sinks: not met, a known failure
+ * (`test_settling known_failure surface_grain`; below). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -35,6 +38,7 @@
 
 #include <cmocka.h>
 
+#include "known_failure.h"
 #include "pore_pressure.h"
 #include "sim.h"
 
@@ -44,9 +48,10 @@
 #define POR 0.4
 #define Z_SURFACE 0.3 /* the water's free surface [m] */
 
-/* A tank 0.4 m wide of water Z_SURFACE deep, a block of dry gravel (the slide flume's) of width
- * 0.1 m from x = 0.15 m, between z_lo and z_hi; `extra` is added to the gravel's keys. */
-static const char *tank_json(double z_lo, double z_hi, const char *extra)
+/* A tank 0.4 m wide of water Z_SURFACE deep, a block of dry gravel (the slide flume's) between x_lo
+ * and x_hi and between z_lo and z_hi (its sites take the place of the water's); `extra` is added to
+ * the gravel's keys. */
+static const char *grains_json(double x_lo, double x_hi, double z_lo, double z_hi, const char *extra)
 {
     static char buf[2048];
     snprintf(buf, sizeof buf,
@@ -57,13 +62,19 @@ static const char *tank_json(double z_lo, double z_hi, const char *extra)
              "              \"gravel\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.4,"
              "                          \"phi\": 35.0, \"mu_thr\": 320.0e3, \"mu0\": 5.0e3, \"alpha_m\": 0.0 %s } },"
              "  \"bodies\": { \"block\": { \"medium\": \"gravel\","
-             "                             \"polygon\": [[0.15, %.9g], [0.25, %.9g], [0.25, %.9g], [0.15, %.9g]] },"
+             "                             \"polygon\": [[%.9g, %.9g], [%.9g, %.9g], [%.9g, %.9g], [%.9g, %.9g]] },"
              "               \"tank\": { \"medium\": \"water\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.4, 0.3], [0.0, 0.3]] } },"
              "  \"walls\": { \"box\": { \"polyline\": [[0.0, 0.5], [0.0, 0.0], [0.4, 0.0], [0.4, 0.5]],"
              "                        \"fluid_side\": \"left\" } },"
              "  \"domain\": { \"x_min\": -0.05, \"x_max\": 0.45, \"z_min\": -0.05, \"z_max\": 0.5 } }",
-             extra, z_lo, z_lo, z_hi, z_hi);
+             extra, x_lo, z_lo, x_hi, z_lo, x_hi, z_hi, x_lo, z_hi);
     return buf;
+}
+
+/* The block of (a) and (b): 0.1 m wide from x = 0.15 m. */
+static const char *tank_json(double z_lo, double z_hi, const char *extra)
+{
+    return grains_json(0.15, 0.25, z_lo, z_hi, extra);
 }
 
 static mixsph_sim *create_ok(const char *json)
@@ -171,8 +182,71 @@ static void test_bad_value(void **state)
     assert_non_null(strstr(err, "media.gravel.pore_pressure"));
 }
 
-int main(void)
+/* One grain of dry gravel in the water's top row (the site centred at x = 0.205 m, z = 0.295 m),
+ * released at rest under granular law number `law`: its descent below where it started after
+ * t_end [m], and how high it then lies above the highest water particle within dx of it across [m]. */
+static double surface_grain_descent(int law, double t_end, double *above_water)
 {
+    char extra[128];
+    snprintf(extra, sizeof extra, ", \"law\": %d", law);
+    mixsph_sim *s = create_ok(grains_json(0.20, 0.21, 0.29, 0.30, extra));
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* 1,300 particles: one thread is enough */
+    assert_int_equal(mixsph_sim_advance_to(s, t_end), MIXSPH_OK);
+    const struct particles *P = &s->phys.P;
+    double zg = NAN, xg = NAN;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 1) {
+            zg = P->z[i];
+            xg = P->x[i];
+        }
+    double top = -INFINITY;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 0 && fabs(P->x[i] - xg) <= 0.01)
+            top = fmax(top, P->z[i]);
+    *above_water = zg - top;
+    mixsph_sim_destroy(s);
+    return 0.295 - zg;
+}
+
+/* (d) A single grain at the free surface sinks: the criterion of issue 45 (no grain rides the
+ * surface) at the scale of one particle. Reference: a body of 1590 kg/m3 in water sinks (a
+ * continuum has no state in which it floats); the criterion asks it to be at least 2 dx below
+ * where it started after 0.5 s, under the water's top row (a heavier particle does that: a fluid
+ * particle of 3000 kg/m3 in the same place goes down 0.020 m in 0.5 s, one of 5000 kg/m3 0.048 m;
+ * docs/validation/slide_flume.md, "Why single grains ride the surface"). NOT MET (12-06): under
+ * both laws the grain settles onto the water and lies on it, about 0.9 dx above the highest water
+ * particle within dx of it across, its descent 0.0031 m (paper) and 0.0026 m (elastic-plastic)
+ * after 0.5 s; so does a fluid particle of 1590 or 2000 kg/m3, with no granular law at all. Kept as
+ * a known failure with today's band: the smaller descent of the two laws, 0.0026 m, +- 0.008 m. */
+static void test_surface_grain_sinks(void **state)
+{
+    (void)state;
+    const char *laws[] = {"paper", "elastic_plastic"};
+    double worst = INFINITY;
+    for (int k = 0; k < 2; k++) {
+        double above;
+        const double d = surface_grain_descent(k, 0.5, &above);
+        print_message("%s: a grain released in the top row has gone down %.4f m after 0.5 s and lies %.4f m above "
+                      "the highest water particle within dx of it across\n", laws[k], d, above);
+        worst = fmin(worst, d);
+    }
+    known_failure_check("a dry gravel grain released at the free surface, its descent after 0.5 s [m] (the smaller "
+                        "of the two laws)",
+                        worst >= 0.02, worst, -0.005, 0.011);
+}
+
+/* `test_settling` runs the tests the model meets; `test_settling known_failure surface_grain` the
+ * criterion it does not meet yet (a test of its own in CTest). */
+int main(int argc, char **argv)
+{
+    if (argc > 2 && strcmp(argv[1], "known_failure") == 0) {
+        if (strcmp(argv[2], "surface_grain") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_surface_grain_sinks)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
+        fprintf(stderr, "test_settling: unknown known_failure '%s' (surface_grain)\n", argv[2]);
+        return 2;
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_buoyant_weight),
         cmocka_unit_test(test_block_sinks),
