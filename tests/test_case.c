@@ -665,7 +665,7 @@ static void test_table_defaults(void **state)
     const struct medium *sand = &c.media[1];
     assert_int_equal(sand->law, LAW_MIXTURE_PAPER);
     assert_true(sand->mu0 == INFINITY && sand->alpha_m == 0.0);
-    assert_true(sand->saturated == 0 && sand->tension_cutoff == 1 && sand->hold_fixed == 0 && sand->pore_fluid == -1);
+    assert_true(sand->saturated == 0 && sand->tension_cutoff == 0 && sand->hold_fixed == 0 && sand->pore_fluid == -1);
     assert_true(sand->rho0 == (1.0 - 0.35) * 2650.0);
     case_free(&c);
     /* the front's direction and a full_scale unit */

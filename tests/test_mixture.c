@@ -419,7 +419,7 @@ static void test_pore_pressure(void **state)
     mixsph_sim_destroy(s);
 }
 
-/* ---- (c) tension cut-off (the default; the paper's model has none) ------------------------ */
+/* ---- (c) tension cut-off (an option, not the paper's model) ------------------------------- */
 
 /* Grains stretched 1 % below and compressed 1 % above the mixture density: with the cut-off the
  * stretched ones get the background pressure (0 here) instead of c^2 (rho - rho0) < 0 (linear EOS,
@@ -452,10 +452,10 @@ static void check_tension(const char *media, int cutoff)
 static void test_tension_cutoff(void **state)
 {
     (void)state;
-    check_tension(DRY_SAND, 1); /* default: on */
+    check_tension(DRY_SAND, 0); /* default: off, the paper's model */
     check_tension("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
-                  "\"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": false }",
-                  0); /* the paper's model */
+                  "\"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": true }",
+                  1);
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
                  "\"mu_thr\": 320e3, \"tension_cutoff\": 2 }",
                  "media.sand.tension_cutoff");
@@ -521,11 +521,13 @@ static void test_hold_fixed(void **state)
  * others (1.001 m W(0), W(0) the kernel's value at r = 0). The continuity equation, which has no
  * self term, takes its density below m W(0) in one step (asserted: the rate times the step), where
  * the summation density sum_j m_j W_ij cannot go (its own term alone is m W(0)): the step clamps
- * it there instead of ending the run with a non-positive density (docs/numerics.md 2d). */
+ * it there instead of ending the run with a non-positive density (docs/numerics.md 2d). Only a
+ * medium with the tension cut-off has the floor. */
 static void test_density_of_a_particle_alone(void **state)
 {
     (void)state;
-    mixsph_sim *s = create_ok(DRY_SAND);
+    mixsph_sim *s = create_ok("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, "
+                              "\"phi\": 35.0, \"mu_thr\": 320e3, \"mu0\": 5e3, \"tension_cutoff\": true }");
     struct particles *P = &s->phys.P;
     size_t top = P->n;
     for (size_t i = 0; i < P->n; i++)

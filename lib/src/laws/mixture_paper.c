@@ -19,7 +19,7 @@
  * particles around it (the paper), extrapolated hydrostatically as at walls:
  *   p_i = sum_j (p_j + rho_j g (z_j - z_i)) W_ij / sum_j W_ij  over mobile granular j;
  * with no such neighbour it keeps the pressure of its own density. A medium with
- * `tension_cutoff` (the default; the paper's model has none) has its pressure floored at the
+ * `tension_cutoff` (an option; the paper's model has none) has its pressure floored at the
  * background pressure here and in the equation of state (integrate.c).
  *
  * Fixed bed (numerics.fixed_bed_speed = v_fb >= 0; off by default): SPHERA's rule for a granular
@@ -82,10 +82,10 @@ static const struct case_key granular_keys[] = {
      .meaning = "limiting viscosity μ0: μ_app between μ0 and μ_thr is replaced by μ0; μ0 ≥ μ_thr: no limit"},
     {.key = "mu1", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 1e12, 0), .unit = "Pa s",
      .meaning = "instead of mu_thr and mu0: the rheology of Run 7, μ_thr = μ1 without a limit"},
-    {.key = "tension_cutoff", .type = CASE_BOOL, SCHEMA_DEF(1), .field = CASE_FIELD(medium, tension_cutoff),
+    {.key = "tension_cutoff", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, tension_cutoff),
      .meaning = "no tensile pressure: p below the background pressure is raised to it, as a cohesionless "
                 "medium carries no tension (below); false: the paper's model, whose equation of state pulls "
-                "grains together in tension (its bundled cases set it)"},
+                "grains together in tension"},
     {.key = "hold_fixed", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, hold_fixed),
      .meaning = "a grain held fixed gets no acceleration (below)"},
     {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0), .unit = "-",

@@ -519,14 +519,17 @@ static void density_update_range(void *arg, size_t b, size_t e)
     struct particles *P = &s->phys.P;
     const double dt = L->a;
     const double w0 = kernel_w(&s->phys.K, 0.0);
+    const struct medium *media = s->scheme.media;
     int bad_rho = 0;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         P->rho[i] += dt * P->drho[i];
         /* A particle's summation density sum_j m_j W_ij is at least its own m_i W(0). The continuity
          * equation has no self term and crosses that bound where the neighbours fly apart (a grain
-         * thrown clear of a slide): it is the density of a particle alone (docs/numerics.md 2d). */
-        if (P->rho[i] < P->m[i] * w0) P->rho[i] = P->m[i] * w0;
+         * thrown clear of a slide): it is the density of a particle alone (docs/numerics.md 2d).
+         * Only for a medium that carries no tension, where a density below rho0 is grains parting;
+         * in any other medium a density that low is a blow-up, which the step must report. */
+        if (media[P->medium[i]].tension_cutoff && P->rho[i] < P->m[i] * w0) P->rho[i] = P->m[i] * w0;
         bad_rho |= !(P->rho[i] > 0.0);
         particle_pressure(s, i);
     }
