@@ -15,6 +15,8 @@
 
 #include <cmocka.h>
 
+#include "edit_text.h"
+
 #include "case.h"
 #include "case_schema.h"
 #include "mixsph.h"
@@ -47,22 +49,6 @@ static const char *const BASE =
     "  },\n"
     "  \"output\": { \"monitor_interval\": 0.01 }\n"
     "}\n";
-
-/* `src` with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
-static char *edit_text(const char *src, const char *old, const char *new_text)
-{
-    const char *at = strstr(src, old);
-    assert_non_null(at);
-    assert_null(strstr(at + 1, old));
-    const size_t lb = strlen(src), lo = strlen(old), ln = strlen(new_text);
-    char *out = malloc(lb - lo + ln + 1);
-    assert_non_null(out);
-    const size_t head = (size_t)(at - src);
-    memcpy(out, src, head);
-    memcpy(out + head, new_text, ln);
-    memcpy(out + head + ln, at + lo, lb - head - lo + 1);
-    return out;
-}
 
 /* BASE with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
 static char *edit(const char *old, const char *new_text) { return edit_text(BASE, old, new_text); }

@@ -24,6 +24,8 @@
 
 #include <cmocka.h>
 
+#include "edit_text.h"
+
 #include "case.h"
 #include "mixsph.h"
 
@@ -51,22 +53,6 @@ struct probe {
 static const struct probe WET[] = {{"mid", 0.15, 0},       {"deep", 0.047, 0}, {"side", 0.1, 0},
                                    {"floor", STANDOFF, 0}, {"corner", 0.003, 1}};
 #define N_WET (sizeof WET / sizeof WET[0])
-
-/* `src` with `old` (which must occur exactly once) replaced by `new_text`; caller frees. */
-static char *edit_text(const char *src, const char *old, const char *new_text)
-{
-    const char *at = strstr(src, old);
-    assert_non_null(at);
-    assert_null(strstr(at + 1, old));
-    const size_t lb = strlen(src), lo = strlen(old), ln = strlen(new_text);
-    char *out = malloc(lb - lo + ln + 1);
-    assert_non_null(out);
-    const size_t head = (size_t)(at - src);
-    memcpy(out, src, head);
-    memcpy(out + head, new_text, ln);
-    memcpy(out + head + ln, at + lo, lb - head - lo + 1);
-    return out;
-}
 
 /* The hydrostatic tank's text with the monitors block opened by `monitors` (caller frees). */
 static char *tank_with(const char *monitors)
