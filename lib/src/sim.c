@@ -250,6 +250,8 @@ static void set_scheme_params(mixsph_sim *s)
         .cfl_visc = c->cfl_visc,
         .p_background = c->p_background,
         .pressure_smoothing = c->pressure_smoothing,
+        .density_bound = c->density_bound,
+        .excluded_limit = (long)floor(c->excluded_max * (double)s->phys.n_fluid),
         .pair = {.K = s->phys.K,
                  .eta2 = 0.01 * s->phys.h * s->phys.h,
                  .g = c->g,
@@ -467,6 +469,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
     neighbours_free(&s->work.NB);
     neighbours_gather_free(&s->work.G);
     free(s->work.near_wall);
+    free(s->work.excluding);
     case_free(&s->cfg);
     for (size_t k = 0; k < s->n_ov; k++) free(s->ov_key[k]);
     free(s->ov_key);

@@ -33,7 +33,7 @@
 #define SIM_CELL_COLUMNS 4
 #endif
 
-#define SIM_MAX_OUTPUTS (10 + CASE_MAX_MONITORS)
+#define SIM_MAX_OUTPUTS (13 + CASE_MAX_MONITORS)
 
 /* The physical state: what a state file or a checkpoint restores (io/state.c). */
 struct sim_physics {
@@ -51,6 +51,8 @@ struct sim_physics {
     uint64_t step;
     long n_lost;                  /* particles that left the domain */
     long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
+    long n_excluded;              /* particles excluded for a density beyond numerics.density_bound */
+    double excluded_energy;       /* their kinetic + potential energy (m g z, from z = 0) when excluded [J/m] */
 };
 
 /* The solver's workspaces: rebuilt from the physical state, never saved. */
@@ -59,6 +61,7 @@ struct sim_workspace {
     struct neighbours NB;         /* Verlet lists of the pair loops (skin NB.skin) */
     struct gather G;              /* gather lists: grains (all neighbours), walls (non-wall ones) */
     uint8_t *near_wall;           /* per particle: may reach a wall before the next list build */
+    uint8_t *excluding;           /* per particle: its density left the bound in this step */
     struct forces *forces;        /* the pair loops' cache and scratch */
     struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */
     struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */

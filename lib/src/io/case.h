@@ -89,6 +89,8 @@ struct case_def {
     double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
     double density_diffusion; /* delta of the density diffusion in the continuity equation (0: off; default 0.1) */
     int density_diffusion_form; /* numerics.density_diffusion_form: enum density_diffusion_form of forces.h */
+    double density_bound;     /* |rho/rho0 - 1| beyond which a particle is excluded (0: off) */
+    double excluded_max;      /* fraction of the non-wall particles that may be excluded before the run stops */
     double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
                                  bed; < 0: off (the default) */
     int av_wall;              /* artificial viscosity between fluid and wall particles (default 1) */

@@ -113,6 +113,15 @@ static const struct case_key numerics_keys[] = {
      .meaning = "the density difference the diffusion acts on: hydrostatic (less its hydrostatic part, so a column "
                 "at rest is left at rest; Fourtakas et al. 2019) or molteni (the whole difference; Molteni & "
                 "Colagrossi 2009)"},
+    {.key = "density_bound", .type = CASE_NUMBER, RANGE(0, 0, 1, 1), DEF(0.3), .unit = "-",
+     .field = CASE_FIELD(case_def, density_bound),
+     .meaning = "a particle whose density departs from its medium's ρ0 by more than this fraction is excluded from "
+                "the run (below; counted in `excluded_particles`); 0: off, a non-positive density stops the run "
+                "(the bundled cases of the paper's tables set 0)"},
+    {.key = "excluded_max", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0.01), .unit = "-",
+     .field = CASE_FIELD(case_def, excluded_max),
+     .meaning = "the fraction of the case's particles (walls not counted) that may be excluded; one more stops the "
+                "run as unstable"},
     {.key = "fixed_bed_speed", .type = CASE_NUMBER, RANGE(-1, 0, 100, 0), DEF(-1), .def_text = "-1 (off)",
      .unit = "m/s", .field = CASE_FIELD(case_def, fixed_bed_speed),
      .meaning = "the fixed bed (below): speed at or below which a grain counts as bed; negative: off"},

@@ -50,9 +50,11 @@
 #define PROBE_WET_KERNEL_SUM 0.5
 
 /* Diagnostics; the last two (the implicit viscous solve's) only with numerics.viscosity = "implicit". */
-enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_VISC_ITER, OUT_VISC_RES, OUT_N_DIAG };
+enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_EXCLUDED, OUT_EXCLUDED_E, OUT_FLOORED,
+       OUT_VISC_ITER, OUT_VISC_RES, OUT_N_DIAG };
 static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt", "lost_particles", "wall_corrections",
-                                                   "max_speed", "fixed_particles", "viscous_iterations",
+                                                   "max_speed", "fixed_particles", "excluded_particles",
+                                                   "excluded_energy", "floored_particles", "viscous_iterations",
                                                    "viscous_residual"};
 /* out_monitor[k] of diagnostic d */
 #define OUT_DIAG_CODE(d) (-1 - (int)(d))
@@ -225,6 +227,19 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
     return best;
 }
 
+/* Particles whose density sits at the floor m W(0) of a medium without tension (docs/numerics.md
+ * 2d): grains alone, apart from the rest. */
+static long floored_particles(const mixsph_sim *s)
+{
+    const struct particles *P = &s->phys.P;
+    const double w0 = kernel_w(&s->phys.K, 0.0);
+    long n = 0;
+    for (size_t i = 0; i < P->n; i++)
+        n += P->state[i] <= MIXSPH_STATE_FIXED && s->scheme.media[P->medium[i]].tension_cutoff &&
+             P->rho[i] <= P->m[i] * w0;
+    return n;
+}
+
 double monitors_value(const mixsph_sim *s, size_t k)
 {
     const struct particles *P = &s->phys.P;
@@ -246,6 +261,9 @@ double monitors_value(const mixsph_sim *s, size_t k)
     if (d == OUT_LOST) return (double)s->phys.n_lost;
     if (d == OUT_CLIPS) return (double)s->phys.n_clipped;
     if (d == OUT_FIXED) return (double)s->phys.n_fixed;
+    if (d == OUT_EXCLUDED) return (double)s->phys.n_excluded;
+    if (d == OUT_EXCLUDED_E) return s->phys.excluded_energy;
+    if (d == OUT_FLOORED) return (double)floored_particles(s);
     if (d == OUT_VISC_ITER) return (double)s->work.viscous_last.iterations;
     if (d == OUT_VISC_RES) return s->work.viscous_last.residual;
     double ke = 0.0, mass = 0.0, vmax = 0.0;

@@ -22,7 +22,9 @@ enum law_id {
 /* What a law asks of the step (bits of struct medium's `features`, copied from its law). */
 enum law_feature {
     LAW_USES_GRADIENT = 1u, /* the velocity gradient of its particles is gathered every step */
-    LAW_HAS_STRESS = 2u     /* its particles carry a deviatoric stress (P->sxx, sxz, szz, syy) */
+    LAW_HAS_STRESS = 2u,    /* its particles carry a deviatoric stress (P->sxx, sxz, szz, syy) */
+    LAW_CAPS_TENSION = 4u   /* its update bounds the tension the equation of state gives (a yield surface's
+                               apex), so a density below rho0 is its grains parting, not a blow-up */
 };
 
 struct medium {
@@ -58,5 +60,13 @@ struct medium {
     double dilatancy_deg;  /* psi [deg] */
     double alpha_phi, k_c, alpha_psi; /* the plane-strain matched Drucker-Prager cone (drucker_prager.h) */
 };
+
+/** Whether a medium's pressure follows its equation of state into tension without bound (no
+ *  tension_cutoff, no law that caps it): in such a medium a density far below rho0 means the
+ *  discretisation has failed. */
+static inline int medium_carries_tension(const struct medium *m)
+{
+    return !m->tension_cutoff && !(m->features & LAW_CAPS_TENSION);
+}
 
 #endif

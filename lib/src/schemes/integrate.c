@@ -175,6 +175,10 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     uint8_t *near = realloc(s->work.near_wall, P->cap ? P->cap : 1);
     if (!near) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     s->work.near_wall = near;
+    uint8_t *excluding = realloc(s->work.excluding, P->cap ? P->cap : 1);
+    if (!excluding) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    s->work.excluding = excluding;
+    memset(excluding, 0, P->cap ? P->cap : 1);
     struct particle_loop L = {.s = s, .a = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx};
     team_for(SIM_THREADS(s), n, near_wall_range, &L);
     return MIXSPH_OK;
@@ -511,29 +515,77 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
     return MIXSPH_OK;
 }
 
-/* rho += dt drho (L->a = dt) and the equation of state; L->flag: a non-positive density. */
+/* Whether density rho of a particle of medium m lies beyond numerics.density_bound (docs/numerics.md
+ * 2e). A medium that bounds its tension has no lower side: its density falls as its grains part. */
+static inline int density_out_of_bound(const struct medium *m, double bound, double rho)
+{
+    if (!(bound > 0.0)) return 0;
+    return !(rho <= (1.0 + bound) * m->rho0) || (medium_carries_tension(m) && !(rho >= (1.0 - bound) * m->rho0));
+}
+
+/* rho += dt drho (L->a = dt) and the equation of state; L->flag: a non-positive density; L->count:
+ * particles whose new density is beyond the bound, which keep the old one for this step's momentum
+ * pass and are marked for exclusion (exclude_particles). */
 static void density_update_range(void *arg, size_t b, size_t e)
 {
     struct particle_loop *L = arg;
     mixsph_sim *s = L->s;
     struct particles *P = &s->phys.P;
-    const double dt = L->a;
+    const double dt = L->a, bound = s->scheme.density_bound;
     const double w0 = kernel_w(&s->phys.K, 0.0);
     const struct medium *media = s->scheme.media;
     int bad_rho = 0;
+    long beyond = 0;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        P->rho[i] += dt * P->drho[i];
+        double rho = P->rho[i] + dt * P->drho[i];
         /* A particle's summation density sum_j m_j W_ij is at least its own m_i W(0). The continuity
          * equation has no self term and crosses that bound where the neighbours fly apart (a grain
          * thrown clear of a slide): it is the density of a particle alone (docs/numerics.md 2d).
          * Only for a medium that carries no tension, where a density below rho0 is grains parting;
          * in any other medium a density that low is a blow-up, which the step must report. */
-        if (media[P->medium[i]].tension_cutoff && P->rho[i] < P->m[i] * w0) P->rho[i] = P->m[i] * w0;
+        if (media[P->medium[i]].tension_cutoff && rho < P->m[i] * w0) rho = P->m[i] * w0;
+        if (density_out_of_bound(&media[P->medium[i]], bound, rho)) {
+            s->work.excluding[i] = 1;
+            beyond++;
+        } else {
+            P->rho[i] = rho;
+        }
         bad_rho |= !(P->rho[i] > 0.0);
         particle_pressure(s, i);
     }
     team_or_int(&L->flag, bad_rho);
+    team_add_long(&L->count, beyond);
+}
+
+/* The particles marked in the density update leave the run as a lost particle does (their
+ * energy counted), and the lists are rebuilt without them; past numerics.excluded_max the step
+ * fails instead (docs/numerics.md 2e). */
+static mixsph_status exclude_particles(mixsph_sim *s)
+{
+    struct particles *P = &s->phys.P;
+    const double g = s->cfg.g;
+    size_t last = 0;
+    double last_rho = 0.0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!s->work.excluding[i]) continue;
+        s->work.excluding[i] = 0;
+        last = i;
+        last_rho = P->rho[i] + s->phys.dt * P->drho[i];
+        s->phys.excluded_energy += P->m[i] * (0.5 * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]) + g * P->z[i]);
+        s->phys.n_excluded++;
+        P->state[i] = MIXSPH_STATE_LOST;
+        P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
+    }
+    if (s->phys.n_excluded > s->scheme.excluded_limit)
+        return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
+                        "%ld particles excluded for a density beyond numerics.density_bound = %g of rho0, more than "
+                        "numerics.excluded_max allows (%ld); the last: particle %u (x = %g, z = %g, density %g kg/m3) "
+                        "at t = %.6g s",
+                        s->phys.n_excluded, s->scheme.density_bound, s->scheme.excluded_limit, P->id[last], P->x[last],
+                        P->z[last], last_rho, s->phys.t);
+    forces_forget_cache(s->work.forces); /* its factors and viscous couplings are of the old lists */
+    return integrate_rebuild_lists(s);
 }
 
 /* The rates at the new positions: the density pass (and the velocity gradient), the densities
@@ -560,6 +612,7 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
                                 "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
                                 P->rho[i], P->id[i], P->x[i], P->z[i], s->phys.t);
     }
+    if (L.count > 0) return exclude_particles(s);
     return MIXSPH_OK;
 }
 

@@ -17,6 +17,8 @@ struct scheme_params {
     double cfl, cfl_visc;         /* the coefficients of criterion (4) */
     double p_background;          /* added by the equation of state [Pa] */
     double pressure_smoothing;    /* theta_P of the partial pressure smoothing (0: off) */
+    double density_bound;         /* |rho/rho0 - 1| beyond which a particle is excluded (0: off) */
+    long excluded_limit;          /* particles that may be excluded; one more stops the run */
     struct forces_params pair;    /* what the pair loops read */
     struct viscous_params viscous; /* the implicit viscous step's solver */
 };
