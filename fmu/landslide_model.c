@@ -107,11 +107,11 @@ static const struct {
 };
 
 /* Outputs read from the library by name. */
-enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, O_KE_WATER, N_OUTS };
+enum { O_RUN_UP, O_FRONT, O_KE, O_DT, O_LOST, O_FIXED, O_RUN_UP_Z, O_KE_WATER, O_EXCLUDED, N_OUTS };
 static const char *const out_names[N_OUTS] = {
     [O_RUN_UP] = "run_up",       [O_FRONT] = "landslide_front",      [O_KE] = "kinetic_energy",
     [O_DT] = "dt",               [O_LOST] = "lost_particles",        [O_FIXED] = "fixed_particles",
-    [O_RUN_UP_Z] = "run_up_Z",   [O_KE_WATER] = "water_kinetic_energy"};
+    [O_RUN_UP_Z] = "run_up_Z",   [O_KE_WATER] = "water_kinetic_energy", [O_EXCLUDED] = "excluded_particles"};
 
 /* The instance's data (the glue saves it with an FMU state): plain bytes, no pointers. */
 struct landslide_data {
@@ -302,12 +302,13 @@ static fmi2Status get_integer(struct fmu_instance *in, fmi2ValueReference vr, fm
         *value = data_of(in)->item[e];
         return fmi2OK;
     }
-    if (vr != VR_fixed_particles && vr != VR_lost_particles && vr != VR_steps)
+    if (vr != VR_fixed_particles && vr != VR_lost_particles && vr != VR_excluded_particles && vr != VR_steps)
         return fmu_reject(in, "fmi2GetInteger: no Integer variable with value reference %u", vr);
     if (fmu_need_simulation(in) != fmi2OK) return fmi2Error;
-    const double v = vr == VR_steps              ? (double)mixsph_sim_steps(in->sim)
-                     : vr == VR_fixed_particles ? output_value(in, O_FIXED)
-                                                : output_value(in, O_LOST);
+    const double v = vr == VR_steps                ? (double)mixsph_sim_steps(in->sim)
+                     : vr == VR_fixed_particles    ? output_value(in, O_FIXED)
+                     : vr == VR_excluded_particles ? output_value(in, O_EXCLUDED)
+                                                   : output_value(in, O_LOST);
     *value = isfinite(v) && v < 2147483647.0 ? (fmi2Integer)v : -1;
     return fmi2OK;
 }

@@ -131,7 +131,7 @@ def start(fmu, params):
 
 OUT_REAL = ["run_up", "max_run_up", "time_of_max_run_up", "landslide_front", "kinetic_energy", "dt",
             "max_run_up_Z"]
-OUT_INT = ["fixed_particles", "lost_particles", "steps"]
+OUT_INT = ["fixed_particles", "lost_particles", "excluded_particles", "steps"]
 
 
 def outputs(fmu):
