@@ -1,7 +1,7 @@
 /* test_density_bound.c - numerics.density_bound and numerics.excluded_max (lib/src/schemes/
  * integrate.c, docs/numerics.md section 2e): a particle whose updated density departs from its
  * medium's rho0 by more than the bound leaves the run as a lost particle does, is counted in
- * `excluded_particles` with its energy in `excluded_energy`, and the run goes on; past
+ * `excluded_particles` with its mass and energy in `excluded_mass` and `excluded_energy`, and the run goes on; past
  * excluded_max the step fails as unstable; with the bound 0 nothing is excluded; a medium
  * without tension has no lower side.
  *
@@ -108,6 +108,7 @@ static void test_excluded_below(void **state)
     assert_true(fabs(output(s, "excluded_energy") - e_expected) <= 1e-12 * fabs(e_expected));
     /* the mass output drops by the particle's mass exactly (reference: its m) */
     assert_true(fabs(output(s, "mass") - (mass0 - m)) <= 1e-12 * mass0);
+    assert_true(output(s, "excluded_mass") == m);
     /* the run goes on without it, and no other particle goes beyond the bound */
     for (int k = 0; k < 100; k++) assert_int_equal(mixsph_sim_step(s), MIXSPH_OK);
     assert_true(output(s, "excluded_particles") == 1.0);

@@ -19,7 +19,9 @@ the 50 / 95 / 99 % quantiles of x, and how many grains are higher than 0.05 m ab
 (still suspended) beyond the ramp's toe; the largest water elevation at x >= 1 m (monitor
 run_up). The energy budget: E(t) - E(0) against the work W(t) the plate has done on the water and
 the grains (monitor plate_work, interpolated to the snapshot's time): E(t) - E(0) - W(t) is what
-the run has dissipated, never above 0 in a sound run.
+the run has dissipated, never above 0 in a sound run. E counts what particles excluded for a
+density beyond numerics.density_bound took away (monitors excluded_mass, excluded_energy), and
+their number is printed.
 
 Exit status: 0 the run finished; 1 it did not (its numbers up to the failure are still printed);
 2 bad usage.
@@ -101,13 +103,32 @@ def report(out, case_path):
                   f"{hi[k] / rho0:.3f}) over {len(snaps)} snapshots")
     mon = os.path.join(out, "monitors.csv")
     cols = read_monitors(mon) if os.path.isfile(mon) else {}
+    def at(name, t):  # a monitor column at time t, interpolated (0 without the column)
+        return float(np.interp(t, cols["t"], cols[name])) if name in cols else 0.0
+
+    def so_far(name, t):  # a running count or sum: its last sample at or before t (0 without the column)
+        if name not in cols:
+            return 0.0
+        k = int(np.searchsorted(np.asarray(cols["t"], dtype=float), t + 1e-9, side="right")) - 1
+        return float(cols[name][max(k, 0)])
+
+    if cols and "excluded_particles" in cols:
+        t_end = cols["t"][-1]
+        print(f"  excluded (density beyond numerics.density_bound): {int(so_far('excluded_particles', t_end))} "
+              f"particles, {so_far('excluded_mass', t_end):.4f} kg/m of {cols['mass'][0]:.4f}; floored grains at the "
+              f"end: {int(so_far('floored_particles', t_end))}")
     if energy:
         e0 = energy[0][1] + energy[0][2]
-        work = (lambda t: float(np.interp(t, cols["t"], cols["plate_work"]))) if "plate_work" in cols else None
-        print("  t [s]   kinetic [J/m]  potential [J/m]  E - E(0) [J/m]  plate work W [J/m]  E - E(0) - W [J/m]")
+        work = (lambda t: at("plate_work", t)) if "plate_work" in cols else None
+        print("  E: kinetic + potential of the particles in the run plus what the excluded took away (potential from "
+              "the floor)")
+        print("  t [s]   kinetic [J/m]  potential [J/m]  excluded [J/m]  E - E(0) [J/m]  plate work W [J/m]  "
+              "E - E(0) - W [J/m]")
         for t, ke, pe in energy:
             w = work(t) if work else math.nan
-            print(f"  {t:5.2f}  {ke:13.2f}  {pe:15.2f}  {ke + pe - e0:+14.2f}  {w:18.2f}  {ke + pe - e0 - w:+18.2f}")
+            ex = so_far("excluded_energy", t) - G * FLOOR_Z * so_far("excluded_mass", t)
+            e = ke + pe + ex
+            print(f"  {t:5.2f}  {ke:13.2f}  {pe:15.2f}  {ex:14.2f}  {e - e0:+14.2f}  {w:18.2f}  {e - e0 - w:+18.2f}")
     if last is not None:
         live = last["state"] < 2
         g = live & (last["medium"].astype(int) == 1)

@@ -33,7 +33,7 @@
 #define SIM_CELL_COLUMNS 4
 #endif
 
-#define SIM_MAX_OUTPUTS (13 + CASE_MAX_MONITORS)
+#define SIM_MAX_OUTPUTS (14 + CASE_MAX_MONITORS)
 
 /* The physical state: what a state file or a checkpoint restores (io/state.c). */
 struct sim_physics {
@@ -52,6 +52,7 @@ struct sim_physics {
     long n_lost;                  /* particles that left the domain */
     long n_clipped;               /* wall-crossing corrections applied (diagnostic) */
     long n_excluded;              /* particles excluded for a density beyond numerics.density_bound */
+    double excluded_mass;         /* their mass [kg/m] */
     double excluded_energy;       /* their kinetic + potential energy (m g z, from z = 0) when excluded [J/m] */
 };
 

@@ -50,11 +50,11 @@
 #define PROBE_WET_KERNEL_SUM 0.5
 
 /* Diagnostics; the last two (the implicit viscous solve's) only with numerics.viscosity = "implicit". */
-enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_EXCLUDED, OUT_EXCLUDED_E, OUT_FLOORED,
+enum { OUT_KE, OUT_MASS, OUT_DT, OUT_LOST, OUT_CLIPS, OUT_VMAX, OUT_FIXED, OUT_EXCLUDED, OUT_EXCLUDED_M, OUT_EXCLUDED_E, OUT_FLOORED,
        OUT_VISC_ITER, OUT_VISC_RES, OUT_N_DIAG };
 static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt", "lost_particles", "wall_corrections",
                                                    "max_speed", "fixed_particles", "excluded_particles",
-                                                   "excluded_energy", "floored_particles", "viscous_iterations",
+                                                   "excluded_mass", "excluded_energy", "floored_particles", "viscous_iterations",
                                                    "viscous_residual"};
 /* out_monitor[k] of diagnostic d */
 #define OUT_DIAG_CODE(d) (-1 - (int)(d))
@@ -262,6 +262,7 @@ double monitors_value(const mixsph_sim *s, size_t k)
     if (d == OUT_CLIPS) return (double)s->phys.n_clipped;
     if (d == OUT_FIXED) return (double)s->phys.n_fixed;
     if (d == OUT_EXCLUDED) return (double)s->phys.n_excluded;
+    if (d == OUT_EXCLUDED_M) return s->phys.excluded_mass;
     if (d == OUT_EXCLUDED_E) return s->phys.excluded_energy;
     if (d == OUT_FLOORED) return (double)floored_particles(s);
     if (d == OUT_VISC_ITER) return (double)s->work.viscous_last.iterations;

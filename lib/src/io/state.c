@@ -25,7 +25,7 @@
                             4: the increments of the implicit step's first stage; 5: those of the
                             step before (the warm starts' extrapolation); 6: the particle fields of
                             the particle-field table, each named; 7: the walls' work; 8: the
-                            excluded particles' count and energy */
+                            excluded particles' count, mass and energy */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
@@ -144,7 +144,8 @@ static void put_source(struct writer *w, const mixsph_sim *s)
     IO(&(s)->phys.t, sizeof(s)->phys.t) IO(&(s)->phys.dt, sizeof(s)->phys.dt)              \
     IO(&(s)->phys.step, sizeof(s)->phys.step) IO(&(s)->phys.n_lost, sizeof(s)->phys.n_lost) \
     IO(&(s)->phys.n_clipped, sizeof(s)->phys.n_clipped) IO(&(s)->phys.n_excluded, sizeof(s)->phys.n_excluded) \
-    IO(&(s)->phys.excluded_energy, sizeof(s)->phys.excluded_energy) IO(&(s)->phys.n_fixed, sizeof(s)->phys.n_fixed) \
+    IO(&(s)->phys.excluded_mass, sizeof(s)->phys.excluded_mass) IO(&(s)->phys.excluded_energy, sizeof(s)->phys.excluded_energy) \
+    IO(&(s)->phys.n_fixed, sizeof(s)->phys.n_fixed) \
     IO(&(s)->out.n_samples, sizeof(s)->out.n_samples) IO(&(s)->out.next_sample, sizeof(s)->out.next_sample) \
     IO(&(s)->out.next_snapshot, sizeof(s)->out.next_snapshot) IO(&(s)->out.snap_index, sizeof(s)->out.snap_index) \
     IO(&(s)->work.viscous_last.iterations, sizeof(s)->work.viscous_last.iterations)                       \

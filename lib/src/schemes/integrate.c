@@ -572,6 +572,7 @@ static mixsph_status exclude_particles(mixsph_sim *s)
         s->work.excluding[i] = 0;
         last = i;
         last_rho = P->rho[i] + s->phys.dt * P->drho[i];
+        s->phys.excluded_mass += P->m[i];
         s->phys.excluded_energy += P->m[i] * (0.5 * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]) + g * P->z[i]);
         s->phys.n_excluded++;
         P->state[i] = MIXSPH_STATE_LOST;
