@@ -34,32 +34,32 @@ static void make_particles(struct particles *P, const struct cells *C, uint64_t 
         const double x = test_random_uniform(&s, C->x0 - 0.5 * C->size, X1 + 0.5 * C->size);
         const double z = test_random_uniform(&s, C->z0 - 0.5 * C->size, Z1 + 0.5 * C->size);
         const uint8_t st = k % 17 == 0 ? MIXSPH_STATE_WALL : k % 23 == 0 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
-        assert_true(particles_push(P, x, z, 1000.0, 1.0, 0, st) != (size_t)-1);
+        assert_true(particles_push(P, (const double[DIM]){x, z}, 1000.0, 1.0, 0, st) != (size_t)-1);
     }
     /* on every vertical and horizontal cell border (the last ones, x = X1 and z = Z1, are outside) */
     for (int i = 0; i <= C->nx; i++) {
         for (int k = 0; k < 3; k++) {
-            particles_push(P, C->x0 + i * C->size, test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-            particles_push(P, C->x0 + i * C->size, C->z0 + (k % C->nz) * C->size, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){C->x0 + i * C->size, test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){C->x0 + i * C->size, C->z0 + (k % C->nz) * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
         }
     }
     for (int l = 0; l <= C->nz; l++)
         for (int k = 0; k < 3; k++)
-            particles_push(P, test_random_uniform(&s, C->x0, X1), C->z0 + l * C->size, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), C->z0 + l * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just inside the last column and row, and the far corner */
     for (int k = 0; k < 5; k++) {
-        particles_push(P, nextafter(X1, -INFINITY), test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-        particles_push(P, test_random_uniform(&s, C->x0, X1), nextafter(Z1, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, (const double[DIM]){nextafter(X1, -INFINITY), test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), nextafter(Z1, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     }
-    particles_push(P, nextafter(X1, -INFINITY), nextafter(Z1, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, C->x0, C->z0, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){nextafter(X1, -INFINITY), nextafter(Z1, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){C->x0, C->z0}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just outside the near edges, and not finite */
-    particles_push(P, nextafter(C->x0, -INFINITY), test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, test_random_uniform(&s, C->x0, X1), nextafter(C->z0, -INFINITY), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, NAN, test_random_uniform(&s, C->z0, Z1), 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, test_random_uniform(&s, C->x0, X1), INFINITY, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){nextafter(C->x0, -INFINITY), test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), nextafter(C->z0, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){NAN, test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), INFINITY}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* already lost before the build, inside the grid: stays lost, not counted again */
-    particles_push(P, 0.5 * (C->x0 + X1), 0.5 * (C->z0 + Z1), 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
+    particles_push(P, (const double[DIM]){0.5 * (C->x0 + X1), 0.5 * (C->z0 + Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
     for (size_t i = 0; i < P->n; i++) {
         P->vx[i] = 1.0 + (double)i;
         P->vz[i] = -2.0;
@@ -322,11 +322,11 @@ static void test_neighbour_ranges(void **state)
         uint64_t seed = 99u + (uint64_t)kx;
         for (int i = 0; i < 2500; i++) {
             const uint8_t st = i % 7 == 0 ? MIXSPH_STATE_WALL : MIXSPH_STATE_MOBILE;
-            particles_push(&P, test_random_uniform(&seed, 0.01, 0.49), test_random_uniform(&seed, 0.01, 0.29), 1000.0, 1.0, 0, st);
+            particles_push(&P, (const double[DIM]){test_random_uniform(&seed, 0.01, 0.49), test_random_uniform(&seed, 0.01, 0.29)}, 1000.0, 1.0, 0, st);
         }
         /* particles on column and row borders */
         for (int k = 0; k < 40; k++)
-            particles_push(&P, C.x0 + (k % 10 + 1) * C.width, C.z0 + (k % 5 + 1) * C.size, 1000.0, 1.0, 0,
+            particles_push(&P, (const double[DIM]){C.x0 + (k % 10 + 1) * C.width, C.z0 + (k % 5 + 1) * C.size}, 1000.0, 1.0, 0,
                            MIXSPH_STATE_MOBILE);
         assert_int_equal(cells_build(&C, &P), 0);
         const size_t n = C.start[C.ncell];

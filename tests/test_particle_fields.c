@@ -111,7 +111,7 @@ static void test_absent_rows_have_no_memory(void **state)
         if (features == all) assert_int_equal(absent, 0);
         if (features == 0) assert_true(absent > 0); /* the implicit scheme's increments at least */
         for (size_t i = 0; i < 40; i++) /* past cap: the arrays grow */
-            assert_int_equal(particles_push(&P, (double)i, -(double)i, 1000.0, 1.0, (uint8_t)(i % 3), 0), i);
+            assert_int_equal(particles_push(&P, (const double[DIM]){(double)i, -(double)i}, 1000.0, 1.0, (uint8_t)(i % 3), 0), i);
         const int implicit = (features & PARTICLE_FEATURE_IMPLICIT_VISCOUS) != 0;
         if (implicit) {
             for (size_t i = 0; i < 40; i++) assert_true(P.visc_dvx[i] == 0.0);

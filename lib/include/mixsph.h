@@ -166,7 +166,7 @@ mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_vi
 /** Element type of a particle field's arrays. */
 typedef enum { MIXSPH_FIELD_F64, MIXSPH_FIELD_U8, MIXSPH_FIELD_U16, MIXSPH_FIELD_U32 } mixsph_field_type;
 
-#define MIXSPH_FIELD_MAX_COMPONENTS 4
+#define MIXSPH_FIELD_MAX_COMPONENTS 6
 
 /** One per-particle field of a simulation, as its snapshots hold it: `name` is the dataset's
  *  name in run.h5 (e.g. "velocity"), `columns` its components' names as snap_NNNN.csv heads

@@ -145,8 +145,8 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         above += m->rho0 * s->cfg.g * dx;
         double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
         const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
-        particles_push(&s->phys.P, (sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx, rho, rho * dx * dx,
-                       (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
+        const double pos[DIM] = {(sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx};
+        particles_push(&s->phys.P, pos, rho, rho * dx * dx, (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
         s->phys.P.mu[s->phys.P.n - 1] = m->mu;
     }
     s->phys.n_fluid = n;

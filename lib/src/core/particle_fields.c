@@ -16,17 +16,28 @@
     _Generic(((struct particles *)0)->a, double *: PF_F64, uint8_t *: PF_U8, uint16_t *: PF_U16, uint32_t *: PF_U32)
 #define AT(a) offsetof(struct particles, a)
 #define COMPONENTS1(a) .columns = #a, .type = MEMBER_TYPE(a), .components = 1, .member = {AT(a)}
-#define COMPONENTS2(a, b) .columns = #a "," #b, .type = MEMBER_TYPE(a), .components = 2, .member = {AT(a), AT(b)}
-#define COMPONENTS4(a, b, c, d)                                                                                      \
-    .columns = #a "," #b "," #c "," #d, .type = MEMBER_TYPE(a), .components = 4, .member = {AT(a), AT(b), AT(c), AT(d)}
+/* A vector field (a member v[DIM]): its columns are the prefix followed by each axis ("vx,vz"). */
+#if DIM == 2
+#define VECTOR(v, prefix) .columns = prefix "x," prefix "z", .type = PF_F64, .components = 2, .member = {AT(v[0]), AT(v[1])}
+#define STRESS(s, prefix)                                                                                            \
+    .columns = prefix "xx," prefix "xz," prefix "zz," prefix "yy", .type = PF_F64, .components = SYM_N,              \
+    .member = {AT(s[0]), AT(s[1]), AT(s[2]), AT(s[3])}
+#else
+#define VECTOR(v, prefix)                                                                                            \
+    .columns = prefix "x," prefix "y," prefix "z", .type = PF_F64, .components = 3,                                   \
+    .member = {AT(v[0]), AT(v[1]), AT(v[2])}
+#define STRESS(s, prefix)                                                                                            \
+    .columns = prefix "xx," prefix "xz," prefix "zz," prefix "yy," prefix "xy," prefix "yz", .type = PF_F64,          \
+    .components = SYM_N, .member = {AT(s[0]), AT(s[1]), AT(s[2]), AT(s[3]), AT(s[4]), AT(s[5])}
+#endif
 
 enum { OUT = PF_STATE | PF_HDF5 | PF_CSV | PF_VIEW }; /* a field of the snapshots */
 
 const struct particle_field particle_fields[] = {
     /* the snapshots' fields (run.h5, run.xdmf, snap_NNNN.csv, the view), as run.h5 lists them */
-    {.name = "position", COMPONENTS2(x, z), .unit = "m", .description = "x, z (z up)", .owner = PF_OWNER_CORE,
+    {.name = "position", VECTOR(pos, ""), .unit = "m", .description = DIM == 2 ? "x, z (z up)" : "x, y, z (z up)", .owner = PF_OWNER_CORE,
      .where = OUT | PF_GEOMETRY, .csv_digits = 7},
-    {.name = "velocity", COMPONENTS2(vx, vz), .unit = "m/s", .description = "vx, vz", .owner = PF_OWNER_CORE,
+    {.name = "velocity", VECTOR(vel, "v"), .unit = "m/s", .description = "vx, vz", .owner = PF_OWNER_CORE,
      .where = OUT, .csv_digits = 6},
     {.name = "density", COMPONENTS1(rho), .unit = "kg/m^3", .description = "density", .owner = PF_OWNER_CORE,
      .where = OUT, .csv_digits = 7},
@@ -44,12 +55,12 @@ const struct particle_field particle_fields[] = {
     {.name = "id", COMPONENTS1(id), .unit = "1", .description = "stable particle id", .owner = PF_OWNER_CORE,
      .where = OUT | PF_KEY},
     /* the solver's own fields (states only) */
-    {.name = "viscous_velocity", COMPONENTS2(uvx, uvz), .unit = "m/s",
+    {.name = "viscous_velocity", VECTOR(uv, "uv"), .unit = "m/s",
      .description = "velocity seen by viscous terms (walls: no-slip mirror velocity)", .owner = PF_OWNER_CORE,
      .where = PF_STATE},
     {.name = "volume", COMPONENTS1(vol), .unit = "m^3", .description = "volume m/rho (per unit depth)",
      .owner = PF_OWNER_CORE, .where = PF_STATE},
-    {.name = "acceleration", COMPONENTS2(ax, az), .unit = "m/s^2",
+    {.name = "acceleration", VECTOR(acc, "a"), .unit = "m/s^2",
      .description = "ax, az; of a wall particle the force the other particles exert on it [N/m]",
      .owner = PF_OWNER_CORE, .where = PF_STATE},
     {.name = "density_rate", COMPONENTS1(drho), .unit = "kg/m^3/s", .description = "density rate",
@@ -65,36 +76,34 @@ const struct particle_field particle_fields[] = {
     {.name = "neighbours", COMPONENTS1(nneigh), .unit = "1",
      .description = "neighbours of the same medium within 2h (last force pass)", .owner = PF_OWNER_CORE,
      .where = PF_STATE},
-    {.name = "viscous_increment", COMPONENTS2(visc_dvx, visc_dvz), .unit = "m/s",
+    {.name = "viscous_increment", VECTOR(visc_dv, "visc_dv"), .unit = "m/s",
      .description = "velocity change of the last implicit viscous step (its warm start)",
      .owner = PF_OWNER_SCHEME, .needs = PARTICLE_FEATURE_IMPLICIT_VISCOUS, .where = PF_STATE},
-    {.name = "viscous_stage_increment", COMPONENTS2(visc_d1x, visc_d1z), .unit = "m/s",
+    {.name = "viscous_stage_increment", VECTOR(visc_d1, "visc_d1"), .unit = "m/s",
      .description = "velocity change of the first stage of the last implicit viscous step",
      .owner = PF_OWNER_SCHEME, .needs = PARTICLE_FEATURE_IMPLICIT_VISCOUS, .where = PF_STATE},
-    {.name = "viscous_increment_before", COMPONENTS2(visc_dvpx, visc_dvpz), .unit = "m/s",
+    {.name = "viscous_increment_before", VECTOR(visc_dvp, "visc_dvp"), .unit = "m/s",
      .description = "viscous_increment of the step before the last", .owner = PF_OWNER_SCHEME,
      .needs = PARTICLE_FEATURE_IMPLICIT_VISCOUS, .where = PF_STATE},
-    {.name = "viscous_stage_increment_before", COMPONENTS2(visc_d1px, visc_d1pz), .unit = "m/s",
+    {.name = "viscous_stage_increment_before", VECTOR(visc_d1p, "visc_d1p"), .unit = "m/s",
      .description = "viscous_stage_increment of the step before the last", .owner = PF_OWNER_SCHEME,
      .needs = PARTICLE_FEATURE_IMPLICIT_VISCOUS, .where = PF_STATE},
-    {.name = "sxx", COMPONENTS1(sxx), .unit = "Pa", .description = "deviatoric stress, xx (tension positive)",
-     .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
-    {.name = "sxz", COMPONENTS1(sxz), .unit = "Pa", .description = "deviatoric stress, xz", .owner = PF_OWNER_LAW,
-     .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
-    {.name = "szz", COMPONENTS1(szz), .unit = "Pa", .description = "deviatoric stress, zz (tension positive)",
-     .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
+    {.name = "stress", STRESS(stress, "s"), .unit = "Pa",
+     .description = "deviatoric stress (tension positive): xx, xz, zz, yy (2D: plane strain, yy out of plane)"
+#if DIM == 3
+                    ", xy, yz"
+#endif
+     , .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
     {.name = "wall_rough", COMPONENTS1(wall_rough), .unit = "1",
      .description = "1 for a particle of a no-slip wall (its friction applies), 0 for the others",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
-    {.name = "wall_normal", COMPONENTS2(wall_nx, wall_nz), .unit = "1",
+    {.name = "wall_normal", VECTOR(wall_n, "wall_n"), .unit = "1",
      .description = "a free-slip wall particle's unit normal toward the solid, across which it mirrors "
                     "the solid's stress (0 for the others)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
     {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
      .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi))",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
-    {.name = "syy", COMPONENTS1(syy), .unit = "Pa", .description = "deviatoric stress, yy (out of plane)",
-     .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
 };
 
 const size_t particle_field_count = sizeof particle_fields / sizeof particle_fields[0];

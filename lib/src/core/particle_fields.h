@@ -10,7 +10,9 @@
 #define MIXSPH_PARTICLE_FIELDS_H
 #include <stddef.h>
 
-#define PARTICLE_FIELD_MAX_COMPONENTS 4
+#include "dim.h"
+
+#define PARTICLE_FIELD_MAX_COMPONENTS 6 /* a symmetric tensor in 3D */
 
 /* Element types (sizes 8, 1, 2, 4 bytes). */
 enum particle_field_type { PF_F64, PF_U8, PF_U16, PF_U32 };

@@ -39,7 +39,7 @@ void particles_free(struct particles *P)
     memset(P, 0, sizeof *P);
 }
 
-size_t particles_push(struct particles *P, double x, double z, double rho, double m, uint8_t medium, uint8_t state)
+size_t particles_push(struct particles *P, const double pos[DIM], double rho, double m, uint8_t medium, uint8_t state)
 {
     if (P->n == P->cap && particles_alloc(P, 2 * P->cap) != 0) return (size_t)-1;
     const size_t i = P->n++;
@@ -49,8 +49,7 @@ size_t particles_push(struct particles *P, double x, double z, double rho, doubl
         const size_t elem = particle_field_size(f->type);
         for (unsigned c = 0; c < f->components; c++) memset((char *)particles_array(P, f->member[c]) + i * elem, 0, elem);
     }
-    P->x[i] = x;
-    P->z[i] = z;
+    for (int d = 0; d < DIM; d++) P->pos[d][i] = pos[d];
     P->rho[i] = rho;
     P->m[i] = m;
     P->vol[i] = m / rho;

@@ -86,7 +86,8 @@ static int behind_earlier_fixed_wall(const struct walls *W, size_t w, double x, 
 static long push_wall_particle(const struct wall_state *ws, size_t w, double x, double z, double vol,
                                struct particles *P)
 {
-    const size_t j = particles_push(P, x, z, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
+    const double pos[DIM] = {x, z};
+    const size_t j = particles_push(P, pos, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
     if (j == (size_t)-1) return -1;
     P->vol[j] = vol;
     P->m[j] = 0.0;
