@@ -296,8 +296,9 @@ static mixsph_status sim_init(mixsph_sim *s)
             return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
                             s->phys.P.x[i], s->phys.P.z[i]);
     s->work.NB.skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
-    if (cells_init_columns(&s->work.C, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3], 2.0 * s->phys.h + s->work.NB.skin,
-                           SIM_CELL_COLUMNS) != 0)
+    const double grid_lo[DIM] = {s->phys.domain[0], s->phys.domain[2]};
+    const double grid_hi[DIM] = {s->phys.domain[1], s->phys.domain[3]};
+    if (cells_init_columns(&s->work.C, grid_lo, grid_hi, 2.0 * s->phys.h + s->work.NB.skin, SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3]);
     if (cells_build(&s->work.C, &s->phys.P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");

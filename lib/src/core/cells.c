@@ -7,25 +7,30 @@
 
 #include "mixsph.h"
 
-int cells_init(struct cells *C, double x_min, double x_max, double z_min, double z_max, double size)
+int cells_init(struct cells *C, const double lo[DIM], const double hi[DIM], double size)
 {
-    return cells_init_columns(C, x_min, x_max, z_min, z_max, size, 1);
+    return cells_init_columns(C, lo, hi, size, 1);
 }
 
-int cells_init_columns(struct cells *C, double x_min, double x_max, double z_min, double z_max, double size, int kx)
+int cells_init_columns(struct cells *C, const double lo[DIM], const double hi[DIM], double size, int kx)
 {
     memset(C, 0, sizeof *C);
     if (kx < 1) return -1;
-    C->x0 = x_min;
-    C->z0 = z_min;
     C->size = size;
     C->kx = kx;
     C->width = size / kx;
-    const double nx = ceil((x_max - x_min) / C->width), nz = ceil((z_max - z_min) / size);
-    if (!(nx >= 1 && nz >= 1) || nx * nz > 2e8) return -1;
-    C->nx = (int)nx;
-    C->nz = (int)nz;
-    C->ncell = (size_t)C->nx * (size_t)C->nz;
+    double cells = 1.0;
+    for (int d = 0; d < DIM; d++) {
+        C->lo[d] = lo[d];
+        const double n = ceil((hi[d] - lo[d]) / (d == 0 ? C->width : size));
+        if (!(n >= 1)) return -1;
+        cells *= n;
+        if (cells > 2e8) return -1;
+        C->n[d] = (int)n;
+    }
+    C->layer = 1;
+    for (int d = 0; d < DIM - 1; d++) C->layer *= (size_t)C->n[d];
+    C->ncell = C->layer * (size_t)C->n[DIM_UP];
     C->start = calloc(C->ncell + 2, sizeof *C->start);
     return C->start ? 0 : -1;
 }
@@ -56,21 +61,31 @@ static int ensure(struct cells *C, size_t n)
     return 0;
 }
 
+/* The cell number of position i (pos[d][i]), or ncell when it lies outside the grid (or is not
+ * finite). */
+static inline uint32_t cell_of(const struct cells *C, double *const pos[DIM], size_t i)
+{
+    size_t c = 0;
+    for (int d = DIM - 1; d >= 0; d--) {
+        const double f = (pos[d][i] - C->lo[d]) * (d == 0 ? 1.0 / C->width : 1.0 / C->size);
+        if (!(f >= 0.0 && f < C->n[d])) return (uint32_t)C->ncell;
+        c = c * (size_t)C->n[d] + (size_t)f;
+    }
+    return (uint32_t)c;
+}
+
 long cells_build(struct cells *C, struct particles *P)
 {
     const size_t n = P->n, nc = C->ncell;
     if (ensure(C, n) != 0) return -1;
     long lost = 0;
-    const double invx = 1.0 / C->width, invz = 1.0 / C->size;
     for (size_t i = 0; i < n; i++) {
         uint32_t c = (uint32_t)nc;
         if (P->state[i] != MIXSPH_STATE_LOST) {
-            const double fx = (P->x[i] - C->x0) * invx, fz = (P->z[i] - C->z0) * invz;
-            if (fx >= 0.0 && fz >= 0.0 && fx < C->nx && fz < C->nz) {
-                c = (uint32_t)((size_t)fz * (size_t)C->nx + (size_t)fx);
-            } else {
+            c = cell_of(C, P->pos, i);
+            if (c == nc) {
                 P->state[i] = MIXSPH_STATE_LOST; /* left the domain (or not finite) */
-                P->vx[i] = P->vz[i] = 0.0;
+                for (int d = 0; d < DIM; d++) P->vel[d][i] = 0.0;
                 lost++;
             }
         }
@@ -90,19 +105,17 @@ long cells_build(struct cells *C, struct particles *P)
     return lost;
 }
 
-int cells_index(struct cells *C, const struct particles *P, const double *x, const double *z)
+int cells_index(struct cells *C, const struct particles *P, double *const pos[DIM])
 {
     const size_t n = P->n, nc = C->ncell;
     if (ensure(C, n) != 0) return -1;
-    const double invx = 1.0 / C->width, invz = 1.0 / C->size;
     memset(C->start, 0, (nc + 2) * sizeof *C->start);
     uint32_t prev = 0;
     for (size_t i = 0; i < n; i++) {
         uint32_t c = (uint32_t)nc;
         if (P->state[i] != MIXSPH_STATE_LOST) {
-            const double fx = (x[i] - C->x0) * invx, fz = (z[i] - C->z0) * invz;
-            if (!(fx >= 0.0 && fz >= 0.0 && fx < C->nx && fz < C->nz)) return -1;
-            c = (uint32_t)((size_t)fz * (size_t)C->nx + (size_t)fx);
+            c = cell_of(C, pos, i);
+            if (c == nc) return -1;
         }
         if (c < prev) return -1;
         prev = c;

@@ -13,6 +13,7 @@
  * vanish there (6 in 3D). */
 #ifndef MIXSPH_DIM_H
 #define MIXSPH_DIM_H
+#include <math.h>
 
 #ifndef MIXSPH_DIM
 #define MIXSPH_DIM 2
@@ -47,5 +48,16 @@ static inline int sym_index(int a, int b)
 #else
 #define DIM_AXES "xyz"
 #endif
+
+/* The length of a DIM-vector: hypot in 2D (no overflow, and the rounding the 2D code has always
+ * had), the root of the sum of squares in 3D. */
+static inline double dim_norm(const double v[DIM])
+{
+#if DIM == 2
+    return hypot(v[0], v[1]);
+#else
+    return sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+#endif
+}
 
 #endif

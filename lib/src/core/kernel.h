@@ -1,9 +1,10 @@
-/* kernel.h - the SPH kernels in 2D with compact support 2h (docs/model.md section 1), q = r/h:
+/* kernel.h - the SPH kernels in DIM dimensions with compact support 2h (docs/model.md section 1),
+ * q = r/h; the normalisation a_d makes W integrate to 1 over the plane (2D) or space (3D):
  *
- * cubic B-spline (default; the kernel of SPHERA), a_d = 10 / (7 pi h^2):
+ * cubic B-spline (default; the kernel of SPHERA), a_d = 10 / (7 pi h^2) in 2D, 1 / (pi h^3) in 3D:
  *   W = a_d (1 - 3/2 q^2 + 3/4 q^3)   q < 1        F = a_d/h^2 (-3 + 9/4 q)
  *   W = a_d/4 (2 - q)^3               1 <= q < 2   F = -3/4 a_d/h^2 (2 - q)^2 / q
- * Wendland C2, a_d = 7 / (4 pi h^2):
+ * Wendland C2, a_d = 7 / (4 pi h^2) in 2D, 21 / (16 pi h^3) in 3D:
  *   W = a_d (1 - q/2)^4 (2q + 1)                   F = -5 a_d/h^2 (1 - q/2)^3
  *
  * grad_i W = F (x_i - x_j): F is the scalar the pair loops use (no division by r needed).
@@ -20,6 +21,7 @@
 #define MIXSPH_KERNEL_H
 #include <math.h>
 
+#include "dim.h"
 #include "geometry.h"
 
 enum kernel_type { KERNEL_CUBIC_SPLINE = 0, KERNEL_WENDLAND_C2 = 1 };
@@ -29,8 +31,8 @@ struct kernel {
     double h;      /* smoothing length [m] */
     double inv_h;  /* 1 / h [1/m] */
     double r2max;  /* (2h)^2: squared support radius [m2] */
-    double a_d;    /* normalisation of W [1/m2] */
-    double f_fac;  /* a_d / h^2 times the law's leading factor (see kernel_f_q) [1/m4] */
+    double a_d;    /* normalisation of W [1/m^DIM] */
+    double f_fac;  /* a_d / h^2 times the law's leading factor (see kernel_f_q) [1/m^(DIM+2)] */
 };
 
 static inline struct kernel kernel_make_type(double h, int type)
@@ -40,13 +42,12 @@ static inline struct kernel kernel_make_type(double h, int type)
     k.h = h;
     k.inv_h = 1.0 / h;
     k.r2max = 4.0 * h * h;
-    if (type == KERNEL_WENDLAND_C2) {
-        k.a_d = 7.0 / (4.0 * GEOM_PI * h * h);
-        k.f_fac = -5.0 * k.a_d / (h * h);
-    } else {
-        k.a_d = 10.0 / (7.0 * GEOM_PI * h * h);
-        k.f_fac = k.a_d / (h * h);
-    }
+#if DIM == 2
+    k.a_d = type == KERNEL_WENDLAND_C2 ? 7.0 / (4.0 * GEOM_PI * h * h) : 10.0 / (7.0 * GEOM_PI * h * h);
+#else
+    k.a_d = type == KERNEL_WENDLAND_C2 ? 21.0 / (16.0 * GEOM_PI * h * h * h) : 1.0 / (GEOM_PI * h * h * h);
+#endif
+    k.f_fac = (type == KERNEL_WENDLAND_C2 ? -5.0 * k.a_d : k.a_d) / (h * h);
     return k;
 }
 

@@ -9,8 +9,7 @@
 
 void neighbours_free(struct neighbours *NB)
 {
-    free(NB->x0);
-    free(NB->z0);
+    for (int d = 0; d < DIM; d++) free(NB->pos0[d]);
     free(NB->rng);
     const double skin = NB->skin;
     memset(NB, 0, sizeof *NB);
@@ -29,9 +28,9 @@ int neighbours_reserve(struct neighbours *NB, size_t cap)
 {
     if (cap + 1 <= NB->cap_n) return 0;
     cap++;
-    if (grow((void **)&NB->x0, cap, sizeof(double)) || grow((void **)&NB->z0, cap, sizeof(double)) ||
-        grow((void **)&NB->rng, 4 * cap, sizeof(uint32_t)))
-        return -1;
+    for (int d = 0; d < DIM; d++)
+        if (grow((void **)&NB->pos0[d], cap, sizeof(double))) return -1;
+    if (grow((void **)&NB->rng, 2 * NEIGHBOURS_RANGES * cap, sizeof(uint32_t))) return -1;
     NB->cap_n = cap;
     return 0;
 }
@@ -40,17 +39,24 @@ int neighbours_build(struct neighbours *NB, const struct cells *C, const struct 
                      int n_threads)
 {
     if (neighbours_reserve(NB, P->cap) != 0) return -1;
-    memcpy(NB->x0, P->x, P->n * sizeof(double));
-    memcpy(NB->z0, P->z, P->n * sizeof(double));
+    for (int d = 0; d < DIM; d++) memcpy(NB->pos0[d], P->pos[d], P->n * sizeof(double));
     return neighbours_relist(NB, C, n, rc, n_threads);
 }
 
-/* [b, e) trimmed to its first and last particle closer than rc to (xi, zi) (empty if none). */
-static inline void trim(const double *x, const double *z, double xi, double zi, double rc2, size_t *b, size_t *e)
+/* Squared distance between particles i and j of the positions x[d][.]. */
+static inline double distance2(double *const x[DIM], size_t i, size_t j)
+{
+    double r2 = 0.0;
+    for (int d = 0; d < DIM; d++) r2 += (x[d][i] - x[d][j]) * (x[d][i] - x[d][j]);
+    return r2;
+}
+
+/* [b, e) trimmed to its first and last particle closer than rc to particle i (empty if none). */
+static inline void trim(double *const x[DIM], size_t i, double rc2, size_t *b, size_t *e)
 {
     size_t lo = *b, hi = *e;
-    while (lo < hi && (xi - x[lo]) * (xi - x[lo]) + (zi - z[lo]) * (zi - z[lo]) >= rc2) lo++;
-    while (hi > lo && (xi - x[hi - 1]) * (xi - x[hi - 1]) + (zi - z[hi - 1]) * (zi - z[hi - 1]) >= rc2) hi--;
+    while (lo < hi && distance2(x, i, lo) >= rc2) lo++;
+    while (hi > lo && distance2(x, i, hi - 1) >= rc2) hi--;
     *b = lo;
     *e = hi;
 }
@@ -74,20 +80,22 @@ static void relist_range(void *arg, size_t b, size_t e)
     struct neighbours *NB = L->NB;
     const struct cells *C = L->C;
     const double rc2 = L->rc2;
-    const double *x = NB->x0, *z = NB->z0;
     for (size_t i = b; i < e; i++) {
-        const size_t c = C->cell[i];
-        const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
-        const int last = ix + C->kx < C->nx ? ix + C->kx : C->nx - 1;
-        size_t b1 = i + 1, e1 = C->start[(size_t)iz * (size_t)C->nx + (size_t)last + 1];
-        trim(x, z, x[i], z[i], rc2, &b1, &e1);
-        const struct range up = cells_row(C, ix, iz, 1);
-        size_t b2 = up.begin, e2 = up.end;
-        trim(x, z, x[i], z[i], rc2, &b2, &e2);
-        NB->rng[4 * i] = (uint32_t)b1;
-        NB->rng[4 * i + 1] = (uint32_t)e1;
-        NB->rng[4 * i + 2] = (uint32_t)b2;
-        NB->rng[4 * i + 3] = (uint32_t)e2;
+        int c[DIM];
+        cells_unindex(C, C->cell[i], c);
+        uint32_t *r = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        const int last = c[0] + C->kx < C->n[0] ? c[0] + C->kx : C->n[0] - 1;
+        size_t b1 = i + 1, e1 = C->start[C->cell[i] - (size_t)c[0] + (size_t)last + 1];
+        trim(NB->pos0, i, rc2, &b1, &e1);
+        r[0] = (uint32_t)b1;
+        r[1] = (uint32_t)e1;
+        for (int k = 1; k < NEIGHBOURS_RANGES; k++) {
+            const struct range up = cells_row(C, c, CELLS_ROWS_AROUND / 2 + k);
+            size_t b2 = up.begin, e2 = up.end;
+            trim(NB->pos0, i, rc2, &b2, &e2);
+            r[2 * k] = (uint32_t)b2;
+            r[2 * k + 1] = (uint32_t)e2;
+        }
     }
 }
 
@@ -107,12 +115,19 @@ static void shift_range(void *arg, size_t b, size_t e)
     const struct particles *P = L->P;
     double m = 0.0;
     int out = 0;
-    const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
+    double lo[DIM], hi[DIM];
+    for (int d = 0; d < DIM; d++) {
+        lo[d] = C->lo[d];
+        hi[d] = cells_hi(C, d);
+    }
     for (size_t i = b; i < e; i++) {
-        const double dx = P->x[i] - NB->x0[i], dz = P->z[i] - NB->z0[i];
-        const double d2 = dx * dx + dz * dz;
+        double d2 = 0.0;
+        for (int d = 0; d < DIM; d++) {
+            const double dd = P->pos[d][i] - NB->pos0[d][i];
+            d2 += dd * dd;
+            out |= !(P->pos[d][i] >= lo[d] && P->pos[d][i] < hi[d]);
+        }
         m = d2 > m ? d2 : m;
-        out |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
     }
     team_max_double(&L->m, m);
     team_or_int(&L->out, out);
@@ -140,7 +155,7 @@ int neighbours_gather_reserve(struct gather *G, size_t cap)
 {
     if (cap + 1 <= G->cap_n) return 0;
     cap++;
-    if (grow((void **)&G->rng, 6 * cap, sizeof(uint32_t)) || grow((void **)&G->mode, cap, 1) ||
+    if (grow((void **)&G->rng, 2 * CELLS_ROWS_AROUND * cap, sizeof(uint32_t)) || grow((void **)&G->mode, cap, 1) ||
         grow((void **)&G->start, cap + 1, sizeof(size_t)))
         return -1;
     G->cap_n = cap;
@@ -148,15 +163,15 @@ int neighbours_gather_reserve(struct gather *G, size_t cap)
 }
 
 /* Non-wall neighbours of wall particle i within rc over its ranges: counted or written. */
-static inline size_t wall_scan(const struct gather *G, const double *x, const double *z, const uint8_t *state, size_t i,
-                               double rc2, uint32_t *out)
+static inline size_t wall_scan(const struct gather *G, double *const x[DIM], const uint8_t *state, size_t i, double rc2,
+                               uint32_t *out)
 {
     size_t k = 0;
-    for (int q = 0; q < 6; q += 2)
-        for (size_t j = G->rng[6 * i + q]; j < G->rng[6 * i + q + 1]; j++) {
+    const uint32_t *r = G->rng + 2 * CELLS_ROWS_AROUND * i;
+    for (int q = 0; q < 2 * CELLS_ROWS_AROUND; q += 2)
+        for (size_t j = r[q]; j < r[q + 1]; j++) {
             if (state[j] == MIXSPH_STATE_WALL) continue;
-            const double rx = x[i] - x[j], rz = z[i] - z[j];
-            if (rx * rx + rz * rz < rc2) {
+            if (distance2(x, i, j) < rc2) {
                 if (out) out[k] = (uint32_t)j;
                 k++;
             }
@@ -173,25 +188,25 @@ static void gather_ranges_range(void *arg, size_t i0, size_t i1)
     const struct cells *C = L->C;
     const uint8_t *state = L->state;
     const double rc2 = L->rc2;
-    const double *x = L->cNB->x0, *z = L->cNB->z0;
+    double *const *x = L->cNB->pos0;
     size_t *cnt = G->start + 1;
     for (size_t i = i0; i < i1; i++) {
-        uint32_t *r = G->rng + 6 * i;
+        uint32_t *r = G->rng + 2 * CELLS_ROWS_AROUND * i;
         if (G->mode[i] == NEIGHBOURS_GATHER_NONE) {
-            memset(r, 0, 6 * sizeof *r);
+            memset(r, 0, 2 * CELLS_ROWS_AROUND * sizeof *r);
             cnt[i] = 0;
             continue;
         }
-        const size_t c = C->cell[i];
-        const int ix = (int)(c % (size_t)C->nx), iz = (int)(c / (size_t)C->nx);
-        for (int row = -1; row <= 1; row++) {
-            const struct range g = cells_row(C, ix, iz, row);
+        int c[DIM];
+        cells_unindex(C, C->cell[i], c);
+        for (int row = 0; row < CELLS_ROWS_AROUND; row++) {
+            const struct range g = cells_row(C, c, row);
             size_t b = g.begin, e = g.end;
-            trim(x, z, x[i], z[i], rc2, &b, &e);
-            r[2 * (row + 1)] = (uint32_t)b;
-            r[2 * (row + 1) + 1] = (uint32_t)e;
+            trim(x, i, rc2, &b, &e);
+            r[2 * row] = (uint32_t)b;
+            r[2 * row + 1] = (uint32_t)e;
         }
-        cnt[i] = state[i] == MIXSPH_STATE_WALL ? wall_scan(G, x, z, state, i, rc2, NULL) : 0;
+        cnt[i] = state[i] == MIXSPH_STATE_WALL ? wall_scan(G, x, state, i, rc2, NULL) : 0;
     }
 }
 
@@ -200,9 +215,8 @@ static void gather_list_range(void *arg, size_t b, size_t e)
     const struct nb_loop *L = arg;
     const struct gather *G = L->G;
     const uint8_t *state = L->state;
-    const double *x = L->cNB->x0, *z = L->cNB->z0;
     for (size_t i = b; i < e; i++)
-        if (state[i] == MIXSPH_STATE_WALL) wall_scan(G, x, z, state, i, L->rc2, G->list + G->start[i]);
+        if (state[i] == MIXSPH_STATE_WALL) wall_scan(G, L->cNB->pos0, state, i, L->rc2, G->list + G->start[i]);
 }
 
 int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const struct cells *C, const uint8_t *state,

@@ -1,10 +1,12 @@
 /* neighbours.h - Verlet neighbour ranges with a skin over the cell list (cells.c).
  *
- * The cells are rows of height 2h + skin cut into kx narrow columns per row height, and the
- * particles are sorted by (row, column). For each particle i the pair loops (forces.c) walk two
- * contiguous ranges of candidates j, its half stencil: the particles after i in its own row up
- * to column ix + kx, and the particles of columns ix-kx..ix+kx of the row above, both trimmed at
- * the build to the first and last candidates closer than 2h + skin. Contiguous ranges keep the
+ * The cells are rows 2h + skin apart cut into kx narrow columns per row spacing, and the
+ * particles are sorted by (row, column) (cells.h). For each particle i the pair loops (forces.c)
+ * walk NEIGHBOURS_RANGES contiguous ranges of candidates j, its half stencil: the particles after
+ * i in its own row up to column ix + kx, and the particles of columns ix-kx..ix+kx of the rows
+ * after its own among those around it (the row above in 2D; in 3D the next row of its layer and
+ * the three rows around it in the layer above), each trimmed at the build to the first and last
+ * candidates closer than 2h + skin. Contiguous ranges keep the
  * inner loops on unit-stride loads (this CPU gathers slowly) while the narrow columns and the
  * trimming cut the candidates beyond 2h from about 70% (square cells of side 2h) to about half.
  * The ranges stay valid while no particle has moved more than skin/2 since the build (no pair
@@ -30,23 +32,29 @@
 /* Entries past the end of a gather list that a chunked loop may read (see forces.c). */
 #define NEIGHBOURS_PAD 16
 
+/* The ranges of a particle's half stencil: the rest of its own row and the rows after it around
+ * it (cells.h: 2 in 2D, the row above; 5 in 3D) */
+#define NEIGHBOURS_RANGES (1 + CELLS_ROWS_AROUND / 2)
+
 struct neighbours {
     double skin;        /* [m] */
-    double *x0, *z0;    /* positions at the last build [m] */
-    uint32_t *rng;      /* per particle i, 4 entries: own row [rng[4i], rng[4i+1]), row above [rng[4i+2], rng[4i+3]) */
+    double *pos0[DIM];  /* positions at the last build [m] */
+    uint32_t *rng;      /* per particle i, 2 NEIGHBOURS_RANGES entries: range r is [rng[2 R i + 2 r],
+                         * rng[2 R i + 2 r + 1]), R = NEIGHBOURS_RANGES; r = 0 the rest of i's own row */
     size_t cap_n;
     uint64_t builds;    /* number of builds (diagnostic) */
 };
 
-/* Gather ranges: for chosen particles, their whole neighbourhood as three contiguous ranges
- * (rows iz-1, iz, iz+1, columns ix-kx..ix+kx, trimmed at the build to the candidates closer
- * than rc; i itself included), for loops that gather over one particle's neighbours (the
+/* Gather ranges: for chosen particles, their whole neighbourhood as CELLS_ROWS_AROUND contiguous
+ * ranges (the rows around theirs, columns ix-kx..ix+kx, trimmed at the build to the candidates
+ * closer than rc; i itself included), for loops that gather over one particle's neighbours (the
  * velocity gradient of grains, the pressure of wall particles). Built with the pair ranges,
  * from the same build positions. */
 enum { NEIGHBOURS_GATHER_NONE = 0, NEIGHBOURS_GATHER_ALL = 1 };
 
 struct gather {
-    uint32_t *rng;      /* per particle i, 6 entries: [rng[6i+2r], rng[6i+2r+1]) for rows r = 0, 1, 2 */
+    uint32_t *rng;      /* per particle i, 2 CELLS_ROWS_AROUND entries: [rng[2 A i + 2r], rng[2 A i + 2r + 1])
+                         * for rows r = 0 .. A - 1, A = CELLS_ROWS_AROUND */
     uint8_t *mode;      /* per particle: NEIGHBOURS_GATHER_* (set by the caller before a build) */
     size_t cap_n;
     /* wall particles: their non-wall neighbours as a compact list (few of a wall's neighbours
@@ -71,15 +79,14 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
 int neighbours_build(struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n, double rc,
                      int n_threads);
 
-/** Rebuild the ranges from the build positions already in x0, z0 (a restored state). */
+/** Rebuild the ranges from the build positions already in pos0 (a restored state). */
 int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads);
 
 /** Make room for cap particles' build positions. Returns -1 on allocation failure. */
 int neighbours_reserve(struct neighbours *NB, size_t cap);
 
 /** Largest squared displacement of the first n particles since the last build, and whether
- *  one of them is outside the grid [x0, x0 + nx size) x [z0, z0 + nz size) (then the caller
- *  rebuilds at once, which marks it lost). */
+ *  one of them is outside the grid (then the caller rebuilds at once, which marks it lost). */
 double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
                              int *outside, int n_threads);
 

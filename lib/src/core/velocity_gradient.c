@@ -5,18 +5,21 @@
 
 int velocity_gradient_alloc(struct velocity_gradient *V, size_t cap)
 {
-    double **f[7] = {&V->dudx, &V->dudz, &V->dwdx, &V->dwdz, &V->lxx, &V->lxz, &V->lzz};
     int ok = 1;
-    for (int k = 0; k < 7; k++) ok &= (*f[k] = calloc(cap + 1, sizeof(double))) != NULL;
+    for (int k = 0; k < DIM * DIM; k++) ok &= (V->g[k] = calloc(cap + 1, sizeof(double))) != NULL;
+    for (int k = 0; k < VELOCITY_GRADIENT_L_N; k++) ok &= (V->l[k] = calloc(cap + 1, sizeof(double))) != NULL;
     if (!ok) velocity_gradient_free(V);
     return ok ? 0 : -1;
 }
 
 void velocity_gradient_free(struct velocity_gradient *V)
 {
-    double **f[7] = {&V->dudx, &V->dudz, &V->dwdx, &V->dwdz, &V->lxx, &V->lxz, &V->lzz};
-    for (int k = 0; k < 7; k++) {
-        free(*f[k]);
-        *f[k] = NULL;
+    for (int k = 0; k < DIM * DIM; k++) {
+        free(V->g[k]);
+        V->g[k] = NULL;
+    }
+    for (int k = 0; k < VELOCITY_GRADIENT_L_N; k++) {
+        free(V->l[k]);
+        V->l[k] = NULL;
     }
 }

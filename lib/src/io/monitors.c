@@ -101,21 +101,24 @@ static void probe_point(const mixsph_sim *s, const struct monitor_def *md, doubl
  * non-wall particles (head of the file), 0 when dry. The candidates are those of the cell
  * list's stencil around the point: the cells describe the positions of the last build, and no
  * particle has moved skin/2 since, so every particle now within 2h of the point is in it. */
-static double probe_pressure(const mixsph_sim *s, double x, double z)
+static double probe_pressure(const mixsph_sim *s, const double pt[DIM])
 {
     const struct cells *C = &s->work.C;
     const struct particles *P = &s->phys.P;
     const struct kernel *K = &s->phys.K;
-    if (!(x >= C->x0 && z >= C->z0)) return 0.0; /* a moving wall's probe carried off the grid */
-    int ix, iz;
-    cells_coords(C, x, z, &ix, &iz);
-    if (ix >= C->nx || iz >= C->nz) return 0.0;
+    for (int d = 0; d < DIM; d++)
+        if (!(pt[d] >= C->lo[d])) return 0.0; /* a moving wall's probe carried off the grid */
+    int c[DIM];
+    cells_coords(C, pt, c);
+    for (int d = 0; d < DIM; d++)
+        if (c[d] >= C->n[d]) return 0.0;
     double sw = 0.0, swp = 0.0;
-    for (int row = -1; row <= 1; row++) {
-        const struct range rg = cells_row(C, ix, iz, row);
+    for (int row = 0; row < CELLS_ROWS_AROUND; row++) {
+        const struct range rg = cells_row(C, c, row);
         for (size_t j = rg.begin; j < rg.end; j++) {
             if (P->state[j] > MIXSPH_STATE_FIXED) continue;
-            const double rx = x - P->x[j], rz = z - P->z[j], r2 = rx * rx + rz * rz;
+            double r2 = 0.0;
+            for (int d = 0; d < DIM; d++) r2 += (pt[d] - P->pos[d][j]) * (pt[d] - P->pos[d][j]);
             if (r2 >= K->r2max) continue;
             const double w = kernel_w(K, sqrt(r2)) * P->m[j] / P->rho[j];
             sw += w;
@@ -208,7 +211,8 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
     if (md->kind == MONITOR_PRESSURE_PROBE) {
         double x, z;
         probe_point(s, md, &x, &z);
-        return probe_pressure(s, x, z);
+        const double pt[DIM] = {x, z};
+        return probe_pressure(s, pt);
     }
     if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
         double e = 0.0;

@@ -185,8 +185,7 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
             put(w, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
     }
     /* the neighbour lists' build positions: the lists (and the pair order) are rebuilt from them */
-    put(w, s->work.NB.x0, P->n * sizeof(double));
-    put(w, s->work.NB.z0, P->n * sizeof(double));
+    for (int d = 0; d < DIM; d++) put(w, s->work.NB.pos0[d], P->n * sizeof(double));
     put_u64(w, s->work.NB.builds);
 }
 
@@ -287,7 +286,7 @@ static int state_same_case(const mixsph_sim *s, const char *text, const char *co
 static mixsph_status state_relist(mixsph_sim *s)
 {
     forces_forget_cache(s->work.forces);
-    if (cells_index(&s->work.C, &s->phys.P, s->work.NB.x0, s->work.NB.z0) != 0 ||
+    if (cells_index(&s->work.C, &s->phys.P, s->work.NB.pos0) != 0 ||
         neighbours_relist(&s->work.NB, &s->work.C, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: particles not in cell order (or out of memory)");
     return integrate_build_gather_lists(s);
@@ -344,8 +343,7 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
         for (unsigned c = 0; c < f->components; c++)
             get(r, particles_array(P, f->member[c]), P->n * particle_field_size(f->type));
     }
-    get(r, s->work.NB.x0, P->n * sizeof(double));
-    get(r, s->work.NB.z0, P->n * sizeof(double));
+    for (int d = 0; d < DIM; d++) get(r, s->work.NB.pos0[d], P->n * sizeof(double));
     s->work.NB.builds = get_u64(r);
     if (r->bad || r->pos != r->len) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: malformed particle section");
     return state_relist(s);
@@ -369,16 +367,16 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
     /* keep a copy so that a malformed payload leaves the simulation unchanged */
     mixsph_sim *keep = malloc(sizeof *keep);
     const size_t nb = s->phys.P.n * sizeof(double);
-    double *x0k = malloc(nb + 1), *z0k = malloc(nb + 1);
+    double *pos0_kept[DIM];
+    int no_memory = !keep;
+    for (int d = 0; d < DIM; d++) no_memory |= !(pos0_kept[d] = malloc(nb + 1));
     struct particles Pk;
-    if (!keep || !x0k || !z0k || particles_copy(&Pk, &s->phys.P) != 0) {
+    if (no_memory || particles_copy(&Pk, &s->phys.P) != 0) {
         free(keep);
-        free(x0k);
-        free(z0k);
+        for (int d = 0; d < DIM; d++) free(pos0_kept[d]);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     }
-    memcpy(x0k, s->work.NB.x0, nb);
-    memcpy(z0k, s->work.NB.z0, nb);
+    for (int d = 0; d < DIM; d++) memcpy(pos0_kept[d], s->work.NB.pos0[d], nb);
     memcpy(keep, s, sizeof *s);
     st = read_dynamic(&r, s);
     if (st != MIXSPH_OK) {
@@ -388,15 +386,13 @@ mixsph_status mixsph_sim_load_state(mixsph_sim *s, const void *buf, size_t len)
         memcpy(s, keep, sizeof *s);
         s->phys.P = P;
         particles_copy_values(&s->phys.P, &Pk);
-        memcpy(s->work.NB.x0, x0k, nb);
-        memcpy(s->work.NB.z0, z0k, nb);
+        for (int d = 0; d < DIM; d++) memcpy(s->work.NB.pos0[d], pos0_kept[d], nb);
         state_relist(s);
         memcpy(s->err, msg, sizeof msg);
     }
     particles_free(&Pk);
     free(keep);
-    free(x0k);
-    free(z0k);
+    for (int d = 0; d < DIM; d++) free(pos0_kept[d]);
     return st;
 }
 

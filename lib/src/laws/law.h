@@ -4,9 +4,12 @@
  * struct particles its features name), a per-step update that is given dt and the velocity
  * gradient, its bounds on the time step, and what it hands the momentum pass: the per-particle
  * viscosity P->mu (the Morris Laplacian of a pairwise viscosity) and, with LAW_HAS_STRESS, the
- * deviatoric stress (P->sxx, sxz, szz; syy out of plane), whose divergence the momentum pass adds
- * in one symmetric pair term (passes/forces.c). Adding a law: its module, one line in
- * law_registry.c, an entry in enum law_id (medium.h) and its tests (docs/development.md). */
+ * deviatoric stress (P->stress), whose divergence the momentum pass adds in one symmetric pair
+ * term (passes/forces.c). What else it asks of the step it declares as data: its feature bits
+ * (enum law_feature, medium.h) and, for a law that holds particles, how a held particle is
+ * integrated (held_kicked, held_viscosity); the step reads these and never a law's id. Adding a
+ * law: its module, one line in law_registry.c, an entry in enum law_id (medium.h) and its tests
+ * (docs/development.md). */
 #ifndef MIXSPH_LAW_H
 #define MIXSPH_LAW_H
 #include <stddef.h>
@@ -85,9 +88,16 @@ struct material_law {
     /** Its state for one simulation (NULL members: the law has none); NULL when out of memory. */
     void *(*create)(const struct law_setup *setup);
     void (*destroy)(void *state);
-    /** The per-step update of its particles; returns a count the law reports (the paper's law:
-     *  grains held fixed), 0 otherwise. */
+    /** The per-step update of its particles; returns the particles it holds fixed (a law with
+     *  LAW_HOLDS_PARTICLES), 0 otherwise. */
     long (*update)(void *state, const struct law_step *step);
+    /** With LAW_HOLDS_PARTICLES: whether a held particle takes the kicks of its forces (it is
+     *  never drifted); `rigid`: the implicit scheme holds such particles at rest through its
+     *  viscous step (numerics.held_grains = "rigid"). */
+    int (*held_kicked)(const struct medium *m, int rigid);
+    /** With LAW_HOLDS_PARTICLES: the viscosity [Pa s] a held particle enters the explicit viscous
+     *  bound of the time step (4) with. */
+    double (*held_viscosity)(const struct medium *m);
 };
 
 #endif

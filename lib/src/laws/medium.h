@@ -23,8 +23,15 @@ enum law_id {
 enum law_feature {
     LAW_USES_GRADIENT = 1u, /* the velocity gradient of its particles is gathered every step */
     LAW_HAS_STRESS = 2u,    /* its particles carry a deviatoric stress (P->sxx, sxz, szz, syy) */
-    LAW_CAPS_TENSION = 4u   /* its update bounds the tension the equation of state gives (a yield surface's
+    LAW_CAPS_TENSION = 4u,  /* its update bounds the tension the equation of state gives (a yield surface's
                                apex), so a density below rho0 is its grains parting, not a blow-up */
+    LAW_DENSITY_DIFFUSION = 8u, /* its particles take the continuity pass's density diffusion (a fluid: a
+                                   grain's density carries its packing or its elastic pressure, which
+                                   diffused would let a standing heap creep; docs/numerics.md 2c) */
+    LAW_WALL_FRICTION = 16u,    /* no-slip walls bound the shear they give its particles by their friction
+                                   (docs/model.md [DP-W]; with LAW_HAS_STRESS) */
+    LAW_HOLDS_PARTICLES = 32u   /* its update holds particles fixed (MIXSPH_STATE_FIXED) and returns how
+                                   many; the law says how a held particle is integrated (law.h) */
 };
 
 struct medium {

@@ -85,7 +85,7 @@ static void aligned_block_free(void *p) { free(p); }
  * stress, no-slip walls): the walls' force on it, the wall normal n = -sum_j V_j F_ij x_ij (out of
  * the walls), the weight q = -sum_j V_j F_ij of the walls with a given friction coefficient, that
  * weight times their coefficient, and the weight of the walls that take the grain's own. */
-enum { WALL_FX, WALL_FZ, WALL_NX, WALL_NZ, WALL_Q_GIVEN, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS };
+enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS }; /* F, N: DIM each */
 
 struct forces {
     double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
@@ -125,8 +125,8 @@ struct pair_ctx {
     double diffusion_g;   /* g with the hydrostatic form of the diffusion, 0 with Molteni's */
     double *sum, *weight;
     double *visc_w;       /* the viscous couplings of the lanes (implicit viscosity), or NULL */
-    const double *in_x, *in_z; /* the velocity field a viscous operator is applied to */
-    double *out_x, *out_z;     /* and its result */
+    const double *in[DIM];     /* the velocity field a viscous operator is applied to */
+    double *out[DIM];          /* and its result */
     double *out_diag;          /* and its diagonal, or NULL */
     const int32_t *group;      /* forces_viscous_group_couplings: each particle's group, or -1 */
     long group_stride;         /* groups per row of the group grid */
@@ -153,8 +153,11 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->media = S->media;
     X->diffusion_g = fp->diffusion_form == DENSITY_DIFFUSION_HYDROSTATIC ? fp->g : 0.0;
     X->visc_w = NULL;
-    X->in_x = X->in_z = NULL;
-    X->out_x = X->out_z = X->out_diag = NULL;
+    for (int d = 0; d < DIM; d++) {
+        X->in[d] = NULL;
+        X->out[d] = NULL;
+    }
+    X->out_diag = NULL;
     X->group = NULL;
     X->group_stride = 0;
     X->group_w = NULL;
@@ -204,9 +207,15 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
                                     const int wendland, const int store, const int diffuse)
 {
-    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], ti = P->tag[i], voli = P->vol[i];
-    const double rhoi = P->rho[i];
-    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
+    const double ti = P->tag[i], voli = P->vol[i], rhoi = P->rho[i];
+    double xi[DIM], vi[DIM];
+    const double *restrict x[DIM], *restrict v[DIM];
+    for (int d = 0; d < DIM; d++) {
+        xi[d] = P->pos[d][i];
+        vi[d] = P->vel[d][i];
+        x[d] = P->pos[d];
+        v[d] = P->vel[d];
+    }
     const double *restrict vol = P->vol, *restrict tag = P->tag, *restrict rho = P->rho;
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
@@ -217,10 +226,14 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double in = FORCES_LANE_IN(k, m);
-            const double rx = xi - x[j], rz = zi - z[j];
-            const double r2 = rx * rx + rz * rz;
+            double r[DIM], r2 = 0.0, uf = 0.0;
+            for (int d = 0; d < DIM; d++) {
+                r[d] = xi[d] - x[d][j];
+                r2 += r[d] * r[d];
+            }
             const double F = pair_f(&Xl, r2, wendland) * in;
-            const double uf = ((vxi - vx[j]) * rx + (vzi - vz[j]) * rz) * F;
+            for (int d = 0; d < DIM; d++) uf += (vi[d] - v[d][j]) * r[d];
+            uf *= F;
             const double c = (r2 < Xl.K.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
             if (store) fk[k] = F;
             acc[k] += vol[j] * uf;
@@ -229,7 +242,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             cj[k] = c;
             if (diffuse) {
                 const double one = (tag[j] == ti ? 1.0 : 0.0) * fluid_i; /* F is 0 on masked lanes */
-                const double q = -(rho[j] - rhoi - hyd_i * rz) * F * one;
+                const double q = -(rho[j] - rhoi - hyd_i * r[DIM_UP]) * F * one;
                 dif[k] += vol[j] * q;
                 ej[k] = -voli * q;
             }
@@ -255,8 +268,14 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
                                 const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
                                 double *restrict sum, double *restrict weight, const int wendland)
 {
-    const double xi = P->x[i], zi = P->z[i], pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
-    const double *restrict x = P->x, *restrict z = P->z, *restrict p = P->p, *restrict rho = P->rho;
+    const double pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
+    double xi[DIM];
+    const double *restrict x[DIM];
+    for (int d = 0; d < DIM; d++) {
+        xi[d] = P->pos[d][i];
+        x[d] = P->pos[d];
+    }
+    const double *restrict p = P->p, *restrict rho = P->rho;
     const double *restrict vol = P->vol, *restrict tag = P->tag;
     const struct pair_ctx Xl = *X;
     double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
@@ -265,10 +284,14 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
-            const double rx = xi - x[j], rz = zi - z[j];
-            double w = kernel_w_q(&Xl.K, kernel_q(&Xl.K, rx * rx + rz * rz), wendland);
+            double r[DIM], r2 = 0.0;
+            for (int d = 0; d < DIM; d++) {
+                r[d] = xi[d] - x[d][j];
+                r2 += r[d] * r[d];
+            }
+            double w = kernel_w_q(&Xl.K, kernel_q(&Xl.K, r2), wendland);
             w *= FORCES_LANE_IN(k, m) * (tag[j] < 0.0 ? 0.0 : 1.0);
-            const double b = (p[j] - pi - 0.5 * (rhoi + rho[j]) * g * rz) * w;
+            const double b = (p[j] - pi - 0.5 * (rhoi + rho[j]) * g * r[DIM_UP]) * w;
             sa[k] += b * vol[j];
             su[k] += w * vol[j];
             aj[k] = -b * voli;
@@ -285,78 +308,124 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
 
 /* Velocity gradient of granular particle i, gathered over its nr ranges of candidates: the uncorrected
  * G = sum_j V_j (u_j - u_i) (x) grad_i W and the correction matrix
- * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (docs/model.md section 5). Walls enter
- * with their no-slip velocity, so grains feel the shear of a wall. Only granular particles need
- * it, so it is a gather over them alone rather than part of the symmetric pass. */
+ * L = sum_j V_j (x_j - x_i) (x) grad_i W of the strain rate (docs/model.md section 5), in the
+ * layout of core/velocity_gradient.h (G's DIM x DIM, then L's upper triangle). Walls enter with
+ * their no-slip velocity, so grains feel the shear of a wall. Only granular particles need it, so
+ * it is a gather over them alone rather than part of the symmetric pass. */
+enum { GRADIENT_SUMS = DIM * DIM + VELOCITY_GRADIENT_L_N };
+
 FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double *acc_i, const int wendland)
 {
-    const double xi = P->x[i], zi = P->z[i], uxi = P->uvx[i], uzi = P->uvz[i];
-    const double *restrict x = P->x, *restrict z = P->z, *restrict uvx = P->uvx, *restrict uvz = P->uvz;
+    double xi[DIM], ui[DIM];
+    const double *restrict x[DIM], *restrict uv[DIM];
+    for (int d = 0; d < DIM; d++) {
+        xi[d] = P->pos[d][i];
+        ui[d] = P->uv[d][i];
+        x[d] = P->pos[d];
+        uv[d] = P->uv[d];
+    }
     const double *restrict vol = P->vol;
     const struct pair_ctx Xl = *X;
-    double a[7][FORCES_CHUNK] = {{0}};
+    double a[GRADIENT_SUMS][FORCES_CHUNK] = {{0}};
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
-            const double rx = xi - x[j], rz = zi - z[j];
-            const double r2 = rx * rx + rz * rz;
+            double r[DIM], r2 = 0.0, du[DIM];
+            for (int d = 0; d < DIM; d++) {
+                r[d] = xi[d] - x[d][j];
+                r2 += r[d] * r[d];
+            }
             const double vf = vol[j] * pair_f(&Xl, r2, wendland) * FORCES_LANE_IN(k, m);
-            const double dux = (uvx[j] - uxi) * vf, duz = (uvz[j] - uzi) * vf;
-            a[0][k] += dux * rx;
-            a[1][k] += dux * rz;
-            a[2][k] += duz * rx;
-            a[3][k] += duz * rz;
-            a[4][k] -= vf * rx * rx;
-            a[5][k] -= vf * rx * rz;
-            a[6][k] -= vf * rz * rz;
+            for (int d = 0; d < DIM; d++) du[d] = (uv[d][j] - ui[d]) * vf;
+            for (int c = 0; c < DIM; c++)
+                for (int d = 0; d < DIM; d++) a[c * DIM + d][k] += du[c] * r[d];
+            for (int c = 0; c < DIM; c++)
+                for (int d = c; d < DIM; d++) a[DIM * DIM + velocity_gradient_l_index(c, d)][k] -= vf * r[c] * r[d];
         }
     }
-    for (int q = 0; q < 7; q++)
+    for (int q = 0; q < GRADIENT_SUMS; q++)
         for (size_t k = 0; k < FORCES_CHUNK; k++) acc_i[q] += a[q][k];
 }
 
-/* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth) is added to
- * i and subtracted from j (ax, az hold forces during the pass; forces_momentum divides by the
- * masses after it). With `implicit` the viscous force is left out and its coupling
+/* The stress a wall particle w of unit normal n (free-slip; n = 0 on no-slip walls and for the
+ * other particles) adds to the stress s it takes from the particle it meets: the change of s
+ * mirrored across the wall, whose shear on the wall's plane is reversed,
+ * s' - s = -2 (q_t (x) n + n (x) q_t), q_t = s n - (n . s n) n, so the pair transmits the normal
+ * stress and no shear (SYM_N components, dim.h; 2D: -2 s_nt (n t + t n), t = (-n_z, n_x),
+ * s_nt = a (s_zz - s_xx) + b s_xz with a = n_x n_z, b = n_x^2 - n_z^2). */
+#if DIM == 3
+FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], double out[SYM_N])
+{
+    double q[3];
+    for (int a = 0; a < 3; a++) {
+        q[a] = 0.0;
+        for (int b = 0; b < 3; b++) q[a] += s[sym_index3(a, b)] * n[b];
+    }
+    const double qn = q[0] * n[0] + q[1] * n[1] + q[2] * n[2];
+    for (int a = 0; a < 3; a++) q[a] -= qn * n[a];
+    for (int a = 0; a < 3; a++)
+        for (int b = a; b < 3; b++) out[sym_index3(a, b)] = -2.0 * (q[a] * n[b] + n[a] * q[b]);
+}
+#endif
+
+/* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth in 2D)
+ * is added to i and subtracted from j (acc holds forces during the pass; forces_momentum divides
+ * by the masses after it). With `implicit` the viscous force is left out and its coupling
  * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
  * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). */
 enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                  const uint32_t *restrict rng, int nr, double *axi, double *azi,
+                                  const uint32_t *restrict rng, int nr, double f_i[DIM],
                                   const double *restrict fk, double *restrict wl, const int wendland,
                                   const int cached, const int implicit, const int stress)
 {
-    const double xi = P->x[i], zi = P->z[i], vxi = P->vx[i], vzi = P->vz[i], uvxi = P->uvx[i], uvzi = P->uvz[i];
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
     const double ti = P->tag[i], avci = P->avc[i];
     const double walli = ti < 0.0 ? 1.0 : 0.0;
-    const double *restrict x = P->x, *restrict z = P->z, *restrict vx = P->vx, *restrict vz = P->vz;
-    const double *restrict uvx = P->uvx, *restrict uvz = P->uvz, *restrict p = P->p, *restrict vol = P->vol;
+    double xi[DIM], vi[DIM], uvi[DIM], si[SYM_N], ni[DIM];
+    const double *restrict x[DIM], *restrict v[DIM], *restrict uv[DIM], *restrict sg[SYM_N], *restrict wall_n[DIM];
+    for (int d = 0; d < DIM; d++) {
+        xi[d] = P->pos[d][i];
+        vi[d] = P->vel[d][i];
+        uvi[d] = P->uv[d][i];
+        x[d] = P->pos[d];
+        v[d] = P->vel[d];
+        uv[d] = P->uv[d];
+        wall_n[d] = P->wall_n[d];
+        ni[d] = stress ? wall_n[d][i] : 0.0;
+    }
+    for (int c = 0; c < SYM_N; c++) {
+        sg[c] = P->stress[c];
+        si[c] = stress ? sg[c][i] : 0.0;
+    }
+    const double *restrict p = P->p, *restrict vol = P->vol;
     const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
     const double *restrict avc = P->avc;
-    const double *restrict sxx = P->sxx, *restrict sxz = P->sxz, *restrict szz = P->szz;
-    const double sxxi = stress ? sxx[i] : 0.0, sxzi = stress ? sxz[i] : 0.0, szzi = stress ? szz[i] : 0.0;
     const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
-    const double *restrict wall_nx = P->wall_nx, *restrict wall_nz = P->wall_nz;
     const double roughi = stress ? wall_rough[i] : 0.0, mu_wi = stress ? wall_mu[i] : 0.0;
+#if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
-    const double mbi = stress ? wall_nx[i] * wall_nx[i] - wall_nz[i] * wall_nz[i] : 0.0;
-    const double mai = stress ? wall_nx[i] * wall_nz[i] : 0.0;
+    const double mbi = ni[0] * ni[0] - ni[1] * ni[1];
+    const double mai = ni[0] * ni[1];
+#endif
     const struct pair_ctx Xl = *X;
-    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}; /* per-lane sums, reduced once */
-    double ws[WALL_SUMS][FORCES_CHUNK] = {{0}};            /* i's wall sums (stress), per lane */
+    double sf[DIM][FORCES_CHUNK] = {{0}};         /* per-lane sums, reduced once */
+    double ws[WALL_SUMS][FORCES_CHUNK] = {{0}};   /* i's wall sums (stress), per lane */
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, n) {
-        double ajx[FORCES_CHUNK], ajz[FORCES_CHUNK];
+        double fj[DIM][FORCES_CHUNK];
         double wj[WALL_SUMS][FORCES_CHUNK]; /* what j's wall sums receive from wall particle i */
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double in = FORCES_LANE_IN(k, n);
-            const double rx = xi - x[j], rz = zi - z[j];
-            const double r2 = rx * rx + rz * rz;
+            double r[DIM], r2 = 0.0;
+            for (int d = 0; d < DIM; d++) {
+                r[d] = xi[d] - x[d][j];
+                r2 += r[d] * r[d];
+            }
             const double F = cached ? fk[k] : pair_f(&Xl, r2, wendland) * in;
             const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
             /* one division for 1 / (r^2 + eta^2) and 1 / (mu_i + mu_j) (a wall takes the
@@ -372,7 +441,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
-            double vdotr = (vxi - vx[j]) * rx + (vzi - vz[j]) * rz;
+            double vdotr = 0.0;
+            for (int d = 0; d < DIM; d++) vdotr += (vi[d] - v[d][j]) * r[d];
             vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
             const double same = (tag[j] == ti ? 1.0 : 0.0) + Xl.av_mixed * (1.0 - walli - wallj) + Xl.av_wall * (walli + wallj) > 0.0 ? 1.0 : 0.0;
             const double avc_ij = avci > avc[j] ? avci : avc[j];
@@ -384,69 +454,76 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double fv = implicit == MOMENTUM_IMPLICIT_ARITHMETIC && tag[j] == ti
                                   ? vv * mus * mus * r2 * inv_d
                                   : vv * 4.0 * mu_i * muj * r2 * inv_d;
-            double fx, fz;
+            double f[DIM];
             if (implicit) {
                 wl[k] = -F * fv;
-                fx = F * (fr * rx);
-                fz = F * (fr * rz);
+                for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d]);
             } else {
-                fx = F * (fr * rx + fv * (uvxi - uvx[j]));
-                fz = F * (fr * rz + fv * (uvzi - uvz[j]));
+                for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d] + fv * (uvi[d] - uv[d][j]));
             }
             if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W. A wall holds none of
                            * its own: a wall particle takes the stress s of the particle it meets, as
                            * it is on a no-slip wall, mirrored across the wall on a free-slip one
-                           * (its shear s_nt reversed: s' = s - 2 s_nt (n t + t n), t = (-n_z, n_x),
-                           * s_nt = a (s_zz - s_xx) + b s_xz with a = n_x n_z, b = n_x^2 - n_z^2),
-                           * so that the pair transmits the normal stress and no shear. */
+                           * (wall_mirror_change), so that the pair transmits the normal stress and
+                           * no shear. */
                 const double ci = 1.0 + wallj, cj = 1.0 + walli;
-                const double maj = wall_nx[j] * wall_nz[j], mbj = wall_nx[j] * wall_nx[j] - wall_nz[j] * wall_nz[j];
-                const double snt_i = maj * (szzi - sxxi) + mbj * sxzi;       /* i's shear on j's mirror */
-                const double snt_j = mai * (szz[j] - sxx[j]) + mbi * sxz[j];      /* j's on i's */
+                double t[SYM_N];
+#if DIM == 2
+                const double maj = wall_n[0][j] * wall_n[1][j];
+                const double mbj = wall_n[0][j] * wall_n[0][j] - wall_n[1][j] * wall_n[1][j];
+                const double snt_i = maj * (si[SYM_ZZ] - si[SYM_XX]) + mbj * si[SYM_XZ]; /* i's shear on j's mirror */
+                const double snt_j = mai * (sg[SYM_ZZ][j] - sg[SYM_XX][j]) + mbi * sg[SYM_XZ][j]; /* j's on i's */
                 const double d_normal = 4.0 * (maj * snt_i + mai * snt_j), d_shear = 2.0 * (mbj * snt_i + mbi * snt_j);
-                const double txx = vv * (ci * sxxi + cj * sxx[j] + d_normal), txz = vv * (ci * sxzi + cj * sxz[j] - d_shear);
-                const double tzz = vv * (ci * szzi + cj * szz[j] - d_normal);
-                fx += F * (txx * rx + txz * rz);
-                fz += F * (txz * rx + tzz * rz);
+                t[SYM_XX] = vv * (ci * si[SYM_XX] + cj * sg[SYM_XX][j] + d_normal);
+                t[SYM_XZ] = vv * (ci * si[SYM_XZ] + cj * sg[SYM_XZ][j] - d_shear);
+                t[SYM_ZZ] = vv * (ci * si[SYM_ZZ] + cj * sg[SYM_ZZ][j] - d_normal);
+#else
+                double nj[3], sj[SYM_N], mi_[SYM_N], mj_[SYM_N];
+                for (int d = 0; d < 3; d++) nj[d] = wall_n[d][j];
+                for (int c = 0; c < SYM_N; c++) sj[c] = sg[c][j];
+                wall_mirror_change(nj, si, mi_); /* i's stress as wall particle j takes it */
+                wall_mirror_change(ni, sj, mj_); /* j's as wall particle i takes it */
+                for (int c = 0; c < SYM_N; c++) t[c] = vv * (ci * si[c] + cj * sj[c] + mi_[c] + mj_[c]);
+#endif
+                for (int a = 0; a < DIM; a++) {
+                    double tr = 0.0;
+                    for (int b = 0; b < DIM; b++) tr += t[sym_index(a, b)] * r[b];
+                    f[a] += F * tr;
+                }
                 /* the wall sums of the wall friction: i's from a rough wall particle j, j's from
                  * a rough wall particle i (its force on j is -f, its normal at j -V_i F x_ji) */
                 const double to_i = wall_rough[j] * (1.0 - walli), to_j = roughi * (1.0 - wallj);
                 const double mu_gj = wall_mu[j] >= 0.0 ? 1.0 : 0.0, mu_gi = mu_wi >= 0.0 ? 1.0 : 0.0;
                 const double qi = -vol[j] * F * to_i, qj = -voli * F * to_j;
-                ws[WALL_FX][k] += to_i * fx;
-                ws[WALL_FZ][k] += to_i * fz;
-                ws[WALL_NX][k] += qi * rx;
-                ws[WALL_NZ][k] += qi * rz;
+                for (int d = 0; d < DIM; d++) {
+                    ws[WALL_F + d][k] += to_i * f[d];
+                    ws[WALL_N + d][k] += qi * r[d];
+                    wj[WALL_F + d][k] = -to_j * f[d];
+                    wj[WALL_N + d][k] = -qj * r[d];
+                }
                 ws[WALL_Q_GIVEN][k] += qi * mu_gj;
                 ws[WALL_QMU_GIVEN][k] += qi * mu_gj * wall_mu[j];
                 ws[WALL_Q_OWN][k] += qi * (1.0 - mu_gj);
-                wj[WALL_FX][k] = -to_j * fx;
-                wj[WALL_FZ][k] = -to_j * fz;
-                wj[WALL_NX][k] = -qj * rx;
-                wj[WALL_NZ][k] = -qj * rz;
                 wj[WALL_Q_GIVEN][k] = qj * mu_gi;
                 wj[WALL_QMU_GIVEN][k] = qj * mu_gi * mu_wi;
                 wj[WALL_Q_OWN][k] = qj * (1.0 - mu_gi);
             }
-            sx[k] += fx;
-            sz[k] += fz;
-            ajx[k] = -fx; /* forces: divided by the masses once, after the pass */
-            ajz[k] = -fz;
+            for (int d = 0; d < DIM; d++) {
+                sf[d][k] += f[d];
+                fj[d][k] = -f[d]; /* forces: divided by the masses once, after the pass */
+            }
         }
-        chunk_add(P->ax, jb, n, ajx);
-        chunk_add(P->az, jb, n, ajz);
+        for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], jb, n, fj[d]);
         if (stress && roughi != 0.0 && Xl.wall_sum[0])
             for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], jb, n, wj[q]);
         if (cached) fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
     }
-    double tx = 0.0, tz = 0.0;
-    for (size_t k = 0; k < FORCES_CHUNK; k++) {
-        tx += sx[k];
-        tz += sz[k];
+    for (int d = 0; d < DIM; d++) {
+        double t = 0.0;
+        for (size_t k = 0; k < FORCES_CHUNK; k++) t += sf[d][k];
+        f_i[d] += t;
     }
-    *axi += tx;
-    *azi += tz;
     if (stress && Xl.wall_sum[0])
         for (int q = 0; q < WALL_SUMS; q++) {
             double t = 0.0;
@@ -461,7 +538,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
  * creeps, docs/numerics.md section 2c). A pair diffuses only within one medium, so i decides. */
 FORCES_INLINE int diffuses(const struct pair_ctx *X, const struct particles *restrict P, size_t i)
 {
-    return P->tag[i] >= 0.0 && X->media[P->medium[i]].law == LAW_NEWTONIAN;
+    return P->tag[i] >= 0.0 && (X->media[P->medium[i]].features & LAW_DENSITY_DIFFUSION);
 }
 
 /* hyd_i of continuity_range: rho0 g / c^2 of i's medium with the hydrostatic form of the
@@ -488,7 +565,7 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
         double di = 0.0, ni = 0.0, ei = 0.0;
         const int diffuse_i = diffuse && diffuses(X, P, i);
         const double hyd_i = diffuse_i ? diffusion_hydrostatic(X, P, i) : 0.0;
-        continuity_range(X, P, i, NB->rng + 4 * i, 2, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
+        continuity_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
                          X->diffusion, hyd_i, wendland, store, diffuse_i);
         P->drho[i] += di;
         X->count[i] += ni;
@@ -500,16 +577,12 @@ FORCES_CLONES
 static void gradient_particle(const struct pair_ctx *X, const struct gather *G, const struct particles *restrict P,
                               struct velocity_gradient *restrict out, size_t i)
 {
-    double acc[7] = {0};
-    if (X->wendland) gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 1);
-    else gradient_range(X, P, i, G->rng + 6 * i, 3, acc, 0);
-    out->dudx[i] = acc[0];
-    out->dudz[i] = acc[1];
-    out->dwdx[i] = acc[2];
-    out->dwdz[i] = acc[3];
-    out->lxx[i] = acc[4];
-    out->lxz[i] = acc[5];
-    out->lzz[i] = acc[6];
+    double acc[GRADIENT_SUMS] = {0};
+    const uint32_t *rng = G->rng + 2 * CELLS_ROWS_AROUND * i;
+    if (X->wendland) gradient_range(X, P, i, rng, CELLS_ROWS_AROUND, acc, 1);
+    else gradient_range(X, P, i, rng, CELLS_ROWS_AROUND, acc, 0);
+    for (int q = 0; q < DIM * DIM; q++) out->g[q][i] = acc[q];
+    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) out->l[q][i] = acc[DIM * DIM + q];
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
@@ -517,51 +590,57 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
                                  const int stress)
 {
     for (size_t i = b0; i < b1; i++) {
-        double sx = 0.0, sz = 0.0;
-        momentum_range(X, P, i, NB->rng + 4 * i, 2, &sx, &sz, cached ? X->fk + X->fk_off[i] : NULL,
-                       implicit ? X->visc_w + X->fk_off[i] : NULL, wendland, cached, implicit, stress);
-        P->ax[i] += sx;
-        P->az[i] += sz;
+        double f[DIM] = {0.0};
+        momentum_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, f,
+                       cached ? X->fk + X->fk_off[i] : NULL, implicit ? X->visc_w + X->fk_off[i] : NULL, wendland,
+                       cached, implicit, stress);
+        for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
 
-/* The viscous operator's pair sums over i's two ranges: for each component,
+/* The viscous operator's pair sums over i's ranges: for each component,
  * out_i += sum_j w_ij (in_i - in_j) and out_j -= w_ij (in_i - in_j); with `diagonal` also
  * diag_i += sum_j w_ij and diag_j += w_ij. */
 FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint32_t *restrict rng,
                                  const double *restrict wl, const int diagonal)
 {
-    const double *restrict ux = X->in_x, *restrict uz = X->in_z;
-    double *restrict ox = X->out_x, *restrict oz = X->out_z, *restrict od = X->out_diag;
-    const double uxi = ux[i], uzi = uz[i];
-    double sx[FORCES_CHUNK] = {0}, sz[FORCES_CHUNK] = {0}, sd[FORCES_CHUNK] = {0};
-    FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
-        double jx[FORCES_CHUNK], jz[FORCES_CHUNK];
+    const double *restrict u[DIM];
+    double *restrict o[DIM];
+    double ui[DIM];
+    for (int d = 0; d < DIM; d++) {
+        u[d] = X->in[d];
+        o[d] = X->out[d];
+        ui[d] = u[d][i];
+    }
+    double *restrict od = X->out_diag;
+    double so[DIM][FORCES_CHUNK] = {{0}}, sd[FORCES_CHUNK] = {0};
+    FORCES_FOR_EACH_CHUNK(rng, NEIGHBOURS_RANGES, jb, m) {
+        double oj[DIM][FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double w = wl[k];
-            const double dx = w * (uxi - ux[j]), dz = w * (uzi - uz[j]);
-            sx[k] += dx;
-            sz[k] += dz;
-            jx[k] = -dx;
-            jz[k] = -dz;
+            for (int d = 0; d < DIM; d++) {
+                const double du = w * (ui[d] - u[d][j]);
+                so[d][k] += du;
+                oj[d][k] = -du;
+            }
             if (diagonal) sd[k] += w;
         }
-        chunk_add(ox, jb, m, jx);
-        chunk_add(oz, jb, m, jz);
+        for (int d = 0; d < DIM; d++) chunk_add(o[d], jb, m, oj[d]);
         if (diagonal) chunk_add(od, jb, m, wl);
         wl += FORCES_CHUNK;
     }
-    double tx = 0.0, tz = 0.0, td = 0.0;
-    for (size_t k = 0; k < FORCES_CHUNK; k++) {
-        tx += sx[k];
-        tz += sz[k];
-        td += sd[k];
+    for (int d = 0; d < DIM; d++) {
+        double t = 0.0;
+        for (size_t k = 0; k < FORCES_CHUNK; k++) t += so[d][k];
+        o[d][i] += t;
     }
-    ox[i] += tx;
-    oz[i] += tz;
-    if (diagonal) od[i] += td;
+    if (diagonal) {
+        double td = 0.0;
+        for (size_t k = 0; k < FORCES_CHUNK; k++) td += sd[k];
+        od[i] += td;
+    }
 }
 
 FORCES_CLONES
@@ -571,8 +650,9 @@ static void viscous_band(const struct pair_ctx *X, const struct neighbours *NB, 
     (void)P;
     const int diagonal = X->out_diag != NULL;
     for (size_t i = b0; i < b1; i++) {
-        if (diagonal) viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 1);
-        else viscous_range(X, i, NB->rng + 4 * i, X->visc_w + X->fk_off[i], 0);
+        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        if (diagonal) viscous_range(X, i, rng, X->visc_w + X->fk_off[i], 1);
+        else viscous_range(X, i, rng, X->visc_w + X->fk_off[i], 0);
     }
 }
 
@@ -588,9 +668,9 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
         const int32_t gi = group[i];
         if (gi < 0) continue;
         double *gw = X->group_w + 5 * (size_t)gi;
-        const uint32_t *rng = NB->rng + 4 * i;
+        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
         const double *wl = X->visc_w + X->fk_off[i];
-        FORCES_FOR_EACH_CHUNK(rng, 2, jb, m) {
+        FORCES_FOR_EACH_CHUNK(rng, NEIGHBOURS_RANGES, jb, m) {
                 for (size_t k = 0; k < m; k++) {
                     const int32_t gj = group[jb + k];
                     if (gj < 0) continue;
@@ -610,8 +690,9 @@ static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, s
     for (size_t i = b0; i < b1; i++) {
         if (P->tag[i] < 0.0) continue; /* walls neither smooth nor are smoothed */
         double a = 0.0, u = 0.0;
-        if (X->wendland) smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, X->sum, X->weight, 1);
-        else smooth_range(X, P, i, NB->rng + 4 * i, 2, X->g, &a, &u, X->sum, X->weight, 0);
+        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        if (X->wendland) smooth_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, X->sum, X->weight, 1);
+        else smooth_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, X->sum, X->weight, 0);
         X->sum[i] += a;
         X->weight[i] += u;
     }
@@ -706,8 +787,8 @@ static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n
     size_t total = 0;
     for (size_t i = 0; i < n; i++) {
         F->fk_off[i] = total;
-        for (int r = 0; r < 2; r++) {
-            const size_t len = rng[4 * i + 2 * r + 1] - rng[4 * i + 2 * r];
+        for (int r = 0; r < NEIGHBOURS_RANGES; r++) {
+            const size_t len = rng[2 * NEIGHBOURS_RANGES * i + 2 * r + 1] - rng[2 * NEIGHBOURS_RANGES * i + 2 * r];
             total += (len + FORCES_CHUNK - 1) / FORCES_CHUNK * FORCES_CHUNK;
         }
     }
@@ -752,13 +833,13 @@ static void bands_in_team(const struct pair_system *S, band_fn fn, const struct 
                           int last_nowait)
 {
     const struct cells *C = S->C;
-    const long nb = (C->nz + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
+    const long layers = C->n[DIM_UP], nb = (layers + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
     struct particles *P = S->P;
 #define FORCES_BAND(b)                                                                                        \
     do {                                                                                                      \
         const long r0 = (b) * FORCES_BAND_ROWS;                                                               \
-        const long r1 = r0 + FORCES_BAND_ROWS < C->nz ? r0 + FORCES_BAND_ROWS : C->nz;                        \
-        fn(X, S->NB, P, C->start[(size_t)r0 * (size_t)C->nx], C->start[(size_t)r1 * (size_t)C->nx]);         \
+        const long r1 = r0 + FORCES_BAND_ROWS < layers ? r0 + FORCES_BAND_ROWS : layers;                      \
+        fn(X, S->NB, P, C->start[(size_t)r0 * C->layer], C->start[(size_t)r1 * C->layer]);                   \
     } while (0)
     for (long b; (b = 2 * team_next(&bands[0])) < nb;) FORCES_BAND(b);
     team_barrier();
@@ -906,27 +987,33 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
  * walls' normal forces on a body sum to its load and their friction to tan(delta) times it. Adds
  * the change to the force (fx, fz). */
 static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, double vol_i, double tan_phi,
-                                double p_background, double *fx, double *fz)
+                                double p_background, double f[DIM])
 {
     const double q = ws[WALL_Q_GIVEN][i] + ws[WALL_Q_OWN][i];
-    const double nx = ws[WALL_NX][i], nz = ws[WALL_NZ][i], nn = hypot(nx, nz);
+    double n[DIM], fw[DIM], e[DIM], t[DIM];
+    for (int d = 0; d < DIM; d++) {
+        n[d] = ws[WALL_N + d][i];
+        fw[d] = ws[WALL_F + d][i];
+    }
+    const double nn = dim_norm(n);
     if (!(q > 0.0) || !(nn > 0.0)) return;
     const double mu = (ws[WALL_QMU_GIVEN][i] + ws[WALL_Q_OWN][i] * tan_phi) / q;
-    const double ex = nx / nn, ez = nz / nn;
-    const double fwx = ws[WALL_FX][i], fwz = ws[WALL_FZ][i];
-    const double fn = fwx * ex + fwz * ez;
-    const double tx = fwx - fn * ex, tz = fwz - fn * ez, ft = hypot(tx, tz);
+    double fn = 0.0;
+    for (int d = 0; d < DIM; d++) {
+        e[d] = n[d] / nn;
+        fn += fw[d] * e[d];
+    }
+    for (int d = 0; d < DIM; d++) t[d] = fw[d] - fn * e[d];
+    const double ft = dim_norm(t);
     const double n_eff = fn - 2.0 * p_background * vol_i * nn;
     if (n_eff < 0.0) { /* a wall pushes a grain, never pulls it (no adhesion), and then has no shear on it */
-        *fx -= tx + n_eff * ex;
-        *fz -= tz + n_eff * ez;
+        for (int d = 0; d < DIM; d++) f[d] -= t[d] + n_eff * e[d];
         return;
     }
     const double bound = mu * n_eff;
     if (ft <= bound) return;
     const double cut = (ft - bound) / ft;
-    *fx -= cut * tx;
-    *fz -= cut * tz;
+    for (int d = 0; d < DIM; d++) f[d] -= cut * t[d];
 }
 
 static void momentum_region(void *arg, int tid, int nth)
@@ -941,13 +1028,19 @@ static void momentum_region(void *arg, int tid, int nth)
     int bad = 0;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue; /* keeps the force on it: its wall's work (walls_move) */
-        if (R->wall_sums && M[P->medium[i]].law == LAW_ELASTIC_PLASTIC) {
+        if (R->wall_sums && (M[P->medium[i]].features & LAW_WALL_FRICTION)) {
             const double s = M[P->medium[i]].sin_phi;
-            wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, &P->ax[i], &P->az[i]);
+            double f[DIM];
+            for (int d = 0; d < DIM; d++) f[d] = P->acc[d][i];
+            wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, f);
+            for (int d = 0; d < DIM; d++) P->acc[d][i] = f[d];
         }
-        P->ax[i] *= P->inv_m[i]; /* the pass summed forces */
-        P->az[i] = P->az[i] * P->inv_m[i] - g;
-        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(P->ax[i] + P->az[i]);
+        double sum = 0.0;
+        for (int d = 0; d < DIM; d++) { /* the pass summed forces */
+            P->acc[d][i] = d == DIM_UP ? P->acc[d][i] * P->inv_m[i] - g : P->acc[d][i] * P->inv_m[i];
+            sum += P->acc[d][i];
+        }
+        bad |= P->state[i] == MIXSPH_STATE_MOBILE && !isfinite(sum);
     }
     team_or_int(&R->bad, bad);
 }
@@ -958,8 +1051,7 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     const size_t n = active_count(S);
-    memset(P->ax, 0, n * sizeof(double));
-    memset(P->az, 0, n * sizeof(double));
+    for (int d = 0; d < DIM; d++) memset(P->acc[d], 0, n * sizeof(double));
     F->visc_valid = 0;
     if (S->params.implicit_viscosity) {
         /* the couplings are stored in the cache's lane layout, so the cache must be there */
@@ -1005,19 +1097,18 @@ static int stored_couplings(const struct forces *F, const struct pair_system *S,
     return 0;
 }
 
-int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
-                         double *out_x, double *out_z, double *diag)
+int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *const in[DIM],
+                         double *const out[DIM], double *diag)
 {
     struct pair_ctx X;
     if (stored_couplings(F, S, &X) != 0) return -1;
     const size_t n = active_count(S);
-    memset(out_x, 0, n * sizeof(double));
-    memset(out_z, 0, n * sizeof(double));
+    for (int d = 0; d < DIM; d++) {
+        memset(out[d], 0, n * sizeof(double));
+        X.in[d] = in[d];
+        X.out[d] = out[d];
+    }
     if (diag) memset(diag, 0, n * sizeof(double));
-    X.in_x = in_x;
-    X.in_z = in_z;
-    X.out_x = out_x;
-    X.out_z = out_z;
     X.out_diag = diag;
     struct pass_region R;
     pass_region_init(&R, S, &X, viscous_band, n);
@@ -1039,27 +1130,30 @@ int forces_viscous_group_couplings(const struct forces *F, const struct pair_sys
     return 0;
 }
 
-void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho)
+void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double a[DIM], double *drho)
 {
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     struct particles *P = S->P;
-    const double save[3] = {P->ax[j], P->az[j], P->drho[j]};
-    double sx = 0.0, sz = 0.0, di = 0.0, ni = 0.0, ei = 0.0;
+    double save[DIM + 1];
+    for (int d = 0; d < DIM; d++) save[d] = P->acc[d][j];
+    save[DIM] = P->drho[j];
+    double f[DIM] = {0.0}, di = 0.0, ni = 0.0, ei = 0.0;
     double *count = calloc(j + 1 + FORCES_CHUNK, sizeof(double)); /* the range's neighbour counts */
     double *diff = calloc(j + 1 + FORCES_CHUNK, sizeof(double));  /* and diffusion sums */
     if (!count || !diff) {
         free(count);
         free(diff);
-        *ax = *az = *drho = NAN;
+        for (int d = 0; d < DIM; d++) a[d] = NAN;
+        *drho = NAN;
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, &sx, &sz, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress);
-    *ax = sx * P->inv_m[i];
-    *az = sz * P->inv_m[i];
-    P->ax[j] = save[0];
-    P->az[j] = save[1];
+    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress);
+    for (int d = 0; d < DIM; d++) {
+        a[d] = f[d] * P->inv_m[i];
+        P->acc[d][j] = save[d];
+    }
     const double delta_h = S->params.diffusion * X.K.h;
     if (delta_h > 0.0 && diffuses(&X, P, i)) {
         continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
@@ -1069,7 +1163,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0);
         *drho = P->rho[i] * di;
     }
-    P->drho[j] = save[2];
+    P->drho[j] = save[DIM];
     free(count);
     free(diff);
 }

@@ -31,7 +31,7 @@ struct forces_params {
                                couplings for forces_viscous_apply (docs/numerics.md) */
     int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */
     int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
-                               stress (P->sxx, sxz, szz; a law with LAW_HAS_STRESS) and bounds the
+                               stress (P->stress; a law with LAW_HAS_STRESS) and bounds the
                                shear of no-slip walls on elastic-plastic grains (wall friction) */
     double p_background;    /* the equation of state's background pressure [Pa] (not an effective
                                normal stress: left out of the wall friction's bound) */
@@ -78,18 +78,18 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
  *  results: the gradient reads nothing the density pass writes). */
 int forces_density_rate_gradient(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad);
 
-/** Acceleration (ax, az) of every particle, gravity included (without the viscous term when
+/** Acceleration P->acc of every particle, gravity included (without the viscous term when
  *  params.implicit_viscosity; the pass then stores the viscous couplings w_ij of the pairs, and
  *  must follow this step's forces_density_rate). Returns 1 if a non-finite value appeared at a
  *  mobile particle, -1 when out of memory or without this step's density pass, 0 otherwise. */
 int forces_momentum(struct forces *F, const struct pair_system *S);
 
 /** The viscous operator of the last implicit momentum pass, out_i = sum_j w_ij (in_i - in_j)
- *  for both components, so that the viscous acceleration of a velocity field u is -out_i / m_i;
+ *  for every component, so that the viscous acceleration of a velocity field u is -out_i / m_i;
  *  with diag != NULL also its diagonal diag_i = sum_j w_ij. Arrays of the active particles.
  *  Returns -1 without a stored operator. */
-int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *in_x, const double *in_z,
-                         double *out_x, double *out_z, double *diag);
+int forces_viscous_apply(const struct forces *F, const struct pair_system *S, const double *const in[DIM],
+                         double *const out[DIM], double *diag);
 
 /** The couplings of the last implicit momentum pass summed between groups of particles (the
  *  coarse grid of viscous_coarse.h). group[i] >= 0 numbers particle i's group on a grid
@@ -117,6 +117,6 @@ int forces_viscous_ready(const struct forces *F);
 
 /** Test hook: the acceleration (without gravity) and the density rate particle j gives i (its
  *  density diffusion included), evaluated by the same pair code. */
-void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double *ax, double *az, double *drho);
+void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, double a[DIM], double *drho);
 
 #endif

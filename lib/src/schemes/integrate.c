@@ -34,7 +34,6 @@
 #include "eos.h"
 #include "time_step.h"
 #include "law_registry.h"
-#include "mixture_paper.h"
 #include "status.h"
 #include "viscous.h"
 
@@ -50,30 +49,34 @@
 static inline double particle_time_step(const mixsph_sim *s, size_t i, int implicit)
 {
     const struct particles *P = &s->phys.P;
-    const double u = sqrt(P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
+    double u2 = 0.0;
+    for (int d = 0; d < DIM; d++) u2 += P->vel[d][i] * P->vel[d][i];
+    const double u = sqrt(u2);
     double mu = implicit ? 0.0 : P->mu[i];
     if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) /* the viscosity it will have once mobilised */
-        mu = mixture_paper_held_viscosity(&s->scheme.media[P->medium[i]]);
+        mu = law_held_viscosity(&s->scheme.media[P->medium[i]]);
     return time_step_bound(s->scheme.cfl, s->scheme.cfl_visc, s->phys.h, s->phys.c_max, u, P->rho[i], mu);
 }
 
-/* A loop of this file over the particles: the simulation, the loop's parameters and its
- * reductions (exact: min, max, |, integer +, so any split of the loop gives the same). */
-struct particle_loop {
-    mixsph_sim *s;
-    int implicit;
-    double a, b;      /* the loop's parameters (a kick, a time step) */
-    const double *ox_old, *oz_old;
-    size_t n_active;
+/* Whether held particle i (MIXSPH_STATE_FIXED) takes the kicks of its forces (laws/law.h). */
+static inline int held_kicked(const mixsph_sim *s, size_t i, int rigid)
+{
+    return law_held_kicked(&s->scheme.media[s->phys.P.medium[i]], rigid);
+}
+
+/* The parallel loops of this file (core/team.h) each take their own arguments; their reductions
+ * are exact (min, max, |, integer +), so any split of a loop gives the same. */
+
+/* The time step (4) over the particles: its smallest bound. */
+struct time_step_loop {
+    const mixsph_sim *s;
+    int implicit;     /* no viscous bound (the implicit viscous step) */
     double dt_min;    /* min */
-    double shift2;    /* max */
-    int flag;         /* | */
-    long count;       /* + */
 };
 
 static void time_step_range(void *arg, size_t b, size_t e)
 {
-    struct particle_loop *L = arg;
+    struct time_step_loop *L = arg;
     const mixsph_sim *s = L->s;
     const struct particles *P = &s->phys.P;
     double dt = INFINITY;
@@ -88,7 +91,7 @@ static void time_step_range(void *arg, size_t b, size_t e)
 double integrate_time_step(const mixsph_sim *s)
 {
     /* no viscous bound with the implicit viscous step */
-    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = s->scheme.implicit, .dt_min = INFINITY};
+    struct time_step_loop L = {.s = s, .implicit = s->scheme.implicit, .dt_min = INFINITY};
     team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
     return L.dt_min;
 }
@@ -109,7 +112,7 @@ static inline void particle_pressure(mixsph_sim *s, size_t i)
 
 static void pressure_range(void *arg, size_t b, size_t e)
 {
-    mixsph_sim *s = ((struct particle_loop *)arg)->s;
+    mixsph_sim *s = arg;
     const struct particles *P = &s->phys.P;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_LOST) continue;
@@ -119,8 +122,7 @@ static void pressure_range(void *arg, size_t b, size_t e)
 
 void integrate_pressure_and_derived(mixsph_sim *s)
 {
-    struct particle_loop L = {.s = s};
-    team_for(SIM_THREADS(s), s->phys.P.n, pressure_range, &L);
+    team_for(SIM_THREADS(s), s->phys.P.n, pressure_range, s);
 }
 
 mixsph_status integrate_rebuild_lists(mixsph_sim *s)
@@ -133,20 +135,25 @@ mixsph_status integrate_rebuild_lists(mixsph_sim *s)
     return integrate_build_gather_lists(s);
 }
 
-/* near_wall[i]: whether particle i is within L->a of a wall. */
+/* near_wall[i]: whether particle i is within `reach` of a wall. */
+struct near_wall_loop {
+    mixsph_sim *s;
+    double reach; /* [m] */
+};
+
 static void near_wall_range(void *arg, size_t b, size_t e)
 {
-    const struct particle_loop *L = arg;
+    const struct near_wall_loop *L = arg;
     const mixsph_sim *s = L->s;
     const struct particles *P = &s->phys.P;
-    const double reach = L->a;
+    const double reach = L->reach;
     for (size_t i = b; i < e; i++) {
         int close = 0;
         if (P->state[i] != MIXSPH_STATE_WALL)
             for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
                 double d;
                 int at_end;
-                walls_signed_distance(&s->phys.walls, w, P->x[i], P->z[i], &d, &at_end);
+                walls_signed_distance(&s->phys.walls, w, P->pos[0][i], P->pos[DIM_UP][i], &d, &at_end);
                 close = !(fabs(d) > reach); /* NaN counts as close */
             }
         s->work.near_wall[i] = (uint8_t)close;
@@ -179,7 +186,7 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
     if (!excluding) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     s->work.excluding = excluding;
     memset(excluding, 0, P->cap ? P->cap : 1);
-    struct particle_loop L = {.s = s, .a = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx};
+    struct near_wall_loop L = {.s = s, .reach = 2.0 * s->work.NB.skin + 2.0 * s->phys.dx};
     team_for(SIM_THREADS(s), n, near_wall_range, &L);
     return MIXSPH_OK;
 }
@@ -214,18 +221,20 @@ int integrate_density_rates(mixsph_sim *s, const struct pair_system *S)
 }
 
 /* The material laws' updates over law_dt (0: at the current state, no advance), in the order of
- * their ids; the paper's law reports the grains it holds fixed. */
+ * their ids; a law that holds particles (LAW_HOLDS_PARTICLES) reports how many. */
 void integrate_update_laws(mixsph_sim *s, double law_dt)
 {
     const struct law_step step = {.P = &s->phys.P, .n = active_particles(s), .media = s->scheme.media, .grad = &s->work.grad,
                                   .G = &s->work.G, .K = &s->phys.K, .dt = law_dt,
                                   .p_background = s->scheme.p_background, .n_threads = SIM_THREADS(s)};
+    long held = 0;
     for (int id = 0; id < LAW_COUNT; id++) {
         const struct material_law *law = law_get(id);
         if (!law->update || !law_in_use(s, id)) continue;
         const long count = law->update(s->phys.law_state[id], &step);
-        if (id == LAW_MIXTURE_PAPER) s->phys.n_fixed = count;
+        if (law->features & LAW_HOLDS_PARTICLES) held += count;
     }
+    s->phys.n_fixed = held;
 }
 
 /* After the densities are updated and the equation of state: pressures smoothed (with
@@ -239,27 +248,31 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
     return 0;
 }
 
-/* v += dt a of the particles that take kicks (not walls, lost particles, grains held fixed with
- * hold_fixed or, in the implicit scheme, rigid ones: those stay at rest through the viscous step). */
+/* v += dt a of the particles that take kicks (not walls, lost particles, held particles that take
+ * no kicks: laws/law.h; in the implicit scheme rigid held grains stay at rest through the viscous
+ * step). */
+struct kick_loop {
+    mixsph_sim *s;
+    double dt; /* [s] */
+};
+
 static void kick_range(void *arg, size_t b, size_t e)
 {
-    const struct particle_loop *L = arg;
+    const struct kick_loop *L = arg;
     const mixsph_sim *s = L->s;
     struct particles *P = &L->s->phys.P;
     const int rigid = s->scheme.implicit && s->scheme.held_grains_rigid;
-    const double dt = L->a;
+    const double dt = L->dt;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid))
-            continue;
-        P->vx[i] += dt * P->ax[i];
-        P->vz[i] += dt * P->az[i];
+        if (P->state[i] == MIXSPH_STATE_FIXED && !held_kicked(s, i, rigid)) continue;
+        for (int d = 0; d < DIM; d++) P->vel[d][i] += dt * P->acc[d][i];
     }
 }
 
 static void kick_velocities(mixsph_sim *s, double dt)
 {
-    struct particle_loop L = {.s = s, .a = dt};
+    struct kick_loop L = {.s = s, .dt = dt};
     team_for(SIM_THREADS(s), s->phys.P.n, kick_range, &L);
 }
 
@@ -270,7 +283,7 @@ static void kick_velocities(mixsph_sim *s, double dt)
  * nearly balance would be released that the model holds. */
 static double held_grain_judge_dt(const mixsph_sim *s, double dt)
 {
-    struct particle_loop L = {.s = (mixsph_sim *)s, .implicit = 0, .dt_min = dt};
+    struct time_step_loop L = {.s = s, .implicit = 0, .dt_min = dt};
     team_for(SIM_THREADS(s), s->phys.P.n, time_step_range, &L);
     return L.dt_min;
 }
@@ -285,14 +298,14 @@ static unsigned char *realloc_unknowns(unsigned char *u, size_t cap)
 }
 
 /* With rigid held grains (numerics.held_grains = "rigid"): the velocity of every held grain that
- * is not of a hold_fixed medium after one explicit step of judge_dt, as the explicit scheme gives
- * it to the grain it judges (mixture_paper.c): its acceleration by the other forces (P->ax, P->az
- * of the last momentum pass) plus the viscous one from the solved velocities around it,
- * -(L u)_i / m_i with u_i = 0; (lx, lz) = L u of the solved field. */
+ * takes kicks (laws/law.h) after one explicit step of judge_dt, as the explicit scheme gives it to
+ * the grain it judges (mixture_paper.c): its acceleration by the other forces (P->acc of the last
+ * momentum pass) plus the viscous one from the solved velocities around it, -(L u)_i / m_i with
+ * u_i = 0; lu = L u of the solved field. */
 struct held_kick_loop {
     mixsph_sim *s;
-    double judge_dt;
-    const double *lx, *lz;
+    double judge_dt;              /* [s] */
+    const double *const *lu;      /* L u, DIM components */
 };
 
 static void held_kick_range(void *arg, size_t b, size_t e)
@@ -300,18 +313,16 @@ static void held_kick_range(void *arg, size_t b, size_t e)
     const struct held_kick_loop *L = arg;
     const mixsph_sim *s = L->s;
     struct particles *P = &L->s->phys.P;
-    const double judge_dt = L->judge_dt, *lx = L->lx, *lz = L->lz;
+    const double judge_dt = L->judge_dt;
     for (size_t i = b; i < e; i++) {
-        if (P->state[i] != MIXSPH_STATE_FIXED || !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))
-            continue;
-        P->vx[i] = judge_dt * (P->ax[i] - lx[i] / P->m[i]);
-        P->vz[i] = judge_dt * (P->az[i] - lz[i] / P->m[i]);
+        if (P->state[i] != MIXSPH_STATE_FIXED || !held_kicked(s, i, 0)) continue;
+        for (int d = 0; d < DIM; d++) P->vel[d][i] = judge_dt * (P->acc[d][i] - L->lu[d][i] / P->m[i]);
     }
 }
 
-static void held_grain_kicks(mixsph_sim *s, int n_threads, double judge_dt, const double *lx, const double *lz)
+static void held_grain_kicks(mixsph_sim *s, int n_threads, double judge_dt, const double *const lu[DIM])
 {
-    struct held_kick_loop L = {.s = s, .judge_dt = judge_dt, .lx = lx, .lz = lz};
+    struct held_kick_loop L = {.s = s, .judge_dt = judge_dt, .lu = lu};
     team_for(n_threads, active_particles(s), held_kick_range, &L);
 }
 
@@ -327,13 +338,12 @@ static void held_grain_kicks(mixsph_sim *s, int n_threads, double judge_dt, cons
  * (mixture_paper.h). */
 static void unknowns_range(void *arg, size_t b, size_t e)
 {
-    mixsph_sim *s = ((struct particle_loop *)arg)->s;
+    mixsph_sim *s = arg;
     const struct particles *P = &s->phys.P;
     const int rigid = s->scheme.held_grains_rigid;
     for (size_t i = b; i < e; i++)
-        s->work.viscous_unknown[i] = P->state[i] == MIXSPH_STATE_MOBILE ||
-                                (P->state[i] == MIXSPH_STATE_FIXED &&
-                                 mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], rigid));
+        s->work.viscous_unknown[i] =
+            P->state[i] == MIXSPH_STATE_MOBILE || (P->state[i] == MIXSPH_STATE_FIXED && held_kicked(s, i, rigid));
 }
 
 static int any_wall_moves(const struct walls *W)
@@ -346,14 +356,13 @@ static int any_wall_moves(const struct walls *W)
 /* The viscous force of the solved velocities on the wall particles of moving walls, -(L u)_j,
  * added to the force the momentum pass left in their accelerations (which leaves out the viscous
  * force in this scheme), so that a wall's work (walls_move) counts it. */
-static void viscous_wall_forces(mixsph_sim *s, const double *lx, const double *lz)
+static void viscous_wall_forces(mixsph_sim *s, const double *const lu[DIM])
 {
     const struct walls *W = &s->phys.walls;
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < active_particles(s); i++) {
         if (P->state[i] != MIXSPH_STATE_WALL || W->def[particles_wall_index(P, i)].motion < 0) continue;
-        P->ax[i] -= lx[i];
-        P->az[i] -= lz[i];
+        for (int d = 0; d < DIM; d++) P->acc[d][i] -= lu[d][i];
     }
 }
 
@@ -366,17 +375,15 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
          * accelerations from the kicked velocities, and rigid held grains are judged on the
          * restored ones, so those are kept */
         const size_t bytes = s->phys.P.n * sizeof(double);
-        double *ax = malloc(bytes ? bytes : 1), *az = malloc(bytes ? bytes : 1);
-        int bad = !ax || !az;
+        double *acc[DIM];
+        int bad = 0;
+        for (int d = 0; d < DIM; d++) bad |= !(acc[d] = malloc(bytes ? bytes : 1));
         if (!bad) {
-            memcpy(ax, s->phys.P.ax, bytes);
-            memcpy(az, s->phys.P.az, bytes);
+            for (int d = 0; d < DIM; d++) memcpy(acc[d], s->phys.P.acc[d], bytes);
             bad = integrate_density_rates(s, &S) < 0 || forces_momentum(s->work.forces, &S) < 0;
-            memcpy(s->phys.P.ax, ax, bytes);
-            memcpy(s->phys.P.az, az, bytes);
+            for (int d = 0; d < DIM; d++) memcpy(s->phys.P.acc[d], acc[d], bytes);
         }
-        free(ax);
-        free(az);
+        for (int d = 0; d < DIM; d++) free(acc[d]);
         if (bad) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     }
     if (!s->work.wall_mirror && !(s->work.wall_mirror = walls_mirror_create()))
@@ -385,18 +392,17 @@ static mixsph_status implicit_viscous_step(mixsph_sim *s, double dt, double judg
     if (!(s->work.viscous_unknown = realloc_unknowns(s->work.viscous_unknown, s->phys.P.cap)))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
     const int rigid = s->scheme.held_grains_rigid;
-    struct particle_loop L = {.s = s};
-    team_for(S.n_threads, active_particles(s), unknowns_range, &L);
+    team_for(S.n_threads, active_particles(s), unknowns_range, s);
     const struct viscous_params *vp = &s->scheme.viscous;
     const double t0 = clock_monotonic_s();
     int failed = viscous_step(s->work.viscous, s->work.forces, &S, s->work.wall_mirror, &s->phys.walls, s->phys.t, dt,
                               s->work.viscous_unknown, vp, rep);
     const int kicks = rigid && judge_dt > 0.0, walls_work = any_wall_moves(&s->phys.walls);
     if (!failed && (kicks || walls_work)) { /* one operator pass, L u of the solved field, for both */
-        const double *lx, *lz;
-        failed = viscous_solution_operator(s->work.viscous, s->work.forces, &S, &lx, &lz) != 0;
-        if (!failed && kicks) held_grain_kicks(s, S.n_threads, judge_dt, lx, lz);
-        if (!failed && walls_work) viscous_wall_forces(s, lx, lz);
+        const double *lu[DIM];
+        failed = viscous_solution_operator(s->work.viscous, s->work.forces, &S, lu) != 0;
+        if (!failed && kicks) held_grain_kicks(s, S.n_threads, judge_dt, lu);
+        if (!failed && walls_work) viscous_wall_forces(s, lu);
     }
     s->work.viscous_wall_s += clock_monotonic_s() - t0;
     if (failed) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the implicit viscous step");
@@ -437,53 +443,66 @@ static mixsph_status check_time_step(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-/* The kick and drift of move_particles over particles [b, e): L->a = dt, L->b = the half kick.
- * With the drift, in the same loop, the largest squared displacement of an active particle
- * (walls included: they moved before) since the last build and whether one left the grid, as
- * neighbours_max_shift2 computes them (max and | are exact, so any order gives the same). */
+/* The kick and drift of move_particles over particles [b, e). With the drift, in the same loop,
+ * the largest squared displacement of an active particle (walls included: they moved before)
+ * since the last build and whether one left the grid, as neighbours_max_shift2 computes them (max
+ * and | are exact, so any order gives the same). */
+struct drift_loop {
+    mixsph_sim *s;
+    double dt;                /* the drift [s] */
+    double half_kick;         /* the kick before it [s] (0: none) */
+    const double *ox_old, *oz_old; /* the walls' displacements before they moved (walls_clip) */
+    size_t n_active;
+    long clips;               /* + particles put back on their side of a wall */
+    double shift2;            /* max squared displacement since the last build [m2] */
+    int outside;              /* | one left the grid */
+};
+
 static void drift_range(void *arg, size_t b, size_t e)
 {
-    struct particle_loop *L = arg;
+    struct drift_loop *L = arg;
     const mixsph_sim *s = L->s;
     struct particles *P = &L->s->phys.P;
-    const double dt = L->a, half_kick = L->b, gap = INTEGRATE_CLIP_GAP * s->phys.dx;
-    const double *ox_old = L->ox_old, *oz_old = L->oz_old;
+    const double dt = L->dt, half_kick = L->half_kick, gap = INTEGRATE_CLIP_GAP * s->phys.dx;
     const size_t n_active = L->n_active;
-    const double *x_build = s->work.NB.x0, *z_build = s->work.NB.z0;
     const struct cells *C = &s->work.C;
-    const double xa = C->x0, xb = C->x0 + C->nx * C->width, za = C->z0, zb = C->z0 + C->nz * C->size;
+    double lo[DIM], hi[DIM];
+    for (int d = 0; d < DIM; d++) {
+        lo[d] = C->lo[d];
+        hi[d] = cells_hi(C, d);
+    }
     long clips = 0;
     double shift2 = 0.0;
     int outside = 0;
     for (size_t i = b; i < e; i++) {
         const int st = P->state[i];
         if (st != MIXSPH_STATE_WALL && st != MIXSPH_STATE_LOST) {
-            const double kick =
-                st == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0) ? 0.0
-                                                                                                           : half_kick;
-            double vx = P->vx[i] + kick * P->ax[i];
-            double vz = P->vz[i] + kick * P->az[i];
+            const double kick = st == MIXSPH_STATE_FIXED && !held_kicked(s, i, 0) ? 0.0 : half_kick;
+            double v[DIM];
+            for (int d = 0; d < DIM; d++) v[d] = P->vel[d][i] + kick * P->acc[d][i];
             if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
-                const double x0 = P->x[i], z0 = P->z[i];
-                double x1 = x0 + dt * vx, z1 = z0 + dt * vz;
+                double x1[DIM];
+                for (int d = 0; d < DIM; d++) x1[d] = P->pos[d][i] + dt * v[d];
                 if (s->work.near_wall[i])
-                    walls_clip(&s->phys.walls, ox_old, oz_old, gap, x0, z0, &x1, &z1, &vx, &vz, &clips);
-                P->x[i] = x1;
-                P->z[i] = z1;
+                    walls_clip(&s->phys.walls, L->ox_old, L->oz_old, gap, P->pos[0][i], P->pos[DIM_UP][i], &x1[0],
+                               &x1[DIM_UP], &v[0], &v[DIM_UP], &clips);
+                for (int d = 0; d < DIM; d++) P->pos[d][i] = x1[d];
             }
-            P->vx[i] = P->uvx[i] = vx;
-            P->vz[i] = P->uvz[i] = vz;
+            for (int d = 0; d < DIM; d++) P->vel[d][i] = P->uv[d][i] = v[d];
         }
         if (i < n_active) {
-            const double ddx = P->x[i] - x_build[i], ddz = P->z[i] - z_build[i];
-            const double d2 = ddx * ddx + ddz * ddz;
+            double d2 = 0.0;
+            for (int d = 0; d < DIM; d++) {
+                const double dd = P->pos[d][i] - s->work.NB.pos0[d][i];
+                d2 += dd * dd;
+                outside |= !(P->pos[d][i] >= lo[d] && P->pos[d][i] < hi[d]);
+            }
             shift2 = d2 > shift2 ? d2 : shift2;
-            outside |= !(P->x[i] >= xa && P->x[i] < xb && P->z[i] >= za && P->z[i] < zb);
         }
     }
-    team_add_long(&L->count, clips);
+    team_add_long(&L->clips, clips);
     team_max_double(&L->shift2, shift2);
-    team_or_int(&L->flag, outside);
+    team_or_int(&L->outside, outside);
 }
 
 /* The walls move over dt (their displacements before it kept in *ox_old, *oz_old), then every
@@ -500,18 +519,15 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
         oz_old[w] = s->phys.walls.state[w].oz;
     }
     walls_move(&s->phys.walls, P, s->phys.t, dt);
-    struct particle_loop L = {.s = s, .a = dt, .b = half_kick, .ox_old = ox_old, .oz_old = oz_old,
-                              .n_active = s->work.C.start[s->work.C.ncell]};
+    struct drift_loop L = {.s = s, .dt = dt, .half_kick = half_kick, .ox_old = ox_old, .oz_old = oz_old,
+                           .n_active = s->work.C.start[s->work.C.ncell]};
     team_for(SIM_THREADS(s), P->n, drift_range, &L);
-    const long clips = L.count;
-    const double shift2 = L.shift2;
-    const int outside = L.flag;
-    s->phys.n_clipped += clips;
+    s->phys.n_clipped += L.clips;
     s->phys.t += dt;
     s->phys.step++;
     /* the lists hold while no particle has moved skin/2 since their build; a particle that left
      * the grid is marked lost by the rebuild at once */
-    if (outside || 4.0 * shift2 >= s->work.NB.skin * s->work.NB.skin) return integrate_rebuild_lists(s);
+    if (L.outside || 4.0 * L.shift2 >= s->work.NB.skin * s->work.NB.skin) return integrate_rebuild_lists(s);
     return MIXSPH_OK;
 }
 
@@ -523,15 +539,21 @@ static inline int density_out_of_bound(const struct medium *m, double bound, dou
     return !(rho <= (1.0 + bound) * m->rho0) || (medium_carries_tension(m) && !(rho >= (1.0 - bound) * m->rho0));
 }
 
-/* rho += dt drho (L->a = dt) and the equation of state; L->flag: a non-positive density; L->count:
- * particles whose new density is beyond the bound, which keep the old one for this step's momentum
- * pass and are marked for exclusion (exclude_particles). */
+/* rho += dt drho and the equation of state. Particles whose new density is beyond the bound keep
+ * the old one for this step's momentum pass and are marked for exclusion (exclude_particles). */
+struct density_update_loop {
+    mixsph_sim *s;
+    double dt;    /* [s] */
+    int bad_rho;  /* | a non-positive density */
+    long beyond;  /* + particles beyond the density bound */
+};
+
 static void density_update_range(void *arg, size_t b, size_t e)
 {
-    struct particle_loop *L = arg;
+    struct density_update_loop *L = arg;
     mixsph_sim *s = L->s;
     struct particles *P = &s->phys.P;
-    const double dt = L->a, bound = s->scheme.density_bound;
+    const double dt = L->dt, bound = s->scheme.density_bound;
     const double w0 = kernel_w(&s->phys.K, 0.0);
     const struct medium *media = s->scheme.media;
     int bad_rho = 0;
@@ -554,8 +576,8 @@ static void density_update_range(void *arg, size_t b, size_t e)
         bad_rho |= !(P->rho[i] > 0.0);
         particle_pressure(s, i);
     }
-    team_or_int(&L->flag, bad_rho);
-    team_add_long(&L->count, beyond);
+    team_or_int(&L->bad_rho, bad_rho);
+    team_add_long(&L->beyond, beyond);
 }
 
 /* The particles marked in the density update leave the run as a lost particle does (their
@@ -573,18 +595,20 @@ static mixsph_status exclude_particles(mixsph_sim *s)
         last = i;
         last_rho = P->rho[i] + s->phys.dt * P->drho[i];
         s->phys.excluded_mass += P->m[i];
-        s->phys.excluded_energy += P->m[i] * (0.5 * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]) + g * P->z[i]);
+        double u2 = 0.0;
+        for (int d = 0; d < DIM; d++) u2 += P->vel[d][i] * P->vel[d][i];
+        s->phys.excluded_energy += P->m[i] * (0.5 * u2 + g * P->pos[DIM_UP][i]);
         s->phys.n_excluded++;
         P->state[i] = MIXSPH_STATE_LOST;
-        P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
+        for (int d = 0; d < DIM; d++) P->vel[d][i] = P->uv[d][i] = 0.0;
     }
     if (s->phys.n_excluded > s->scheme.excluded_limit)
         return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                         "%ld particles excluded for a density beyond numerics.density_bound = %g of rho0, more than "
                         "numerics.excluded_max allows (%ld); the last: particle %u (x = %g, z = %g, density %g kg/m3) "
                         "at t = %.6g s",
-                        s->phys.n_excluded, s->scheme.density_bound, s->scheme.excluded_limit, P->id[last], P->x[last],
-                        P->z[last], last_rho, s->phys.t);
+                        s->phys.n_excluded, s->scheme.density_bound, s->scheme.excluded_limit, P->id[last],
+                        P->pos[0][last], P->pos[DIM_UP][last], last_rho, s->phys.t);
     forces_forget_cache(s->work.forces); /* its factors and viscous couplings are of the old lists */
     return integrate_rebuild_lists(s);
 }
@@ -599,40 +623,47 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
     int bad_rho = integrate_density_rates(s, &S);
     if (bad_rho < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     /* the densities and the equation of state, in one loop */
-    struct particle_loop L = {.s = s, .a = dt};
+    struct density_update_loop L = {.s = s, .dt = dt};
     team_for(SIM_THREADS(s), P->n, density_update_range, &L);
-    bad_rho |= L.flag;
+    bad_rho |= L.bad_rho;
     if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->work.forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     if (bad_a || bad_rho) {
-        for (size_t i = 0; i < P->n; i++)
-            if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(P->ax[i] + P->az[i] + P->drho[i]) && P->rho[i] > 0.0))
+        for (size_t i = 0; i < P->n; i++) {
+            double sum = 0.0;
+            for (int d = 0; d < DIM; d++) sum += P->acc[d][i];
+            if (P->state[i] <= MIXSPH_STATE_FIXED && !(isfinite(sum + P->drho[i]) && P->rho[i] > 0.0))
                 return SIM_FAIL(s, MIXSPH_ERR_UNSTABLE,
                                 "non-finite acceleration or non-positive density (%g kg/m3) at particle %u (x = %g, z = %g) at t = %.6g s",
-                                P->rho[i], P->id[i], P->x[i], P->z[i], s->phys.t);
+                                P->rho[i], P->id[i], P->pos[0][i], P->pos[DIM_UP][i], s->phys.t);
+        }
     }
-    if (L.count > 0) return exclude_particles(s);
+    if (L.beyond > 0) return exclude_particles(s);
     return MIXSPH_OK;
 }
 
 /* The last half kick (`last_kick`, 0 for none) and the next time step, in one loop. */
+struct last_kick_loop {
+    mixsph_sim *s;
+    double last_kick; /* [s] */
+    int implicit;     /* the time step without the viscous bound */
+    double dt_min;    /* min: the next time step [s] */
+};
+
 static void last_kick_range(void *arg, size_t b, size_t e)
 {
-    struct particle_loop *L = arg;
+    struct last_kick_loop *L = arg;
     const mixsph_sim *s = L->s;
     struct particles *P = &L->s->phys.P;
-    const double last_kick = L->a;
+    const double last_kick = L->last_kick;
     const int implicit = L->implicit;
     double dt_next = INFINITY;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        if (last_kick > 0.0 &&
-            !(P->state[i] == MIXSPH_STATE_FIXED && !mixture_paper_held_grain_kicked(&s->scheme.media[P->medium[i]], 0))) {
-            P->vx[i] += last_kick * P->ax[i];
-            P->vz[i] += last_kick * P->az[i];
-        }
+        if (last_kick > 0.0 && !(P->state[i] == MIXSPH_STATE_FIXED && !held_kicked(s, i, 0)))
+            for (int d = 0; d < DIM; d++) P->vel[d][i] += last_kick * P->acc[d][i];
         const double d = particle_time_step(s, i, implicit);
         if (d < dt_next) dt_next = d;
     }
@@ -641,7 +672,7 @@ static void last_kick_range(void *arg, size_t b, size_t e)
 
 static void last_kick_and_time_step(mixsph_sim *s, double last_kick, int implicit)
 {
-    struct particle_loop L = {.s = s, .a = last_kick, .implicit = implicit, .dt_min = INFINITY};
+    struct last_kick_loop L = {.s = s, .last_kick = last_kick, .implicit = implicit, .dt_min = INFINITY};
     team_for(SIM_THREADS(s), s->phys.P.n, last_kick_range, &L);
     s->phys.dt = L.dt_min;
 }

@@ -183,7 +183,7 @@ static int apply_a(const struct solve_ctx *c, int in, int out, int dot, int dot2
 {
     double **v = c->V->v;
     fill_wall_rows(c, 0, v[in], v[in + 1]);
-    if (forces_viscous_apply(c->F, c->S, v[in], v[in + 1], v[out], v[out + 1], NULL) != 0) return -1;
+    if (forces_viscous_apply(c->F, c->S, (const double *const *)&v[in], &v[out], NULL) != 0) return -1;
     const long nb = BLOCKS(c->n);
     struct vloop L = {.c = c, .in = in, .out = out, .dot = dot, .dot2 = dot2};
     team_for(c->S->n_threads, (size_t)nb, apply_a_blocks, &L);
@@ -331,12 +331,12 @@ static int setup(const struct solve_ctx *c)
      * operator pass fewer per stage */
     team_for(c->S->n_threads, c->n, prescribed_moving_range, &L);
     if (L.flag) {
-        if (forces_viscous_apply(c->F, c->S, v[U0X], v[U0Z], v[BX], v[BZ], NULL) != 0) return -1;
+        if (forces_viscous_apply(c->F, c->S, (const double *const *)&v[U0X], &v[BX], NULL) != 0) return -1;
     } else {
         memset(v[BX], 0, c->n * sizeof(double));
         memset(v[BZ], 0, c->n * sizeof(double));
     }
-    if (forces_viscous_apply(c->F, c->S, v[UX], v[UZ], v[RX], v[RZ], v[MINV]) != 0) return -1;
+    if (forces_viscous_apply(c->F, c->S, (const double *const *)&v[UX], &v[RX], v[MINV]) != 0) return -1;
     team_for(c->S->n_threads, c->n, setup_last_range, &L);
     return 0;
 }
@@ -605,12 +605,11 @@ int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct
 #define SDIRK_GAMMA 1.7071067811865475 /* 1 + 1/sqrt 2 */
 
 int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                              const double **lx, const double **lz)
+                              const double *lu[DIM])
 {
     double **v = V->v;
-    if (forces_viscous_apply(F, S, v[UX], v[UZ], v[RX], v[RZ], NULL) != 0) return -1;
-    *lx = v[RX];
-    *lz = v[RZ];
+    if (forces_viscous_apply(F, S, (const double *const *)&v[UX], &v[RX], NULL) != 0) return -1;
+    for (int d = 0; d < DIM; d++) lu[d] = v[RX + d];
     return 0;
 }
 

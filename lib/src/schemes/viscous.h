@@ -54,10 +54,10 @@ int viscous_step(struct viscous_solver *V, const struct forces *F, const struct 
                  const unsigned char *unknown, const struct viscous_params *vp, struct viscous_report *report);
 
 /** The viscous operator applied to the last step's solved velocity field (its wall rows as the
- *  mirror made them): *lx, *lz point at sum_j w_ij (u_i - u_j) per particle, in the solver's
+ *  mirror made them): lu[d] points at component d of sum_j w_ij (u_i - u_j) per particle, in the solver's
  *  scratch, valid until its next use. Returns -1 without a stored operator. */
 int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
-                              const double **lx, const double **lz);
+                              const double *lu[DIM]);
 
 /** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the velocities of the
  *  particles mobile or held (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the

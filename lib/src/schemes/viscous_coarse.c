@@ -91,17 +91,28 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
                          const unsigned char *unknown, size_t n)
 {
     const struct cells *C = S->C;
+#if DIM != 2
+    /* the groups and their 5-slot stencil are those of a 2D grid of cell rows: the coarse level
+     * of a 3D run is not written (numerics.viscous_preconditioner "jacobi" there) */
+    (void)F;
+    (void)unknown;
+    (void)n;
+    (void)C;
+    (void)K;
+    return -1;
+#else
+    const long nx = C->n[0], nz = C->n[DIM_UP];
     const long width = (long)COARSE_WIDTH_KX * C->kx;
-    const long per_row = (C->nx + width - 1) / width;
+    const long per_row = (nx + width - 1) / width;
     K->stride = per_row + 2;
-    K->size = (size_t)K->stride * (size_t)(C->nz + 2);
+    K->size = (size_t)K->stride * (size_t)(nz + 2);
     if (reserve(K, n, K->size) != 0) return -1;
     for (size_t id = 0; id < K->size; id++) K->compact[id] = -1;
     K->n_active = 0;
-    for (long row = 0; row < C->nz; row++)
+    for (long row = 0; row < nz; row++)
         for (long gx = 0; gx < per_row; gx++) {
-            const size_t row0 = (size_t)row * (size_t)C->nx;
-            const long col1 = gx * width + width < C->nx ? gx * width + width : C->nx;
+            const size_t row0 = (size_t)row * (size_t)nx;
+            const long col1 = gx * width + width < nx ? gx * width + width : nx;
             const size_t b = C->start[row0 + (size_t)(gx * width)], e = C->start[row0 + (size_t)col1];
             const size_t id = (size_t)(row + 1) * (size_t)K->stride + (size_t)(gx + 1);
             int any = 0;
@@ -121,6 +132,7 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
     if (forces_viscous_group_couplings(F, S, K->group, K->stride, K->w) != 0) return -1;
     K->e[0][K->n_active] = K->e[1][K->n_active] = 0.0; /* the "no neighbour" entry */
     return 0;
+#endif
 }
 
 /* With P a group's value on each of its unknowns and A = m + kappa L,
