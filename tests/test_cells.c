@@ -25,41 +25,71 @@ struct grid_spec {
 };
 
 /* Random particles in and around the grid, plus the special positions. */
+/* This file tests the 2D grid through its (x, z) coordinates; test_neighbours.c tests the
+ * ranges for any DIM. */
+_Static_assert(DIM == 2, "test_cells is the 2D grid's test");
+
+static void coords_2d(const struct cells *C, double x, double z, int *ix, int *iz)
+{
+    const double p[2] = {x, z};
+    int c[2];
+    cells_coords(C, p, c);
+    *ix = c[0];
+    *iz = c[1];
+}
+
+static struct range row_2d(const struct cells *C, int ix, int iz, int drow)
+{
+    const int c[2] = {ix, iz};
+    return cells_row(C, c, drow + 1);
+}
+
+static int init_columns_2d(struct cells *C, double x0, double x1, double z0, double z1, double size, int kx)
+{
+    const double lo[2] = {x0, z0}, hi[2] = {x1, z1};
+    return cells_init_columns(C, lo, hi, size, kx);
+}
+
+static int init_2d(struct cells *C, double x0, double x1, double z0, double z1, double size)
+{
+    return init_columns_2d(C, x0, x1, z0, z1, size, 1);
+}
+
 static void make_particles(struct particles *P, const struct cells *C, uint64_t seed, size_t n_random)
 {
     uint64_t s = seed;
-    const double X1 = C->x0 + C->nx * C->size, Z1 = C->z0 + C->nz * C->size;
+    const double X1 = C->lo[0] + C->n[0] * C->size, Z1 = C->lo[1] + C->n[1] * C->size;
     assert_int_equal(particles_alloc(P, 16), 0);
     for (size_t k = 0; k < n_random; k++) {
-        const double x = test_random_uniform(&s, C->x0 - 0.5 * C->size, X1 + 0.5 * C->size);
-        const double z = test_random_uniform(&s, C->z0 - 0.5 * C->size, Z1 + 0.5 * C->size);
+        const double x = test_random_uniform(&s, C->lo[0] - 0.5 * C->size, X1 + 0.5 * C->size);
+        const double z = test_random_uniform(&s, C->lo[1] - 0.5 * C->size, Z1 + 0.5 * C->size);
         const uint8_t st = k % 17 == 0 ? MIXSPH_STATE_WALL : k % 23 == 0 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
         assert_true(particles_push(P, (const double[DIM]){x, z}, 1000.0, 1.0, 0, st) != (size_t)-1);
     }
     /* on every vertical and horizontal cell border (the last ones, x = X1 and z = Z1, are outside) */
-    for (int i = 0; i <= C->nx; i++) {
+    for (int i = 0; i <= C->n[0]; i++) {
         for (int k = 0; k < 3; k++) {
-            particles_push(P, (const double[DIM]){C->x0 + i * C->size, test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-            particles_push(P, (const double[DIM]){C->x0 + i * C->size, C->z0 + (k % C->nz) * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){C->lo[0] + i * C->size, test_random_uniform(&s, C->lo[1], Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){C->lo[0] + i * C->size, C->lo[1] + (k % C->n[1]) * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
         }
     }
-    for (int l = 0; l <= C->nz; l++)
+    for (int l = 0; l <= C->n[1]; l++)
         for (int k = 0; k < 3; k++)
-            particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), C->z0 + l * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+            particles_push(P, (const double[DIM]){test_random_uniform(&s, C->lo[0], X1), C->lo[1] + l * C->size}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just inside the last column and row, and the far corner */
     for (int k = 0; k < 5; k++) {
-        particles_push(P, (const double[DIM]){nextafter(X1, -INFINITY), test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-        particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), nextafter(Z1, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, (const double[DIM]){nextafter(X1, -INFINITY), test_random_uniform(&s, C->lo[1], Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+        particles_push(P, (const double[DIM]){test_random_uniform(&s, C->lo[0], X1), nextafter(Z1, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     }
     particles_push(P, (const double[DIM]){nextafter(X1, -INFINITY), nextafter(Z1, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, (const double[DIM]){C->x0, C->z0}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){C->lo[0], C->lo[1]}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* just outside the near edges, and not finite */
-    particles_push(P, (const double[DIM]){nextafter(C->x0, -INFINITY), test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), nextafter(C->z0, -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, (const double[DIM]){NAN, test_random_uniform(&s, C->z0, Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
-    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->x0, X1), INFINITY}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){nextafter(C->lo[0], -INFINITY), test_random_uniform(&s, C->lo[1], Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->lo[0], X1), nextafter(C->lo[1], -INFINITY)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){NAN, test_random_uniform(&s, C->lo[1], Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
+    particles_push(P, (const double[DIM]){test_random_uniform(&s, C->lo[0], X1), INFINITY}, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE);
     /* already lost before the build, inside the grid: stays lost, not counted again */
-    particles_push(P, (const double[DIM]){0.5 * (C->x0 + X1), 0.5 * (C->z0 + Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
+    particles_push(P, (const double[DIM]){0.5 * (C->lo[0] + X1), 0.5 * (C->lo[1] + Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
     for (size_t i = 0; i < P->n; i++) {
         P->vx[i] = 1.0 + (double)i;
         P->vz[i] = -2.0;
@@ -72,9 +102,9 @@ static void make_particles(struct particles *P, const struct cells *C, uint64_t 
  * last cell or out of the grid; either is right). */
 static int inside(const struct cells *C, double x, double z)
 {
-    const double X1 = C->x0 + C->nx * C->size, Z1 = C->z0 + C->nz * C->size;
+    const double X1 = C->lo[0] + C->n[0] * C->size, Z1 = C->lo[1] + C->n[1] * C->size;
     const double tol = 1e-12 * C->size;
-    if (!(x >= C->x0 && z >= C->z0 && x < X1 + tol && z < Z1 + tol)) return 0;
+    if (!(x >= C->lo[0] && z >= C->lo[1] && x < X1 + tol && z < Z1 + tol)) return 0;
     if (x > X1 - tol || z > Z1 - tol) return -1;
     return 1;
 }
@@ -98,9 +128,9 @@ static size_t check_neighbours(const struct cells *C, const struct particles *P)
     for (size_t i = 0; i < n_in; i++) {
         size_t na = 0, nb = 0;
         int ix, iz;
-        cells_coords(C, P->x[i], P->z[i], &ix, &iz);
+        coords_2d(C, P->x[i], P->z[i], &ix, &iz);
         for (int row = -1; row <= 1; row++) {
-            const struct range rg = cells_row(C, ix, iz, row);
+            const struct range rg = row_2d(C, ix, iz, row);
             assert_true(rg.begin <= rg.end && rg.end <= n_in);
             for (size_t j = rg.begin; j < rg.end; j++) {
                 const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
@@ -152,11 +182,11 @@ static void check_sort(const struct cells *C, const struct particles *P, const d
             const uint32_t c = C->cell[k];
             assert_true(c < C->ncell);
             assert_true(C->start[c] <= k && k < C->start[c + 1]);
-            const int ix = (int)(c % (uint32_t)C->nx), iz = (int)(c / (uint32_t)C->nx);
+            const int ix = (int)(c % (uint32_t)C->n[0]), iz = (int)(c / (uint32_t)C->n[0]);
             /* tolerance: a position on a border may fall on either side by one rounding */
             const double tol = 1e-12 * C->size;
-            assert_true(P->x[k] >= C->x0 + ix * C->size - tol && P->x[k] < C->x0 + (ix + 1) * C->size + tol);
-            assert_true(P->z[k] >= C->z0 + iz * C->size - tol && P->z[k] < C->z0 + (iz + 1) * C->size + tol);
+            assert_true(P->x[k] >= C->lo[0] + ix * C->size - tol && P->x[k] < C->lo[0] + (ix + 1) * C->size + tol);
+            assert_true(P->z[k] >= C->lo[1] + iz * C->size - tol && P->z[k] < C->lo[1] + (iz + 1) * C->size + tol);
             if (k > 0) assert_true(C->cell[k - 1] <= c);
             /* stable: particles of one cell keep their previous (here: id) order */
             if (k > C->start[c]) assert_true(P->id[k - 1] < id);
@@ -174,10 +204,10 @@ static void run_grid(const struct grid_spec *g, uint64_t seed, size_t n_random)
     struct cells C;
     struct particles P;
     memset(&P, 0, sizeof P);
-    assert_int_equal(cells_init(&C, g->x_min, g->x_max, g->z_min, g->z_max, g->size), 0);
+    assert_int_equal(init_2d(&C, g->x_min, g->x_max, g->z_min, g->z_max, g->size), 0);
     /* the grid covers the box with whole cells */
-    assert_true(C.nx == (int)ceil((g->x_max - g->x_min) / g->size));
-    assert_true(C.x0 + C.nx * C.size >= g->x_max && C.z0 + C.nz * C.size >= g->z_max);
+    assert_true(C.n[0] == (int)ceil((g->x_max - g->x_min) / g->size));
+    assert_true(C.lo[0] + C.n[0] * C.size >= g->x_max && C.lo[1] + C.n[1] * C.size >= g->z_max);
     make_particles(&P, &C, seed, n_random);
     const size_t n = P.n;
     double *x = malloc(n * sizeof *x), *z = malloc(n * sizeof *z);
@@ -236,7 +266,7 @@ static void run_grid(const struct grid_spec *g, uint64_t seed, size_t n_random)
     assert_true(lost2 >= expect2 && lost2 <= expect2 + undecided2);
     check_sort(&C, &P, x, z, st, n);
     check_neighbours(&C, &P);
-    print_message("grid %d x %d, %zu particles: %ld lost, then %ld more, %zu neighbour pairs\n", C.nx, C.nz, n, lost,
+    print_message("grid %d x %d, %zu particles: %ld lost, then %ld more, %zu neighbour pairs\n", C.n[0], C.n[1], n, lost,
                   lost2, pairs);
     free(perm);
     free(scratch);
@@ -281,16 +311,16 @@ static void test_empty(void **state)
     struct cells C;
     struct particles P;
     memset(&P, 0, sizeof P);
-    assert_int_equal(cells_init(&C, 0.0, 1.0, 0.0, 1.0, 0.25), 0);
+    assert_int_equal(init_2d(&C, 0.0, 1.0, 0.0, 1.0, 0.25), 0);
     assert_int_equal(particles_alloc(&P, 16), 0);
     assert_int_equal(cells_build(&C, &P), 0);
     for (size_t c = 0; c <= C.ncell + 1; c++) assert_true(C.start[c] == 0);
-    const struct range r = cells_row(&C, 1, 1, 0);
+    const struct range r = row_2d(&C, 1, 1, 0);
     assert_true(r.begin == r.end);
     particles_free(&P);
     cells_free(&C);
     /* a box of zero width cannot hold a grid */
-    assert_int_equal(cells_init(&C, 0.0, 0.0, 0.0, 1.0, 0.25), -1);
+    assert_int_equal(init_2d(&C, 0.0, 0.0, 0.0, 1.0, 0.25), -1);
     cells_free(&C);
 }
 
@@ -316,7 +346,7 @@ static void test_neighbour_ranges(void **state)
         struct cells C;
         struct particles P;
         memset(&P, 0, sizeof P);
-        assert_int_equal(cells_init_columns(&C, 0.0, 0.5, 0.0, 0.3, rc, kx), 0);
+        assert_int_equal(init_columns_2d(&C, 0.0, 0.5, 0.0, 0.3, rc, kx), 0);
         assert_true(C.width * kx == C.size);
         assert_int_equal(particles_alloc(&P, 3000), 0);
         uint64_t seed = 99u + (uint64_t)kx;
@@ -326,7 +356,7 @@ static void test_neighbour_ranges(void **state)
         }
         /* particles on column and row borders */
         for (int k = 0; k < 40; k++)
-            particles_push(&P, (const double[DIM]){C.x0 + (k % 10 + 1) * C.width, C.z0 + (k % 5 + 1) * C.size}, 1000.0, 1.0, 0,
+            particles_push(&P, (const double[DIM]){C.lo[0] + (k % 10 + 1) * C.width, C.lo[1] + (k % 5 + 1) * C.size}, 1000.0, 1.0, 0,
                            MIXSPH_STATE_MOBILE);
         assert_int_equal(cells_build(&C, &P), 0);
         const size_t n = C.start[C.ncell];

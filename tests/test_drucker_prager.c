@@ -298,8 +298,8 @@ static void test_jaumann_rigid_rotation(void **state)
     double p = p0;
     const long n_turns = (long)llround(10.0 * 2.0 * GEOM_PI / (omega * dt));
     for (long k = 0; k < n_turns; k++) {
-        elasticity_jaumann_step(&s, 0.0, -omega, omega, 0.0, m.G, dt);
-        p = elasticity_pressure_step(p, 0.0, 0.0, m.K, dt);
+        elasticity_jaumann_step(&s, (const double[]){0.0, -omega, omega, 0.0}, m.G, dt);
+        p = elasticity_pressure_step(p, (const double[]){0.0, 0.0, 0.0, 0.0}, m.K, dt);
         assert_int_equal(drucker_prager_return(&s, &p, &m), DRUCKER_PRAGER_ELASTIC);
     }
     assert_rel(drucker_prager_sqrt_j2(&s), j0, 1e-10, "sqrt(J2) after ten turns");
@@ -309,7 +309,7 @@ static void test_jaumann_rigid_rotation(void **state)
 
     const double dt8 = (0.25 * GEOM_PI / omega) / 10000.0;
     s = s0;
-    for (int k = 0; k < 10000; k++) elasticity_jaumann_step(&s, 0.0, -omega, omega, 0.0, m.G, dt8);
+    for (int k = 0; k < 10000; k++) elasticity_jaumann_step(&s, (const double[]){0.0, -omega, omega, 0.0}, m.G, dt8);
     const double c = cos(0.25 * GEOM_PI), sn = sin(0.25 * GEOM_PI); /* R = [[c, -sn], [sn, c]] */
     const double xx = c * c * s0.xx - 2.0 * c * sn * s0.xz + sn * sn * s0.zz;
     const double zz = sn * sn * s0.xx + 2.0 * c * sn * s0.xz + c * c * s0.zz;
@@ -337,8 +337,8 @@ static void test_oedometric_ratio(void **state)
         double p = 0.0;
         const double rate = -1e-3, dt = 1e-3;
         for (int n = 0; n < 100; n++) {
-            elasticity_jaumann_step(&s, 0.0, 0.0, 0.0, rate, G, dt);
-            p = elasticity_pressure_step(p, 0.0, rate, K, dt);
+            elasticity_jaumann_step(&s, (const double[]){0.0, 0.0, 0.0, rate}, G, dt);
+            p = elasticity_pressure_step(p, (const double[]){0.0, 0.0, 0.0, rate}, K, dt);
         }
         const double sv = s.zz - p, sh = s.xx - p, sy = s.yy - p;
         const double nu = nus[k], M = E_SAND * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu));
@@ -376,8 +376,8 @@ static void test_biaxial_mohr_coulomb(void **state)
         for (int n = 0; n < 50000; n++) {
             const double sxx = s.xx - p;
             const double dudx = (target - sxx - lambda * dwdz * dt) / (M * dt);
-            elasticity_jaumann_step(&s, dudx, 0.0, 0.0, dwdz, m.G, dt);
-            p = elasticity_pressure_step(p, dudx, dwdz, m.K, dt);
+            elasticity_jaumann_step(&s, (const double[]){dudx, 0.0, 0.0, dwdz}, m.G, dt);
+            p = elasticity_pressure_step(p, (const double[]){dudx, 0.0, 0.0, dwdz}, m.K, dt);
             drucker_prager_return(&s, &p, &m);
         }
         const double sxx = s.xx - p, szz = s.zz - p;

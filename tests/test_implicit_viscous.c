@@ -208,7 +208,9 @@ static void momentum_only_changed_by_walls(int preconditioner)
         dpz += P->m[i] * (P->vz[i] - uz0[i]);
         scale += P->m[i] * hypot(ux0[i], uz0[i]);
     }
-    assert_int_equal(forces_viscous_apply(s->work.forces, &S, ux, uz, lx, lz, NULL), 0);
+    const double *const u[DIM] = {ux, uz};
+    double *const lu[DIM] = {lx, lz};
+    assert_int_equal(forces_viscous_apply(s->work.forces, &S, u, lu, NULL), 0);
     double fx = 0.0, fz = 0.0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_MOBILE) {

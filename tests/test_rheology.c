@@ -143,18 +143,18 @@ static void test_sqrt_ii(void **state)
 {
     (void)state;
     /* pure shear u = g z: D_xz = g/2, sqrt(II_D) = sqrt(g^2/4) = g/2 */
-    assert_close(rheology_sqrt_ii(0.0, 3.0, 0.0, 0.0), 1.5);
-    assert_close(rheology_sqrt_ii(0.0, -3.0, 0.0, 0.0), 1.5);
-    assert_close(rheology_sqrt_ii(0.0, 0.0, 3.0, 0.0), 1.5); /* w = g x: the same shear */
+    assert_close(rheology_sqrt_ii((const double[]){0.0, 3.0, 0.0, 0.0}), 1.5);
+    assert_close(rheology_sqrt_ii((const double[]){0.0, -3.0, 0.0, 0.0}), 1.5);
+    assert_close(rheology_sqrt_ii((const double[]){0.0, 0.0, 3.0, 0.0}), 1.5); /* w = g x: the same shear */
     /* pure extension u = a x, w = -a z (divergence-free): sqrt(a^2/2 + a^2/2) = a */
-    assert_close(rheology_sqrt_ii(2.5, 0.0, 0.0, -2.5), 2.5);
+    assert_close(rheology_sqrt_ii((const double[]){2.5, 0.0, 0.0, -2.5}), 2.5);
     /* rigid rotation u = w z, w = -w x: no strain rate at all (exactly 0) */
-    assert_true(rheology_sqrt_ii(0.0, 4.0, -4.0, 0.0) == 0.0);
+    assert_true(rheology_sqrt_ii((const double[]){0.0, 4.0, -4.0, 0.0}) == 0.0);
     /* rotation plus shear: only the symmetric part counts, du/dz + dw/dx = 1 -> 1/2 */
-    assert_close(rheology_sqrt_ii(0.0, 4.5, -3.5, 0.0), 0.5);
+    assert_close(rheology_sqrt_ii((const double[]){0.0, 4.5, -3.5, 0.0}), 0.5);
     /* everything at once: 1/2 + 1/2 * 4 + 1/4 * 9 = 4.75 */
-    assert_close(rheology_sqrt_ii(1.0, 1.0, 2.0, 2.0), sqrt(4.75));
-    assert_true(rheology_sqrt_ii(0.0, 0.0, 0.0, 0.0) == 0.0);
+    assert_close(rheology_sqrt_ii((const double[]){1.0, 1.0, 2.0, 2.0}), sqrt(4.75));
+    assert_true(rheology_sqrt_ii((const double[]){0.0, 0.0, 0.0, 0.0}) == 0.0);
 }
 
 /* sigma' = max(p - max(p_w, 0), 0). */

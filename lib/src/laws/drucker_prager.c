@@ -38,7 +38,11 @@ const char *drucker_prager_material(double E, double nu, double phi, double c, d
 
 double drucker_prager_sqrt_j2(const struct deviatoric_stress *s)
 {
+#if DIM == 2
     return sqrt(0.5 * (s->xx * s->xx + s->zz * s->zz + s->yy * s->yy) + s->xz * s->xz);
+#else
+    return sqrt(0.5 * (s->xx * s->xx + s->zz * s->zz + s->yy * s->yy) + s->xz * s->xz + s->xy * s->xy + s->yz * s->yz);
+#endif
 }
 
 double drucker_prager_yield(const struct deviatoric_stress *s, double p_eff,
@@ -61,12 +65,19 @@ enum drucker_prager_outcome drucker_prager_return(struct deviatoric_stress *s, d
         s->zz *= r;
         s->xz *= r;
         s->yy *= r;
+#if DIM == 3
+        s->xy *= r;
+        s->yz *= r;
+#endif
         *p_eff += 3.0 * m->K * m->alpha_psi * dlambda;
         return DRUCKER_PRAGER_CONE;
     }
     /* The apex: reached only where alpha_phi > 0 (with alpha_phi = 0 the shrink is sqrt(J2) - k_c,
      * below sqrt(J2) for k_c > 0, and k_c = 0 is refused by the matching). */
     s->xx = s->zz = s->xz = s->yy = 0.0;
+#if DIM == 3
+    s->xy = s->yz = 0.0;
+#endif
     *p_eff = -m->k_c / (3.0 * m->alpha_phi);
     return DRUCKER_PRAGER_APEX;
 }

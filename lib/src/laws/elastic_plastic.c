@@ -119,22 +119,19 @@ static void plastic_range(void *arg, size_t b, size_t e)
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const struct medium *m = &media[P->medium[i]];
         if (m->law != LAW_ELASTIC_PLASTIC) continue;
-        double g[4];
+        double g[DIM * DIM];
         velocity_gradient_corrected(step->grad, i, g);
-        struct deviatoric_stress s = {.xx = P->sxx[i], .zz = P->szz[i], .xz = P->sxz[i], .yy = P->syy[i]};
-        elasticity_jaumann_step(&s, g[0], g[1], g[2], g[3], m->shear_modulus, dt);
+        struct deviatoric_stress s = deviatoric_stress_load(P->stress, i);
+        elasticity_jaumann_step(&s, g, m->shear_modulus, dt);
         const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->shear_modulus,
                                                    .alpha_phi = m->alpha_phi, .k_c = m->k_c,
                                                    .alpha_psi = m->alpha_psi};
-        const double pw = fmax(pore_pressure(pore, m, P->x[i], P->z[i]), 0.0);
+        const double pw = fmax(pore_pressure(pore, m, P->pos[0][i], P->pos[DIM_UP][i]), 0.0);
         double p_eff = P->p[i] - pb - pw;
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
         if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb + pw; /* the tension cut-off */
         plastic += out != DRUCKER_PRAGER_ELASTIC;
-        P->sxx[i] = s.xx;
-        P->sxz[i] = s.xz;
-        P->szz[i] = s.zz;
-        P->syy[i] = s.yy;
+        deviatoric_stress_store(&s, P->stress, i);
     }
     team_add_long(&L->plastic, plastic);
 }

@@ -66,14 +66,11 @@ static void elastic_range(void *arg, size_t b, size_t e)
     const double dt = step->dt;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || media[P->medium[i]].law != LAW_ELASTIC_SOLID) continue;
-        double g[4];
+        double g[DIM * DIM];
         velocity_gradient_corrected(step->grad, i, g);
-        struct deviatoric_stress s = {.xx = P->sxx[i], .zz = P->szz[i], .xz = P->sxz[i], .yy = P->syy[i]};
-        elasticity_jaumann_step(&s, g[0], g[1], g[2], g[3], media[P->medium[i]].shear_modulus, dt);
-        P->sxx[i] = s.xx;
-        P->sxz[i] = s.xz;
-        P->szz[i] = s.zz;
-        P->syy[i] = s.yy;
+        struct deviatoric_stress s = deviatoric_stress_load(P->stress, i);
+        elasticity_jaumann_step(&s, g, media[P->medium[i]].shear_modulus, dt);
+        deviatoric_stress_store(&s, P->stress, i);
     }
 }
 

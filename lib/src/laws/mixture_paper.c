@@ -202,10 +202,12 @@ static void fixed_bed_tops(struct mixture *M, const struct particles *P, size_t 
     }
     for (size_t i = 0; i < n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || M->media[P->medium[i]].law != LAW_MIXTURE_PAPER) continue;
-        if (P->state[i] == MIXSPH_STATE_MOBILE && P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i] > v2) continue;
-        const size_t b = bed_column(M, P->x[i]);
-        if (P->z[i] > M->bed_z[b]) {
-            M->bed_z[b] = P->z[i];
+        double u2 = 0.0;
+        for (int d = 0; d < DIM; d++) u2 += P->vel[d][i] * P->vel[d][i];
+        if (P->state[i] == MIXSPH_STATE_MOBILE && u2 > v2) continue;
+        const size_t b = bed_column(M, P->pos[0][i]);
+        if (P->pos[DIM_UP][i] > M->bed_z[b]) {
+            M->bed_z[b] = P->pos[DIM_UP][i];
             M->bed_ref[b] = (long)i;
         }
     }
@@ -214,7 +216,7 @@ static void fixed_bed_tops(struct mixture *M, const struct particles *P, size_t 
 /* Whether grain i lies more than 2h below the top of its column's fixed bed. */
 static int frozen(const struct mixture *M, const struct particles *P, size_t i)
 {
-    return P->z[i] < M->bed_z[bed_column(M, P->x[i])] - 2.0 * M->h;
+    return P->pos[DIM_UP][i] < M->bed_z[bed_column(M, P->pos[0][i])] - 2.0 * M->h;
 }
 
 /* The three loops of the update in one parallel region (each waits for the one before: the
@@ -244,10 +246,10 @@ static void mixture_region(void *arg, int tid, int nth)
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
         const struct medium *m = &media[P->medium[i]];
         if (m->law != LAW_MIXTURE_PAPER) continue;
-        double grad[4];
+        double grad[DIM * DIM];
         velocity_gradient_corrected(step->grad, i, grad);
-        const double sii = rheology_sqrt_ii(grad[0], grad[1], grad[2], grad[3]);
-        const double pw = pore_pressure(M->pore, m, P->x[i], P->z[i]);
+        const double sii = rheology_sqrt_ii(grad);
+        const double pw = pore_pressure(M->pore, m, P->pos[0][i], P->pos[DIM_UP][i]);
         const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
         const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
         double mu;
@@ -258,7 +260,7 @@ static void mixture_region(void *arg, int tid, int nth)
         }
         if (fix) {
             P->state[i] = MIXSPH_STATE_FIXED;
-            P->vx[i] = P->vz[i] = P->uvx[i] = P->uvz[i] = 0.0;
+            for (int d = 0; d < DIM; d++) P->vel[d][i] = P->uv[d][i] = 0.0;
             fixed++;
         } else {
             P->state[i] = MIXSPH_STATE_MOBILE;
@@ -271,18 +273,19 @@ static void mixture_region(void *arg, int tid, int nth)
     /* pressure of the fixed grains from the mobile grains around them */
     for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_FIXED || (fixed_bed && frozen(M, P, i))) continue;
-        const double xi = P->x[i], zi = P->z[i];
+        const double zi = P->pos[DIM_UP][i];
         double sw = 0.0, sp = 0.0;
-        for (size_t k = 0; k < 6; k += 2) /* the three rows of the neighbourhood */
-            for (size_t j = G->rng[6 * i + k]; j < G->rng[6 * i + k + 1]; j++) {
-            if (P->state[j] != MIXSPH_STATE_MOBILE || media[P->medium[j]].law != LAW_MIXTURE_PAPER) continue;
-            const double rx = xi - P->x[j], rz = zi - P->z[j];
-            const double r2 = rx * rx + rz * rz;
-            if (r2 >= KW->r2max) continue;
-            const double w = kernel_w(KW, sqrt(r2));
-            sw += w;
-            sp += (P->p[j] + P->rho[j] * g * (P->z[j] - zi)) * w;
-        }
+        const uint32_t *rng = G->rng + 2 * CELLS_ROWS_AROUND * i; /* the rows of the neighbourhood */
+        for (size_t k = 0; k < 2 * CELLS_ROWS_AROUND; k += 2)
+            for (size_t j = rng[k]; j < rng[k + 1]; j++) {
+                if (P->state[j] != MIXSPH_STATE_MOBILE || media[P->medium[j]].law != LAW_MIXTURE_PAPER) continue;
+                double r2 = 0.0;
+                for (int d = 0; d < DIM; d++) r2 += (P->pos[d][i] - P->pos[d][j]) * (P->pos[d][i] - P->pos[d][j]);
+                if (r2 >= KW->r2max) continue;
+                const double w = kernel_w(KW, sqrt(r2));
+                sw += w;
+                sp += (P->p[j] + P->rho[j] * g * (P->pos[DIM_UP][j] - zi)) * w;
+            }
         if (sw > 0.0) {
             const double p = sp / sw;
             P->p[i] = media[P->medium[i]].tension_cutoff && p < pb ? pb : p;
@@ -294,9 +297,9 @@ static void mixture_region(void *arg, int tid, int nth)
      * final: the top is never frozen, and its extrapolation above is done) */
     for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_FIXED || !frozen(M, P, i)) continue;
-        const size_t top = (size_t)M->bed_ref[bed_column(M, P->x[i])];
+        const size_t top = (size_t)M->bed_ref[bed_column(M, P->pos[0][i])];
         const struct medium *m = &media[P->medium[i]];
-        double p = P->p[top] + media[P->medium[top]].rho0 * g * (P->z[top] - P->z[i]);
+        double p = P->p[top] + media[P->medium[top]].rho0 * g * (P->pos[DIM_UP][top] - P->pos[DIM_UP][i]);
         if (m->tension_cutoff && p < pb) p = pb;
         P->p[i] = p;
         P->rho[i] = eos_density(p - pb, m->rho0, m->c);

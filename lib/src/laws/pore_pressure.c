@@ -51,8 +51,8 @@ void pore_columns_tops(struct pore_columns *C, const struct particles *P, const 
         const struct medium *m = &media[P->medium[i]];
         const int fluid = m->law == LAW_NEWTONIAN;
         if (!fluid && !m->saturated) continue;
-        const size_t b = bin_of(C, P->x[i]);
-        const double top = P->z[i] + 0.5 * C->dx;
+        const size_t b = bin_of(C, P->pos[0][i]);
+        const double top = P->pos[DIM_UP][i] + 0.5 * C->dx;
         if (m->saturated && top > C->ztop[b]) C->ztop[b] = top;
         if (top > C->wet_top[b]) { /* ties: the first in memory order, whatever the threads */
             C->wet_top[b] = top;

@@ -15,15 +15,30 @@
 #define MIXSPH_RHEOLOGY_H
 #include <math.h>
 
+#include "dim.h"
+
 #define RHEOLOGY_II_MIN 1e-12 /* [1/s] below this strain rate the grains are at rest */
 
 enum rheology_regime { RHEOLOGY_FRICTIONAL = 0, RHEOLOGY_LIMITED = 1, RHEOLOGY_FIXED = 2 };
 
-/** sqrt(II_D) [1/s] of the 2D strain rate from the velocity gradient. */
-static inline double rheology_sqrt_ii(double dudx, double dudz, double dwdx, double dwdz)
+/** sqrt(II_D) [1/s] of the strain rate D = (L + L^T) / 2 from the velocity gradient
+ *  L[a DIM + b] = du_a/dx_b: II_D = D_ab D_ab / 2. */
+static inline double rheology_sqrt_ii(const double L[DIM * DIM])
 {
-    const double s = dudz + dwdx;
-    return sqrt(0.5 * dudx * dudx + 0.5 * dwdz * dwdz + 0.25 * s * s);
+#if DIM == 2
+    const double s = L[1] + L[2];
+    return sqrt(0.5 * L[0] * L[0] + 0.5 * L[3] * L[3] + 0.25 * s * s);
+#else
+    double ii = 0.0;
+    for (int a = 0; a < 3; a++) {
+        ii += 0.5 * L[4 * a] * L[4 * a];
+        for (int b = a + 1; b < 3; b++) {
+            const double s = L[3 * a + b] + L[3 * b + a];
+            ii += 0.25 * s * s;
+        }
+    }
+    return sqrt(ii);
+#endif
 }
 
 /** Effective stress sigma' [Pa] from the particle pressure p and the pore pressure p_w. */
