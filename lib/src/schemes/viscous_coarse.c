@@ -32,7 +32,7 @@ struct viscous_coarse {
     int32_t *nb;              /* per compact group: COARSE_NEIGHBOURS compact neighbours (n_active: none) */
     double *nw;               /* and their weights -A_c(I, J) / A_c(I, I) */
     double *inv_diag;         /* 1 / A_c(I, I) */
-    double *b[2], *e[2];      /* a restricted residual and its coarse correction (x, z; n_active + 1) */
+    double *b[DIM], *e[DIM];  /* a restricted residual and its coarse correction (per component; n_active + 1) */
     size_t n_active, cap_size, cap_particles, cap_active;
 };
 
@@ -41,9 +41,12 @@ struct viscous_coarse *viscous_coarse_create(void) { return calloc(1, sizeof(str
 void viscous_coarse_free(struct viscous_coarse *K)
 {
     if (!K) return;
-    void *arrays[] = {K->group, K->w,  K->compact,  K->entry, K->first, K->last, K->nb,
-                      K->nw,    K->inv_diag, K->b[0], K->b[1], K->e[0], K->e[1]};
+    void *arrays[] = {K->group, K->w, K->compact, K->entry, K->first, K->last, K->nb, K->nw, K->inv_diag};
     for (size_t k = 0; k < sizeof arrays / sizeof arrays[0]; k++) free(arrays[k]);
+    for (int d = 0; d < DIM; d++) {
+        free(K->b[d]);
+        free(K->e[d]);
+    }
     free(K);
 }
 
@@ -79,7 +82,7 @@ static int reserve(struct viscous_coarse *K, size_t n, size_t size)
             grow((void **)&K->nw, COARSE_NEIGHBOURS * cap, sizeof(double)) ||
             grow((void **)&K->inv_diag, cap, sizeof(double)))
             return -1;
-        for (int k = 0; k < 2; k++)
+        for (int k = 0; k < DIM; k++)
             if (grow((void **)&K->b[k], cap, sizeof(double)) || grow((void **)&K->e[k], cap, sizeof(double)))
                 return -1;
         K->cap_active = cap;
@@ -130,7 +133,7 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
         }
     for (size_t i = n; i < n + FORCES_PAD; i++) K->group[i] = -1;
     if (forces_viscous_group_couplings(F, S, K->group, K->stride, K->w) != 0) return -1;
-    K->e[0][K->n_active] = K->e[1][K->n_active] = 0.0; /* the "no neighbour" entry */
+    for (int d = 0; d < DIM; d++) K->e[d][K->n_active] = 0.0; /* the "no neighbour" entry */
     return 0;
 #endif
 }
@@ -140,19 +143,17 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
  *   A_c(I, J) = -kappa sum_{i in I, j in J} w_ij,
  * the couplings to prescribed particles and walls kept in the diagonal as if those were at rest
  * (the walls' mirror is left out: this only preconditions). */
-/* The arguments of a parallel loop of this file (core/team.h). */
-struct coarse_loop {
+/* The coarse operator's loop over the groups (core/team.h). */
+struct coarse_operator_loop {
     struct viscous_coarse *K;
-    const double *minv;
+    const double *minv;           /* the Jacobi diagonal's inverse */
     const unsigned char *unknown;
     double kappa;
-    const double *in_x, *in_z;
-    double *out_x, *out_z;
 };
 
 static void operator_range(void *arg, size_t a0, size_t a1)
 {
-    const struct coarse_loop *L = arg;
+    const struct coarse_operator_loop *L = arg;
     struct viscous_coarse *K = L->K;
     const double *minv = L->minv;
     const unsigned char *unknown = L->unknown;
@@ -182,7 +183,7 @@ static void operator_range(void *arg, size_t a0, size_t a1)
 void viscous_coarse_operator(struct viscous_coarse *K, const double *minv, const unsigned char *unknown,
                              double kappa, int threads)
 {
-    struct coarse_loop L = {.K = K, .minv = minv, .unknown = unknown, .kappa = kappa};
+    struct coarse_operator_loop L = {.K = K, .minv = minv, .unknown = unknown, .kappa = kappa};
     team_for(threads, K->n_active, operator_range, &L);
 }
 
@@ -201,41 +202,44 @@ static void sweep(const struct viscous_coarse *K, const double *restrict b, doub
         }
 }
 
-/* P^T sums a group's rows; the two components' sweeps (sequential each) run side by side. */
+/* The correction's region (core/team.h): out += P A_c^-1 P^T in, per component. */
+struct coarse_correct_region {
+    struct viscous_coarse *K;
+    const unsigned char *unknown;
+    const double *const *in; /* DIM components */
+    double *const *out;
+};
+
+/* P^T sums a group's rows; the components' sweeps (sequential each) run side by side. */
 static void correct_region(void *arg, int tid, int nth)
 {
-    const struct coarse_loop *L = arg;
+    const struct coarse_correct_region *L = arg;
     struct viscous_coarse *K = L->K;
     const unsigned char *unknown = L->unknown;
     size_t a0, a1;
     team_share(K->n_active, tid, nth, &a0, &a1);
-    for (size_t a = a0; a < a1; a++) {
-        double sx = 0.0, sz = 0.0;
-        for (size_t i = K->first[a]; i < K->last[a]; i++) {
-            sx += L->in_x[i];
-            sz += L->in_z[i];
+    for (size_t a = a0; a < a1; a++)
+        for (int d = 0; d < DIM; d++) {
+            double s = 0.0;
+            for (size_t i = K->first[a]; i < K->last[a]; i++) s += L->in[d][i];
+            K->b[d][a] = s;
+            K->e[d][a] = 0.0;
         }
-        K->b[0][a] = sx;
-        K->b[1][a] = sz;
-        K->e[0][a] = K->e[1][a] = 0.0;
-    }
     team_barrier();
-    for (int comp = tid; comp < 2; comp += nth)
+    for (int comp = tid; comp < DIM; comp += nth)
         for (int k = 0; k < COARSE_SWEEPS; k++) sweep(K, K->b[comp], K->e[comp]);
     team_barrier();
-    for (size_t a = a0; a < a1; a++) {
-        const double ex = K->e[0][a], ez = K->e[1][a];
-        for (size_t i = K->first[a]; i < K->last[a]; i++)
-            if (unknown[i]) {
-                L->out_x[i] += ex;
-                L->out_z[i] += ez;
-            }
-    }
+    for (size_t a = a0; a < a1; a++)
+        for (int d = 0; d < DIM; d++) {
+            const double e = K->e[d][a];
+            for (size_t i = K->first[a]; i < K->last[a]; i++)
+                if (unknown[i]) L->out[d][i] += e;
+        }
 }
 
-void viscous_coarse_correct(struct viscous_coarse *K, const unsigned char *unknown, const double *in_x,
-                            const double *in_z, double *out_x, double *out_z, int threads)
+void viscous_coarse_correct(struct viscous_coarse *K, const unsigned char *unknown, const double *const in[DIM],
+                            double *const out[DIM], int threads)
 {
-    struct coarse_loop L = {.K = K, .unknown = unknown, .in_x = in_x, .in_z = in_z, .out_x = out_x, .out_z = out_z};
+    struct coarse_correct_region L = {.K = K, .unknown = unknown, .in = in, .out = out};
     team_run(threads, correct_region, &L);
 }

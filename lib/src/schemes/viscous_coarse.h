@@ -32,8 +32,8 @@ int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const
 void viscous_coarse_operator(struct viscous_coarse *K, const double *minv, const unsigned char *unknown,
                              double kappa, int threads);
 
-/** (out_x, out_z) += P A_c^-1 P^T (in_x, in_z) on the unknown rows (in zero on the others). */
-void viscous_coarse_correct(struct viscous_coarse *K, const unsigned char *unknown, const double *in_x,
-                            const double *in_z, double *out_x, double *out_z, int threads);
+/** out += P A_c^-1 P^T in (DIM components each) on the unknown rows (in zero on the others). */
+void viscous_coarse_correct(struct viscous_coarse *K, const unsigned char *unknown, const double *const in[DIM],
+                            double *const out[DIM], int threads);
 
 #endif
