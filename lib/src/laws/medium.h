@@ -22,7 +22,7 @@ enum law_id {
 /* What a law asks of the step (bits of struct medium's `features`, copied from its law). */
 enum law_feature {
     LAW_USES_GRADIENT = 1u, /* the velocity gradient of its particles is gathered every step */
-    LAW_HAS_STRESS = 2u,    /* its particles carry a deviatoric stress (P->sxx, sxz, szz, syy) */
+    LAW_HAS_STRESS = 2u,    /* its particles carry a deviatoric stress (P->stress) */
     LAW_CAPS_TENSION = 4u,  /* its update bounds the tension the equation of state gives (a yield surface's
                                apex), so a density below rho0 is its grains parting, not a blow-up */
     LAW_DENSITY_DIFFUSION = 8u, /* its particles take the continuity pass's density diffusion (a fluid: a

@@ -45,8 +45,8 @@ void viscous_free(struct viscous_solver *V);
  *  walls' mirror (M, rebuilt here at the current positions; the walls W) at
  *  the stage's time, warm-started from its increments of the last two steps. unknown[i] != 0:
  *  particle i's velocity is solved for; the others (walls aside) are prescribed at theirs.
- *  Updates P->vx, P->vz of the unknowns, the increments (visc_dv*, visc_d1* and those of the step
- *  before) and the wall particles' uvx, uvz. The report sums the two stages' iterations and keeps
+ *  Updates P->vel of the unknowns, the increments (visc_dv, visc_d1 and those of the step
+ *  before) and the wall particles' P->uv. The report sums the two stages' iterations and keeps
  *  the larger residual; a stage stops at ||r|| <= tolerance ||b|| or after max_iterations (vp).
  *  Returns -1 when out of memory, 0 otherwise (convergence is in the report). */
 int viscous_step(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
@@ -60,9 +60,9 @@ int viscous_solution_operator(struct viscous_solver *V, const struct forces *F, 
                               const double *lu[DIM]);
 
 /** One backward-Euler solve, (m + dt L) u = m u* - dt L u_B, for the velocities of the
- *  particles mobile or held (P->vx, P->vz: u* in, u out; P->visc_dvx, visc_dvz: the warm start in, the
+ *  particles mobile or held (P->vel: u* in, u out; P->visc_dv: the warm start in, the
  *  increment out) after forces_momentum stored the couplings, with the walls' mirror M as
- *  built and timed by the caller (NULL: the walls keep uvx, uvz) and the preconditioner of enum
+ *  built and timed by the caller (NULL: the walls keep P->uv) and the preconditioner of enum
  *  viscous_preconditioner; tests of the solver. */
 int viscous_solve(struct viscous_solver *V, const struct forces *F, const struct pair_system *S,
                   const struct wall_mirror *M, double dt, int preconditioner, double tolerance, int max_iterations,
