@@ -61,17 +61,24 @@ static inline void trim(double *const x[DIM], size_t i, double rc2, size_t *b, s
     *e = hi;
 }
 
-/* The arguments of a parallel loop of this file (core/team.h). */
+/* The arguments of the parallel loops of this file (core/team.h): the lists' build and the
+ * gather lists' build share one (NB or the gather it builds, the grid, the squared cut-off), the
+ * displacement check has its own. */
 struct nb_loop {
-    struct neighbours *NB;
-    const struct neighbours *cNB;
+    struct neighbours *NB;        /* the lists being built (relist) */
+    const struct neighbours *cNB; /* their build positions (gather lists) */
     struct gather *G;
     const struct cells *C;
-    const struct particles *P;
     const uint8_t *state;
-    double rc2;
-    double m;  /* max */
-    int out;   /* | */
+    double rc2;                   /* squared cut-off [m2] */
+};
+
+struct shift_loop {
+    const struct neighbours *NB;
+    const struct cells *C;
+    const struct particles *P;
+    double shift2_max; /* max squared displacement since the build [m2] */
+    int outside;       /* | a particle left the grid */
 };
 
 static void relist_range(void *arg, size_t b, size_t e)
@@ -109,8 +116,8 @@ int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, do
 
 static void shift_range(void *arg, size_t b, size_t e)
 {
-    struct nb_loop *L = arg;
-    const struct neighbours *NB = L->cNB;
+    struct shift_loop *L = arg;
+    const struct neighbours *NB = L->NB;
     const struct cells *C = L->C;
     const struct particles *P = L->P;
     double m = 0.0;
@@ -129,17 +136,17 @@ static void shift_range(void *arg, size_t b, size_t e)
         }
         m = d2 > m ? d2 : m;
     }
-    team_max_double(&L->m, m);
-    team_or_int(&L->out, out);
+    team_max_double(&L->shift2_max, m);
+    team_or_int(&L->outside, out);
 }
 
 double neighbours_max_shift2(const struct neighbours *NB, const struct cells *C, const struct particles *P, size_t n,
                              int *outside, int n_threads)
 {
-    struct nb_loop L = {.cNB = NB, .C = C, .P = P};
+    struct shift_loop L = {.NB = NB, .C = C, .P = P};
     team_for(n_threads > 0 ? n_threads : 1, n, shift_range, &L);
-    *outside = L.out;
-    return L.m;
+    *outside = L.outside;
+    return L.shift2_max;
 }
 
 void neighbours_gather_free(struct gather *G)
