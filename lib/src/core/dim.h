@@ -42,6 +42,11 @@ static inline int sym_index(int a, int b)
     return DIM == 3 ? sym_index3(a, b) : sym_index3(a == 1 ? 2 : a, b == 1 ? 2 : b);
 }
 
+/* Before a loop over components inside a vectorised (omp simd) loop: unroll it completely, so
+ * that the vectoriser sees straight-line code (a nested component loop left rolled, such as the
+ * triangle of a symmetric tensor, stops the vectorisation: "multiple nested loops"). */
+#define DIM_UNROLL _Pragma("GCC unroll 16")
+
 /* The axis letters of component d, for file columns ("x", "z" in 2D; "x", "y", "z" in 3D). */
 #if DIM == 2
 #define DIM_AXES "xz"

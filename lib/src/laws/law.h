@@ -7,7 +7,8 @@
  * deviatoric stress (P->stress), whose divergence the momentum pass adds in one symmetric pair
  * term (passes/forces.c). What else it asks of the step it declares as data: its feature bits
  * (enum law_feature, medium.h) and, for a law that holds particles, how a held particle is
- * integrated (held_kicked, held_viscosity); the step reads these and never a law's id. Adding a
+ * integrated (struct medium's held_takes_kicks, held_viscosity, set by its finish); the step reads
+ * these and never a law's id. Adding a
  * law: its module, one line in law_registry.c, an entry in enum law_id (medium.h) and its tests
  * (docs/development.md). */
 #ifndef MIXSPH_LAW_H
@@ -91,13 +92,6 @@ struct material_law {
     /** The per-step update of its particles; returns the particles it holds fixed (a law with
      *  LAW_HOLDS_PARTICLES), 0 otherwise. */
     long (*update)(void *state, const struct law_step *step);
-    /** With LAW_HOLDS_PARTICLES: whether a held particle takes the kicks of its forces (it is
-     *  never drifted); `rigid`: the implicit scheme holds such particles at rest through its
-     *  viscous step (numerics.held_grains = "rigid"). */
-    int (*held_kicked)(const struct medium *m, int rigid);
-    /** With LAW_HOLDS_PARTICLES: the viscosity [Pa s] a held particle enters the explicit viscous
-     *  bound of the time step (4) with. */
-    double (*held_viscosity)(const struct medium *m);
 };
 
 #endif

@@ -14,18 +14,6 @@ static const struct material_law *const laws[LAW_COUNT] = {
 
 const struct material_law *law_get(int id) { return id >= 0 && id < LAW_COUNT ? laws[id] : NULL; }
 
-int law_held_kicked(const struct medium *m, int rigid)
-{
-    const struct material_law *law = laws[m->law];
-    return law->held_kicked ? law->held_kicked(m, rigid) : 1;
-}
-
-double law_held_viscosity(const struct medium *m)
-{
-    const struct material_law *law = laws[m->law];
-    return law->held_viscosity ? law->held_viscosity(m) : law->viscosity_bound(m);
-}
-
 double law_max_wave_speed(const struct medium *media, size_t n_media)
 {
     double c = 0.0;

@@ -31,13 +31,19 @@ enum law_feature {
     LAW_WALL_FRICTION = 16u,    /* no-slip walls bound the shear they give its particles by their friction
                                    (docs/model.md [DP-W]; with LAW_HAS_STRESS) */
     LAW_HOLDS_PARTICLES = 32u   /* its update holds particles fixed (MIXSPH_STATE_FIXED) and returns how
-                                   many; the law says how a held particle is integrated (law.h) */
+                                   many; its finish says how a held particle is integrated (struct
+                                   medium's held_takes_kicks, held_viscosity) */
 };
 
 struct medium {
     char name[MEDIUM_NAME_LEN];
     int law;           /* enum law_id */
     unsigned features; /* enum law_feature bits of its law */
+    /* how the schemes integrate a particle its law holds fixed (LAW_HOLDS_PARTICLES; set by the
+     * law's finish): whether it takes the kicks of its forces (it is never drifted), and the
+     * viscosity [Pa s] it enters the explicit viscous bound of the time step (4) with */
+    int held_takes_kicks;
+    double held_viscosity;
     double rho0;       /* reference density [kg/m3]; granular: the mixture density (5) */
     double c;          /* sound speed of the equation of state [m/s]; granular: sqrt(K_s / rho_s) */
     double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
@@ -67,6 +73,10 @@ struct medium {
     double dilatancy_deg;  /* psi [deg] */
     double alpha_phi, k_c, alpha_psi; /* the plane-strain matched Drucker-Prager cone (drucker_prager.h) */
 };
+
+/** Whether a held particle of medium m takes the kicks of its forces; `rigid`: the implicit scheme
+ *  holds every held particle at rest through its viscous step (numerics.held_grains = "rigid"). */
+static inline int medium_held_kicked(const struct medium *m, int rigid) { return !rigid && m->held_takes_kicks; }
 
 /** Whether a medium's pressure follows its equation of state into tension without bound (no
  *  tension_cutoff, no law that caps it): in such a medium a density far below rho0 means the

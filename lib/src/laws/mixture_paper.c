@@ -121,6 +121,8 @@ static mixsph_status granular_finish(struct medium *md, const struct law_finish_
         return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1)", ctx->origin, ctx->path);
     }
     md->mu = 0.0; /* set by the rheology */
+    md->held_takes_kicks = mixture_paper_held_grain_kicked(md, 0);
+    md->held_viscosity = mixture_paper_held_viscosity(md);
     return MIXSPH_OK;
 }
 
@@ -330,6 +332,4 @@ const struct material_law law_mixture_paper = {
     .create = mixture_create,
     .destroy = mixture_free,
     .update = mixture_update,
-    .held_kicked = mixture_paper_held_grain_kicked,
-    .held_viscosity = mixture_paper_held_viscosity,
 };

@@ -210,6 +210,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const double ti = P->tag[i], voli = P->vol[i], rhoi = P->rho[i];
     double xi[DIM], vi[DIM];
     const double *restrict x[DIM], *restrict v[DIM];
+    DIM_UNROLL
     for (int d = 0; d < DIM; d++) {
         xi[d] = P->pos[d][i];
         vi[d] = P->vel[d][i];
@@ -227,11 +228,13 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             const size_t j = jb + k;
             const double in = FORCES_LANE_IN(k, m);
             double r[DIM], r2 = 0.0, uf = 0.0;
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 r[d] = xi[d] - x[d][j];
                 r2 += r[d] * r[d];
             }
             const double F = pair_f(&Xl, r2, wendland) * in;
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) uf += (vi[d] - v[d][j]) * r[d];
             uf *= F;
             const double c = (r2 < Xl.K.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
@@ -285,6 +288,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             double r[DIM], r2 = 0.0;
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 r[d] = xi[d] - x[d][j];
                 r2 += r[d] * r[d];
@@ -333,15 +337,21 @@ FORCES_INLINE void gradient_range(const struct pair_ctx *X, const struct particl
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             double r[DIM], r2 = 0.0, du[DIM];
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 r[d] = xi[d] - x[d][j];
                 r2 += r[d] * r[d];
             }
             const double vf = vol[j] * pair_f(&Xl, r2, wendland) * FORCES_LANE_IN(k, m);
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) du[d] = (uv[d][j] - ui[d]) * vf;
+            DIM_UNROLL
             for (int c = 0; c < DIM; c++)
+                DIM_UNROLL
                 for (int d = 0; d < DIM; d++) a[c * DIM + d][k] += du[c] * r[d];
+            DIM_UNROLL
             for (int c = 0; c < DIM; c++)
+                DIM_UNROLL
                 for (int d = c; d < DIM; d++) a[DIM * DIM + velocity_gradient_l_index(c, d)][k] -= vf * r[c] * r[d];
         }
     }
@@ -422,6 +432,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const size_t j = jb + k;
             const double in = FORCES_LANE_IN(k, n);
             double r[DIM], r2 = 0.0;
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 r[d] = xi[d] - x[d][j];
                 r2 += r[d] * r[d];
@@ -442,6 +453,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
             double vdotr = 0.0;
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) vdotr += (vi[d] - v[d][j]) * r[d];
             vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
             const double same = (tag[j] == ti ? 1.0 : 0.0) + Xl.av_mixed * (1.0 - walli - wallj) + Xl.av_wall * (walli + wallj) > 0.0 ? 1.0 : 0.0;
@@ -457,8 +469,10 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             double f[DIM];
             if (implicit) {
                 wl[k] = -F * fv;
+                DIM_UNROLL
                 for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d]);
             } else {
+                DIM_UNROLL
                 for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d] + fv * (uvi[d] - uv[d][j]));
             }
             if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W. A wall holds none of
@@ -479,14 +493,19 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 t[SYM_ZZ] = vv * (ci * si[SYM_ZZ] + cj * sg[SYM_ZZ][j] - d_normal);
 #else
                 double nj[3], sj[SYM_N], mi_[SYM_N], mj_[SYM_N];
+                DIM_UNROLL
                 for (int d = 0; d < 3; d++) nj[d] = wall_n[d][j];
+                DIM_UNROLL
                 for (int c = 0; c < SYM_N; c++) sj[c] = sg[c][j];
                 wall_mirror_change(nj, si, mi_); /* i's stress as wall particle j takes it */
                 wall_mirror_change(ni, sj, mj_); /* j's as wall particle i takes it */
+                DIM_UNROLL
                 for (int c = 0; c < SYM_N; c++) t[c] = vv * (ci * si[c] + cj * sj[c] + mi_[c] + mj_[c]);
 #endif
+                DIM_UNROLL
                 for (int a = 0; a < DIM; a++) {
                     double tr = 0.0;
+                    DIM_UNROLL
                     for (int b = 0; b < DIM; b++) tr += t[sym_index(a, b)] * r[b];
                     f[a] += F * tr;
                 }
@@ -495,6 +514,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 const double to_i = wall_rough[j] * (1.0 - walli), to_j = roughi * (1.0 - wallj);
                 const double mu_gj = wall_mu[j] >= 0.0 ? 1.0 : 0.0, mu_gi = mu_wi >= 0.0 ? 1.0 : 0.0;
                 const double qi = -vol[j] * F * to_i, qj = -voli * F * to_j;
+                DIM_UNROLL
                 for (int d = 0; d < DIM; d++) {
                     ws[WALL_F + d][k] += to_i * f[d];
                     ws[WALL_N + d][k] += qi * r[d];
@@ -508,6 +528,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 wj[WALL_QMU_GIVEN][k] = qj * mu_gi * mu_wi;
                 wj[WALL_Q_OWN][k] = qj * (1.0 - mu_gi);
             }
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 sf[d][k] += f[d];
                 fj[d][k] = -f[d]; /* forces: divided by the masses once, after the pass */
@@ -620,6 +641,7 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
             const size_t j = jb + k;
             const double w = wl[k];
+            DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
                 const double du = w * (ui[d] - u[d][j]);
                 so[d][k] += du;

@@ -54,14 +54,14 @@ static inline double particle_time_step(const mixsph_sim *s, size_t i, int impli
     const double u = sqrt(u2);
     double mu = implicit ? 0.0 : P->mu[i];
     if (!implicit && P->state[i] == MIXSPH_STATE_FIXED) /* the viscosity it will have once mobilised */
-        mu = law_held_viscosity(&s->scheme.media[P->medium[i]]);
+        mu = s->scheme.media[P->medium[i]].held_viscosity;
     return time_step_bound(s->scheme.cfl, s->scheme.cfl_visc, s->phys.h, s->phys.c_max, u, P->rho[i], mu);
 }
 
-/* Whether held particle i (MIXSPH_STATE_FIXED) takes the kicks of its forces (laws/law.h). */
+/* Whether held particle i (MIXSPH_STATE_FIXED) takes the kicks of its forces (laws/medium.h). */
 static inline int held_kicked(const mixsph_sim *s, size_t i, int rigid)
 {
-    return law_held_kicked(&s->scheme.media[s->phys.P.medium[i]], rigid);
+    return medium_held_kicked(&s->scheme.media[s->phys.P.medium[i]], rigid);
 }
 
 /* The parallel loops of this file (core/team.h) each take their own arguments; their reductions
