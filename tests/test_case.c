@@ -650,8 +650,8 @@ static void test_table_defaults(void **state)
     assert_true(c.monitors[0].x_min == -INFINITY && c.monitors[0].z_max == INFINITY);
     const struct medium *sand = &c.media[1];
     assert_int_equal(sand->law, LAW_MIXTURE_PAPER);
-    assert_true(sand->mu0 == INFINITY && sand->alpha_m == 0.0);
-    assert_true(sand->saturated == 0 && sand->tension_cutoff == 0 && sand->hold_fixed == 0 && sand->pore_fluid == -1);
+    assert_true(sand->paper.mu0 == INFINITY && sand->alpha_m == 0.0);
+    assert_true(sand->granular.saturated == 0 && sand->tension_cutoff == 0 && sand->paper.hold_fixed == 0 && sand->granular.pore_fluid == -1);
     assert_true(sand->rho0 == (1.0 - 0.35) * 2650.0);
     case_free(&c);
     /* the front's direction and a full_scale unit */
@@ -702,14 +702,14 @@ static void test_granular_law_by_number(void **state)
     free(j);
     const struct medium *m = &c.media[1];
     assert_int_equal(m->law, LAW_ELASTIC_PLASTIC);
-    assert_true(m->poisson == 0.25 && m->cohesion == 10.0);
-    assert_true(m->mu_thr == 0.0 && m->mu0 == 0.0 && m->tension_cutoff == 0); /* the paper's keys: not used */
+    assert_true(m->elastic.poisson == 0.25 && m->dp.cohesion == 10.0);
+    assert_true(m->paper.mu_thr == 0.0 && m->paper.mu0 == 0.0 && m->tension_cutoff == 0); /* the paper's keys: not used */
     case_free(&c);
     j = with_sand(", \"law\": 0, \"nu\": 0.25, \"cohesion\": 10.0");
     assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
     m = &c.media[1];
     assert_int_equal(m->law, LAW_MIXTURE_PAPER);
-    assert_true(m->mu_thr == 320e3 && m->poisson == 0.0 && m->cohesion == 0.0);
+    assert_true(m->paper.mu_thr == 320e3 && m->elastic.poisson == 0.0 && m->dp.cohesion == 0.0);
     case_free(&c);
     /* an override of the number chooses the other law */
     const mixsph_override to_ep = {"media.sand.law", 1.0};

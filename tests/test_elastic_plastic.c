@@ -55,11 +55,11 @@ static void test_keys(void **state)
     /* references: rho0 = (1 - n) rho_s (5); K = rho0 c^2 with c = sqrt(K_s / rho_s); G from nu = 0.3 */
     const double rho0 = 0.65 * 2650.0, K = rho0 * 4.24e6 / 2650.0;
     assert_true(fabs(m->rho0 / rho0 - 1.0) < 1e-14 && fabs(m->bulk_modulus / K - 1.0) < 1e-14);
-    assert_true(fabs(m->shear_modulus / (3.0 * K * 0.4 / 2.6) - 1.0) < 1e-14);
+    assert_true(fabs(m->elastic.shear_modulus / (3.0 * K * 0.4 / 2.6) - 1.0) < 1e-14);
     /* psi = 0: alpha_phi = sin(phi) / 3 (drucker_prager.h) */
-    assert_true(fabs(m->alpha_phi - sin(35.0 * GEOM_PI / 180.0) / 3.0) < 1e-15);
+    assert_true(fabs(m->dp.alpha_phi - sin(35.0 * GEOM_PI / 180.0) / 3.0) < 1e-15);
     /* the dissipation [DP-AV]: alpha_M c = c_p, the P-wave speed */
-    assert_true(fabs(m->alpha_m * m->c / sqrt((K + 4.0 / 3.0 * m->shear_modulus) / rho0) - 1.0) < 1e-14);
+    assert_true(fabs(m->alpha_m * m->c / sqrt((K + 4.0 / 3.0 * m->elastic.shear_modulus) / rho0) - 1.0) < 1e-14);
     mixsph_sim_destroy(s);
     /* refused: saturated without a pore fluid, a dilatancy, a paper-law key, the artificial
      * viscosity (a fixed numerical parameter of the law, not a case key) */

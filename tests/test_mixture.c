@@ -107,11 +107,11 @@ static void test_parse_dry(void **state)
     assert_int_equal(m->law, LAW_MIXTURE_PAPER);
     assert_rel(m->rho0, (1.0 - POR) * RHO_S, 1e-15);   /* (5), dry: (1 - n) rho_s = 1722.5 */
     assert_rel(m->c, sqrt(K_S / RHO_S), 1e-15);         /* sqrt(K_s / rho_s) = 40 m/s, not of the mixture */
-    assert_rel(m->sin_phi, sin(PHI * GEOM_PI / 180.0), 1e-15);
-    assert_true(m->eps_f_mu_f == 0.0);                  /* no pore fluid */
-    assert_int_equal(m->saturated, 0);
-    assert_true(m->mu_thr == MU_THR && m->mu0 == MU0);
-    assert_int_equal(m->mu1_mode, 0);
+    assert_rel(m->granular.sin_phi, sin(PHI * GEOM_PI / 180.0), 1e-15);
+    assert_true(m->paper.eps_f_mu_f == 0.0);                  /* no pore fluid */
+    assert_int_equal(m->granular.saturated, 0);
+    assert_true(m->paper.mu_thr == MU_THR && m->paper.mu0 == MU0);
+    assert_int_equal(m->paper.mu1_mode, 0);
     /* particles: 40 x 10 grains at the mixture density (hydrostatic p / c^2 <= 1.7 kg/m3 above it) */
     assert_int_equal(mixsph_sim_particles(s), 400);
     for (size_t i = 0; i < s->phys.P.n; i++) {
@@ -123,7 +123,7 @@ static void test_parse_dry(void **state)
     /* no mu0: no limit (+inf) */
     s = create_ok("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"c\": 40.0, \"porosity\": 0.35, \"phi\": 35.0, "
                   "\"mu_thr\": 20e3 }");
-    assert_true(isinf(s->cfg.media[0].mu0) && s->cfg.media[0].mu_thr == 20e3);
+    assert_true(isinf(s->cfg.media[0].paper.mu0) && s->cfg.media[0].paper.mu_thr == 20e3);
     assert_rel(s->cfg.media[0].c, 40.0, 1e-15);
     mixsph_sim_destroy(s);
 }
@@ -134,11 +134,11 @@ static void test_parse_saturated(void **state)
     mixsph_sim *s = create_ok(WATER ", " WET_SAND);
     const struct medium *m = &s->cfg.media[1];
     assert_int_equal(m->law, LAW_MIXTURE_PAPER);
-    assert_int_equal(m->saturated, 1);
-    assert_int_equal(m->pore_fluid, 0);
+    assert_int_equal(m->granular.saturated, 1);
+    assert_int_equal(m->granular.pore_fluid, 0);
     assert_rel(m->rho0, POR * 1000.0 + (1.0 - POR) * RHO_S, 1e-15); /* (5), saturated: 2072.5 kg/m3 */
-    assert_true(m->rho_f == 1000.0);
-    assert_rel(m->eps_f_mu_f, POR * 1.0e-3, 1e-15);                 /* eps_f mu_f of (12) */
+    assert_true(m->granular.rho_f == 1000.0);
+    assert_rel(m->paper.eps_f_mu_f, POR * 1.0e-3, 1e-15);                 /* eps_f mu_f of (12) */
     assert_rel(m->c, 40.0, 1e-15);                                  /* sqrt(K_s / rho_s) */
     mixsph_sim_destroy(s);
 }
@@ -150,8 +150,8 @@ static void test_parse_mu1(void **state)
     mixsph_sim *s = create_ok("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, "
                               "\"phi\": 35.0, \"mu1\": 5e3 }");
     const struct medium *m = &s->cfg.media[0];
-    assert_int_equal(m->mu1_mode, 1);
-    assert_true(m->mu_thr == 5e3 && isinf(m->mu0));
+    assert_int_equal(m->paper.mu1_mode, 1);
+    assert_true(m->paper.mu_thr == 5e3 && isinf(m->paper.mu0));
     /* at rest every grain is held fixed with mu = mu1 */
     assert_int_equal(s->phys.n_fixed, 400);
     for (size_t i = 0; i < s->phys.P.n; i++)
@@ -229,10 +229,10 @@ static struct counts check_regimes(const mixsph_sim *s, double G, const double *
         double sig = p0[i] - (pw ? pw[i] : 0.0);
         sig = sig > 0.0 ? sig : 0.0;
         /* G = 0: sqrt(II_D) = 0 < 1e-12, mu_app is taken as mu_thr */
-        const double app = G > 0.0 ? m->eps_f_mu_f + sig * m->sin_phi / G : m->mu_thr;
-        if (app >= m->mu_thr) {
+        const double app = G > 0.0 ? m->paper.eps_f_mu_f + sig * m->granular.sin_phi / G : m->paper.mu_thr;
+        if (app >= m->paper.mu_thr) {
             assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
-            assert_true(P->mu[i] == m->mu_thr);
+            assert_true(P->mu[i] == m->paper.mu_thr);
             assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->uvx[i] == 0.0 && P->uvz[i] == 0.0); /* held */
             c.fixed++;
             continue;
@@ -240,8 +240,8 @@ static struct counts check_regimes(const mixsph_sim *s, double G, const double *
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE);
         assert_true(P->vx[i] == G * P->z[i] && P->vz[i] == 0.0); /* a mobile grain keeps its velocity */
         assert_true(P->p[i] == p0[i]);        /* and its pressure */
-        if (app > m->mu0) {
-            assert_true(P->mu[i] == m->mu0);
+        if (app > m->paper.mu0) {
+            assert_true(P->mu[i] == m->paper.mu0);
             c.limited++;
         } else {
             /* tolerance: the corrected gradient reproduces u = G z up to round-off */
@@ -395,11 +395,11 @@ static void test_pore_pressure(void **state)
     for (int k = 9; k >= 0; k--) {
         for (size_t i = 0; i < P->n; i++) {
             if (!is_grain(s, i) || fabs(P->x[i] - 0.205) > 1e-9 || fabs(P->z[i] - (k + 0.5) * DX) > 1e-9) continue;
-            if (P->mu[i] == m->mu0) {
+            if (P->mu[i] == m->paper.mu0) {
                 print_message("  %.3f  %8.2f  %8.2f     (limited: mu = mu0)\n", P->z[i], p0[i], pw[i]);
                 continue;
             }
-            const double sig = (P->mu[i] - m->eps_f_mu_f) * 0.1 / m->sin_phi;
+            const double sig = (P->mu[i] - m->paper.eps_f_mu_f) * 0.1 / m->granular.sin_phi;
             print_message("  %.3f  %8.2f  %8.2f     %8.2f               %8.2f\n", P->z[i], p0[i], pw[i], sig,
                           (m->rho0 - 1000.0) * G_ACC * (ztop - P->z[i]));
         }
@@ -472,7 +472,7 @@ static void check_hold(const char *media, int hold)
 {
     mixsph_sim *s = create_ok(media);
     struct particles *P = &s->phys.P;
-    assert_int_equal(s->cfg.media[0].hold_fixed, hold);
+    assert_int_equal(s->cfg.media[0].paper.hold_fixed, hold);
     assert_int_equal(s->phys.n_fixed, 400);
     double *x0 = calloc(P->n, sizeof *x0), *z0 = calloc(P->n, sizeof *z0);
     assert_true(x0 && z0);
@@ -635,7 +635,7 @@ static void test_fixed_bed(void **state)
         if (P->x[i] < 0.1) assert_true(high);
         if (P->z[i] < P->z[k] - two_h) {
             assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
-            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->mu[i] == m->mu_thr);
+            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->mu[i] == m->paper.mu_thr);
             const double p = P->p[k] + m->rho0 * G_ACC * (P->z[k] - P->z[i]);
             assert_rel(P->p[i], p, REL);
             assert_rel(P->rho[i], m->rho0 + p / (m->c * m->c), 1e-12);

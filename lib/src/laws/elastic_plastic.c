@@ -33,25 +33,25 @@ static const struct case_key elastic_plastic_keys[] = {
      .meaning = "\"elastic_plastic\" (this table): Drucker-Prager, experimental; chosen by its number (a case "
                 "parameter), the medium may hold the paper law's keys too (above)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
-     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
+     .field = CASE_FIELD(medium, granular.rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
      .unit = "Pa", .field = CASE_FIELD(medium, bulk_modulus),
      .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s); the law's bulk modulus is ρ0 c²"},
     {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e5, 0),
      .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
     {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 0.95, 0), .unit = "-",
-     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n: the mixture density (5)"},
+     .field = CASE_FIELD(medium, granular.porosity), .meaning = "porosity n: the mixture density (5)"},
     {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 89, 0), .unit = "deg",
-     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
+     .field = CASE_FIELD(medium, granular.phi_deg), .meaning = "angle of internal friction φ"},
     {.key = "cohesion", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 1e9, 0), SCHEMA_DEF(0), .unit = "Pa",
-     .field = CASE_FIELD(medium, cohesion), .meaning = "cohesion c of the cone"},
+     .field = CASE_FIELD(medium, dp.cohesion), .meaning = "cohesion c of the cone"},
     {.key = "dilatancy", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 0, 0), SCHEMA_DEF(0), .unit = "deg",
-     .field = CASE_FIELD(medium, dilatancy_deg),
+     .field = CASE_FIELD(medium, dp.dilatancy_deg),
      .meaning = "dilatancy angle ψ (0 only: a dilating return changes the pressure, which the equation of state "
                 "would undo)"},
     {.key = "nu", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 0.49, 0), SCHEMA_DEF(0.3), .unit = "-",
-     .field = CASE_FIELD(medium, poisson), .meaning = "Poisson's ratio: G = 3K(1−2ν)/(2(1+ν))"},
-    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
+     .field = CASE_FIELD(medium, elastic.poisson), .meaning = "Poisson's ratio: G = 3K(1−2ν)/(2(1+ν))"},
+    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, granular.saturated),
      .meaning = "pores filled with the pore fluid (else dry): yield on the effective stress of the pore pressure [PW]"},
     {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
      .meaning = "name of a fluid medium defined before this one"},
@@ -66,27 +66,27 @@ static const struct case_section elastic_plastic_section = {
 
 static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_finish_ctx *ctx)
 {
-    if (ctx->given(ctx->entry, "K")) m->c = sqrt(m->bulk_modulus / m->rho_grain);
+    if (ctx->given(ctx->entry, "K")) m->c = sqrt(m->bulk_modulus / m->granular.rho_grain);
     const mixsph_status st = pore_fluid_finish(m, ctx); /* the pore fluid, rho_f and the mixture density (5) */
     if (st != MIXSPH_OK) return st;
     m->bulk_modulus = m->rho0 * m->c * m->c;      /* the equation of state's */
-    const char *why = elasticity_shear_from_bulk(m->bulk_modulus, m->poisson, &m->shear_modulus);
+    const char *why = elasticity_shear_from_bulk(m->bulk_modulus, m->elastic.poisson, &m->elastic.shear_modulus);
     if (!why)
-        why = drucker_prager_matching(m->phi_deg * GEOM_PI / 180.0, m->cohesion, m->dilatancy_deg * GEOM_PI / 180.0,
-                                      &m->alpha_phi, &m->k_c, &m->alpha_psi);
+        why = drucker_prager_matching(m->granular.phi_deg * GEOM_PI / 180.0, m->dp.cohesion, m->dp.dilatancy_deg * GEOM_PI / 180.0,
+                                      &m->dp.alpha_phi, &m->dp.k_c, &m->dp.alpha_psi);
     if (why) return FAIL(ctx, "%s: %s: %s", ctx->origin, ctx->path, why);
-    m->sin_phi = sin(m->phi_deg * GEOM_PI / 180.0);
+    m->granular.sin_phi = sin(m->granular.phi_deg * GEOM_PI / 180.0);
     m->mu = 0.0;
     /* The grains' dissipation (docs/model.md [DP-AV]): Monaghan's term with alpha_M c = c_p, the
      * acoustic impedance rho c_p of the P wave on the approach speed of a pair, as a linearised
      * Riemann solver has it; a fixed numerical parameter, not a case key. */
-    m->alpha_m = elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0) / m->c;
+    m->alpha_m = elasticity_wave_speed(m->bulk_modulus, m->elastic.shear_modulus, m->rho0) / m->c;
     return MIXSPH_OK;
 }
 
 static double elastic_plastic_wave_speed(const struct medium *m)
 {
-    return elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0);
+    return elasticity_wave_speed(m->bulk_modulus, m->elastic.shear_modulus, m->rho0);
 }
 
 static double elastic_plastic_viscosity_bound(const struct medium *m)
@@ -122,10 +122,10 @@ static void plastic_range(void *arg, size_t b, size_t e)
         double g[DIM * DIM];
         velocity_gradient_corrected(step->grad, i, g);
         struct deviatoric_stress s = deviatoric_stress_load(P->stress, i);
-        elasticity_jaumann_step(&s, g, m->shear_modulus, dt);
-        const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->shear_modulus,
-                                                   .alpha_phi = m->alpha_phi, .k_c = m->k_c,
-                                                   .alpha_psi = m->alpha_psi};
+        elasticity_jaumann_step(&s, g, m->elastic.shear_modulus, dt);
+        const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->elastic.shear_modulus,
+                                                   .alpha_phi = m->dp.alpha_phi, .k_c = m->dp.k_c,
+                                                   .alpha_psi = m->dp.alpha_psi};
         const double pw = fmax(pore_pressure(pore, m, P->pos[0][i], P->pos[DIM_UP][i]), 0.0);
         double p_eff = P->p[i] - pb - pw;
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);

@@ -19,9 +19,9 @@ static const struct case_key elastic_keys[] = {
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
      .field = CASE_FIELD(medium, rho0), .meaning = "reference density ρ0"},
     {.key = "E", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e12, 0), .unit = "Pa",
-     .field = CASE_FIELD(medium, youngs_modulus), .meaning = "Young's modulus"},
+     .field = CASE_FIELD(medium, elastic.youngs_modulus), .meaning = "Young's modulus"},
     {.key = "nu", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 0, 0.49, 0), .unit = "-",
-     .field = CASE_FIELD(medium, poisson), .meaning = "Poisson's ratio ν: K = E/(3(1−2ν)) (the equation of state's), "
+     .field = CASE_FIELD(medium, elastic.poisson), .meaning = "Poisson's ratio ν: K = E/(3(1−2ν)) (the equation of state's), "
                                                        "G = E/(2(1+ν))"},
     {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0), .unit = "-",
      .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M"},
@@ -32,7 +32,7 @@ static const struct case_section elastic_section = {
 
 static mixsph_status elastic_finish(struct medium *m, const struct law_finish_ctx *ctx)
 {
-    const char *why = elasticity_constants(m->youngs_modulus, m->poisson, &m->bulk_modulus, &m->shear_modulus);
+    const char *why = elasticity_constants(m->elastic.youngs_modulus, m->elastic.poisson, &m->bulk_modulus, &m->elastic.shear_modulus);
     if (why) return status_set(ctx->err, ctx->err_len, MIXSPH_ERR_CASE, "%s: %s: %s", ctx->origin, ctx->path, why);
     m->c = sqrt(m->bulk_modulus / m->rho0);
     m->mu = 0.0;
@@ -41,7 +41,7 @@ static mixsph_status elastic_finish(struct medium *m, const struct law_finish_ct
 
 static double elastic_wave_speed(const struct medium *m)
 {
-    return elasticity_wave_speed(m->bulk_modulus, m->shear_modulus, m->rho0);
+    return elasticity_wave_speed(m->bulk_modulus, m->elastic.shear_modulus, m->rho0);
 }
 
 static double elastic_viscosity_bound(const struct medium *m)
@@ -69,7 +69,7 @@ static void elastic_range(void *arg, size_t b, size_t e)
         double g[DIM * DIM];
         velocity_gradient_corrected(step->grad, i, g);
         struct deviatoric_stress s = deviatoric_stress_load(P->stress, i);
-        elasticity_jaumann_step(&s, g, media[P->medium[i]].shear_modulus, dt);
+        elasticity_jaumann_step(&s, g, media[P->medium[i]].elastic.shear_modulus, dt);
         deviatoric_stress_store(&s, P->stress, i);
     }
 }

@@ -32,6 +32,14 @@ struct deviatoric_stress {
 #endif
 };
 
+/** The elastic constants of a medium with a stress (the elastic solid, the elastic-plastic law):
+ *  read from media.<name> by their key tables, derived by their finish. */
+struct elastic_params {
+    double youngs_modulus; /* E [Pa] (the elastic solid) */
+    double poisson;        /* nu [-] */
+    double shear_modulus;  /* G [Pa] */
+};
+
 /** Particle i's stress from the stored components (stress[SYM_N], dim.h). */
 static inline struct deviatoric_stress deviatoric_stress_load(double *const stress[SYM_N], size_t i)
 {

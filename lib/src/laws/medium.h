@@ -6,6 +6,10 @@
 #ifndef MIXSPH_MEDIUM_H
 #define MIXSPH_MEDIUM_H
 
+#include "drucker_prager_params.h"
+#include "elasticity.h"
+#include "granular.h"
+#include "mixture_paper_params.h"
 #include "schema.h"
 
 #define MEDIUM_NAME_LEN SCHEMA_NAME_LEN
@@ -48,30 +52,16 @@ struct medium {
     double c;          /* sound speed of the equation of state [m/s]; granular: sqrt(K_s / rho_s) */
     double mu;         /* dynamic viscosity [Pa s]; granular: unused (set by the rheology) */
     double alpha_m;    /* Monaghan artificial viscosity coefficient [-] (granular: 0 unless given) */
-    /* the paper's granular mixture (docs/model.md sections 5-6) */
-    double rho_grain;  /* density of the grains rho_s [kg/m3] */
-    double porosity;   /* n = eps_f at the packing limit [-] */
-    double phi_deg;    /* angle of internal friction [deg] */
-    double sin_phi;
-    int saturated;     /* pores filled with the pore fluid (else dry) */
-    int pore_fluid;    /* index of the pore fluid medium (saturated media), -1 if none */
-    double rho_f;      /* density of the pore fluid [kg/m3] (0 if dry) */
-    int pore_pressure; /* what the pore pressure is measured from (enum pore_pressure_mode, laws/pore_pressure.h) */
-    double eps_f_mu_f; /* eps_f mu_f [Pa s] (0 if dry) */
-    double mu_thr;     /* threshold viscosity [Pa s] */
-    double mu0;        /* limiting viscosity [Pa s]; INFINITY: no limit */
-    int mu1_mode;      /* the "mu1" rheology of Run 7: mu_thr = mu1, no limit */
-    int hold_fixed;     /* granular: a fixed grain gets no acceleration (SPHERA's implementation) */
-    int tension_cutoff; /* granular: no tensile pressure, p >= background pressure (off: the paper's model) */
-    /* the linear-elastic solid */
-    double youngs_modulus; /* E [Pa] */
-    double poisson;        /* nu [-] */
-    double shear_modulus;  /* G = E / (2 (1 + nu)) [Pa] */
-    double bulk_modulus;   /* K = E / (3 (1 - 2 nu)) [Pa]: the equation of state's, c = sqrt(K / rho0) */
-    /* the elastic-perfectly-plastic granular law (also phi_deg, porosity, rho_grain, poisson) */
-    double cohesion;       /* c [Pa] */
-    double dilatancy_deg;  /* psi [deg] */
-    double alpha_phi, k_c, alpha_psi; /* the plane-strain matched Drucker-Prager cone (drucker_prager.h) */
+    double bulk_modulus; /* K of the equation of state [Pa], c = sqrt(K / rho0) (a fluid's and the
+                          * elastic solid's; the grains' K_s of the granular laws) */
+    int tension_cutoff;  /* no tensile pressure, p >= background pressure: the equation of state's
+                          * option (a granular key; off: the paper's model) */
+    /* each law's own parameters (its module's header); a law reads its own and those it shares */
+    struct granular_params granular;    /* the granular laws' grains and pores (granular.h) */
+    struct mixture_paper_params paper;  /* the paper's law (mixture_paper_params.h) */
+    struct elastic_params elastic;      /* the elastic solid and the elastic part of the
+                                         * elastic-plastic law (elasticity.h) */
+    struct drucker_prager_params dp;    /* the elastic-plastic law's cone (drucker_prager_params.h) */
 };
 
 /** Whether a held particle of medium m takes the kicks of its forces; `rigid`: the implicit scheme

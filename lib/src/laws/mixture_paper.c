@@ -60,25 +60,25 @@ static const struct case_key granular_keys[] = {
      .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next); chosen by its number "
                 "(a case parameter), the medium may hold the other law's keys too (below)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
-     .field = CASE_FIELD(medium, rho_grain), .meaning = "density of the grains ρ_s"},
+     .field = CASE_FIELD(medium, granular.rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),
      .unit = "Pa", .field = CASE_FIELD(medium, bulk_modulus), .meaning = "bulk modulus of the grains K_s: c = √(K_s/ρ_s)"},
     {.key = "c", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e5, 0),
      .unit = "m/s", .field = CASE_FIELD(medium, c), .meaning = "sound speed"},
     {.key = "porosity", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 0.95, 0), .unit = "-",
-     .field = CASE_FIELD(medium, porosity), .meaning = "porosity n = ε_f at the packing limit"},
+     .field = CASE_FIELD(medium, granular.porosity), .meaning = "porosity n = ε_f at the packing limit"},
     {.key = "phi", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 89, 0), .unit = "deg",
-     .field = CASE_FIELD(medium, phi_deg), .meaning = "angle of internal friction φ"},
-    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, saturated),
+     .field = CASE_FIELD(medium, granular.phi_deg), .meaning = "angle of internal friction φ"},
+    {.key = "saturated", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, granular.saturated),
      .meaning = "pores filled with the pore fluid (else dry)"},
     {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
      .meaning = "name of a fluid medium defined before this one"},
     PORE_PRESSURE_KEY,
     {.key = "mu_thr", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "unless mu1", SCHEMA_RANGE(0, 1, 1e12, 0),
-     .unit = "Pa s", .field = CASE_FIELD(medium, mu_thr),
+     .unit = "Pa s", .field = CASE_FIELD(medium, paper.mu_thr),
      .meaning = "threshold viscosity μ_thr: a grain with μ_app ≥ μ_thr is held fixed"},
     {.key = "mu0", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 1e12, 0), SCHEMA_DEF(INFINITY), .def_text = "+∞ (no limit)",
-     .unit = "Pa s", .field = CASE_FIELD(medium, mu0),
+     .unit = "Pa s", .field = CASE_FIELD(medium, paper.mu0),
      .meaning = "limiting viscosity μ0: μ_app between μ0 and μ_thr is replaced by μ0; μ0 ≥ μ_thr: no limit"},
     {.key = "mu1", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 1e12, 0), .unit = "Pa s",
      .meaning = "instead of mu_thr and mu0: the rheology of Run 7, μ_thr = μ1 without a limit"},
@@ -86,7 +86,7 @@ static const struct case_key granular_keys[] = {
      .meaning = "no tensile pressure: p below the background pressure is raised to it, as a cohesionless "
                 "medium carries no tension (below); false: the paper's model, whose equation of state pulls "
                 "grains together in tension"},
-    {.key = "hold_fixed", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, hold_fixed),
+    {.key = "hold_fixed", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, paper.hold_fixed),
      .meaning = "a grain held fixed gets no acceleration (below)"},
     {.key = "alpha_m", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 10, 0), SCHEMA_DEF(0), .unit = "-",
      .field = CASE_FIELD(medium, alpha_m), .meaning = "Monaghan artificial viscosity coefficient α_M of the grains"},
@@ -106,17 +106,17 @@ static const struct case_section granular_section = {
  * pore fluid, the mixture density (5), eps_f mu_f and the mu1 rheology of Run 7. */
 static mixsph_status granular_finish(struct medium *md, const struct law_finish_ctx *ctx)
 {
-    if (ctx->given(ctx->entry, "K")) md->c = sqrt(md->bulk_modulus / md->rho_grain);
-    md->sin_phi = sin(md->phi_deg * GEOM_PI / 180.0);
+    if (ctx->given(ctx->entry, "K")) md->c = sqrt(md->bulk_modulus / md->granular.rho_grain);
+    md->granular.sin_phi = sin(md->granular.phi_deg * GEOM_PI / 180.0);
     const mixsph_status st = pore_fluid_finish(md, ctx); /* the pore fluid, rho_f and (5) */
     if (st != MIXSPH_OK) return st;
-    md->eps_f_mu_f = md->saturated ? md->porosity * ctx->media[md->pore_fluid].mu : 0.0;
+    md->paper.eps_f_mu_f = md->granular.saturated ? md->granular.porosity * ctx->media[md->granular.pore_fluid].mu : 0.0;
     if (ctx->given(ctx->entry, "mu1")) {
         if (ctx->given(ctx->entry, "mu_thr") || ctx->given(ctx->entry, "mu0"))
             return FAIL(ctx, "%s: %s.mu1: the mu1 rheology (Run 7) replaces mu_thr and mu0: give mu1 alone", ctx->origin,
                         ctx->path);
-        md->mu_thr = ctx->number(ctx->entry, "mu1"); /* mu0 keeps its default: no limit */
-        md->mu1_mode = 1;
+        md->paper.mu_thr = ctx->number(ctx->entry, "mu1"); /* mu0 keeps its default: no limit */
+        md->paper.mu1_mode = 1;
     } else if (!ctx->given(ctx->entry, "mu_thr")) {
         return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1)", ctx->origin, ctx->path);
     }
@@ -253,12 +253,12 @@ static void mixture_region(void *arg, int tid, int nth)
         const double sii = rheology_sqrt_ii(grad);
         const double pw = pore_pressure(M->pore, m, P->pos[0][i], P->pos[DIM_UP][i]);
         const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
-        const double mu_app = rheology_apparent(sigma, m->sin_phi, sii, m->eps_f_mu_f, m->mu_thr);
+        const double mu_app = rheology_apparent(sigma, m->granular.sin_phi, sii, m->paper.eps_f_mu_f, m->paper.mu_thr);
         double mu;
-        int fix = rheology_regime(mu_app, m->mu_thr, m->mu0, &mu) == RHEOLOGY_FIXED;
+        int fix = rheology_regime(mu_app, m->paper.mu_thr, m->paper.mu0, &mu) == RHEOLOGY_FIXED;
         if (fixed_bed && frozen(M, P, i)) {
             fix = 1;
-            mu = m->mu_thr;
+            mu = m->paper.mu_thr;
         }
         if (fix) {
             P->state[i] = MIXSPH_STATE_FIXED;

@@ -14,7 +14,7 @@
  *  scheme prescribes held grains at rest (`rigid`, numerics.held_grains = "rigid"). */
 static inline int mixture_paper_held_grain_kicked(const struct medium *m, int rigid)
 {
-    return !rigid && !m->hold_fixed;
+    return !rigid && !m->paper.hold_fixed;
 }
 
 /** The viscosity [Pa s] a held grain enters the explicit viscous bound of the time step (4) with:
@@ -22,7 +22,7 @@ static inline int mixture_paper_held_grain_kicked(const struct medium *m, int ri
  *  dt ~ 1/mu0; docs/model.md section 6). Mobile grains have mu <= min(mu0, mu_thr). */
 static inline double mixture_paper_held_viscosity(const struct medium *m)
 {
-    return m->mu0 < m->mu_thr ? m->mu0 : m->mu_thr;
+    return m->paper.mu0 < m->paper.mu_thr ? m->paper.mu0 : m->paper.mu_thr;
 }
 
 #endif

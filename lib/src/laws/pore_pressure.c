@@ -50,13 +50,13 @@ void pore_columns_tops(struct pore_columns *C, const struct particles *P, const 
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
         const struct medium *m = &media[P->medium[i]];
         const int fluid = m->law == LAW_NEWTONIAN;
-        if (!fluid && !m->saturated) continue;
+        if (!fluid && !m->granular.saturated) continue;
         const size_t b = bin_of(C, P->pos[0][i]);
         const double top = P->pos[DIM_UP][i] + 0.5 * C->dx;
-        if (m->saturated && top > C->ztop[b]) C->ztop[b] = top;
+        if (m->granular.saturated && top > C->ztop[b]) C->ztop[b] = top;
         if (top > C->wet_top[b]) { /* ties: the first in memory order, whatever the threads */
             C->wet_top[b] = top;
-            C->wet_rho[b] = fluid ? m->rho0 : m->rho_f;
+            C->wet_rho[b] = fluid ? m->rho0 : m->granular.rho_f;
         }
     }
 }
@@ -77,37 +77,37 @@ static double hydrostatic_below(const struct pore_columns *C, const double *ztop
 double pore_pressure(const struct pore_columns *C, const struct medium *m, double x, double z)
 {
     const size_t b = bin_of(C, x);
-    if (m->pore_pressure == PORE_GRANULAR_COLUMN)
-        return m->saturated ? hydrostatic_below(C, C->ztop, b, m->rho_f, z) : 0.0;
+    if (m->granular.pore_pressure == PORE_GRANULAR_COLUMN)
+        return m->granular.saturated ? hydrostatic_below(C, C->ztop, b, m->granular.rho_f, z) : 0.0;
     /* free_surface: a saturated medium's pores hold its own pore fluid, a dry medium's the fluid
      * it is under */
-    return hydrostatic_below(C, C->wet_top, b, m->saturated ? m->rho_f : C->wet_rho[b], z);
+    return hydrostatic_below(C, C->wet_top, b, m->granular.saturated ? m->granular.rho_f : C->wet_rho[b], z);
 }
 
 #define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
 
 mixsph_status pore_fluid_finish(struct medium *md, const struct law_finish_ctx *ctx)
 {
-    md->pore_fluid = -1;
+    md->granular.pore_fluid = -1;
     const char *fluid = ctx->text(ctx->entry, "pore_fluid");
     if (fluid) {
         for (size_t k = 0; k + 1 < ctx->n_media; k++)
-            if (strcmp(ctx->media[k].name, fluid) == 0) md->pore_fluid = (int)k;
-        if (md->pore_fluid < 0 || ctx->media[md->pore_fluid].law != LAW_NEWTONIAN)
+            if (strcmp(ctx->media[k].name, fluid) == 0) md->granular.pore_fluid = (int)k;
+        if (md->granular.pore_fluid < 0 || ctx->media[md->granular.pore_fluid].law != LAW_NEWTONIAN)
             return FAIL(ctx, "%s: %s.pore_fluid: '%s' is not a fluid medium defined before this one", ctx->origin,
                         ctx->path, fluid);
     }
-    if (md->saturated && md->pore_fluid < 0)
+    if (md->granular.saturated && md->granular.pore_fluid < 0)
         return FAIL(ctx, "%s: %s.pore_fluid: missing (a saturated medium needs the name of its pore fluid)", ctx->origin,
                     ctx->path);
-    const double n = md->porosity;
-    if (md->saturated) {
-        const struct medium *f = &ctx->media[md->pore_fluid];
-        md->rho_f = f->rho0;
-        md->rho0 = n * f->rho0 + (1.0 - n) * md->rho_grain; /* (5), saturated */
+    const double n = md->granular.porosity;
+    if (md->granular.saturated) {
+        const struct medium *f = &ctx->media[md->granular.pore_fluid];
+        md->granular.rho_f = f->rho0;
+        md->rho0 = n * f->rho0 + (1.0 - n) * md->granular.rho_grain; /* (5), saturated */
     } else {
-        md->rho_f = 0.0;
-        md->rho0 = (1.0 - n) * md->rho_grain; /* (5), dry */
+        md->granular.rho_f = 0.0;
+        md->rho0 = (1.0 - n) * md->granular.rho_grain; /* (5), dry */
     }
     return MIXSPH_OK;
 }

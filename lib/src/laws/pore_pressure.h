@@ -25,7 +25,7 @@ static const struct case_choice pore_pressure_modes[] = {
 /* The row of media.<name>.pore_pressure, in the key table of every granular law. */
 #define PORE_PRESSURE_KEY                                                                                             \
     {.key = "pore_pressure", .type = CASE_CHOICE, SCHEMA_DEF(PORE_FREE_SURFACE), .choices = pore_pressure_modes,      \
-     .numeric_choice = CASE_CHOICE_BY_VALUE, .field = CASE_FIELD(medium, pore_pressure),                              \
+     .numeric_choice = CASE_CHOICE_BY_VALUE, .field = CASE_FIELD(medium, granular.pore_pressure),                              \
      .meaning = "what the pore pressure p_w [PW] is measured from: free_surface (0), the top of the water and "       \
                 "saturated grains above the grain, a dry medium's grains under water included; granular_column (1), " \
                 "the top of the saturated grains only, a dry medium none (the paper's; its bundled cases set it)"}

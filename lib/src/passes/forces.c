@@ -1051,7 +1051,7 @@ static void momentum_region(void *arg, int tid, int nth)
     for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue; /* keeps the force on it: its wall's work (walls_move) */
         if (R->wall_sums && (M[P->medium[i]].features & LAW_WALL_FRICTION)) {
-            const double s = M[P->medium[i]].sin_phi;
+            const double s = M[P->medium[i]].granular.sin_phi;
             double f[DIM];
             for (int d = 0; d < DIM; d++) f[d] = P->acc[d][i];
             wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, f);
