@@ -89,18 +89,8 @@ def _maximin_subset(U, idx, n):
 
 def target_weights(m: M.OutputMF, target: str) -> np.ndarray:
     """w_k: the squared coefficient of delta_k in the target (module doc)."""
-    L = len(m.levels)
-    rho = [g.rho for g in m.levels]
-    coef = np.ones(L)
-    if target == M.EXTRAPOLATED and m.order:
-        a, b = m.extrapolation_coeffs(m.order["p"])
-        coef[L - 1] = b
-        for k in range(L - 2, -1, -1):
-            coef[k] = a * float(np.prod(rho[k + 1:L - 1]))
-    else:
-        for k in range(L - 1):
-            coef[k] = float(np.prod(rho[k + 1:L]))
-    return coef ** 2
+    level = M.EXTRAPOLATED if target == M.EXTRAPOLATED and m.order else len(m.levels) - 1
+    return np.asarray(m.linear_form(level, latent=True)["coef"], float) ** 2
 
 
 def pick_batch(m: M.OutputMF, Uc, Ur, costs, k, target="finest", max_cost=math.inf):

@@ -334,17 +334,58 @@ class OutputMF:
                 "scale_applied": max(1.0, rms)})
 
     # prediction
+    def linear_form(self, level, dx=0.0, latent=False) -> dict:
+        """A level's prediction as a linear form of the delta GPs (independent): mean =
+        sum_k coef_k m_k, latent variance sum_k coef_k^2 v_k, predictive variance (latent +
+        noise) scale^2 + (sum_k order_k m_k)^2 (the order's term, extrapolation only). level: a
+        level index or EXTRAPOLATED (to dx, default 0). The one place the recursion and the
+        Richardson extrapolation are composed: predict_level, predict_extrapolated, the design's
+        target weights and the study page's in-browser evaluation (html_report) all use it."""
+        rho = [g.rho for g in self.levels]
+        if level == EXTRAPOLATED:
+            if not self.order:
+                raise MFError(f"{self.name}: no extrapolation: it needs three levels or a given "
+                              f"order (--order)")
+            t = len(self.levels) - 1
+            a, b = self.extrapolation_coeffs(self.order["p"], dx)
+            below = [float(np.prod(rho[k + 1:t])) for k in range(t)]     # f_{t-1} in delta_k
+            coef = [a * w for w in below] + [b]
+            # f(p) = f_c + c(p) (f_c - f_b), f_c - f_b = (rho_t - 1) f_{t-1} + delta_t: the
+            # spread of f between the order's 2.5 and 97.5 % values, as a normal sd
+            c_lo = richardson_c(self.order["p_lo"], self.dxs[-2], self.dxs[-1], dx)
+            c_hi = richardson_c(self.order["p_hi"], self.dxs[-2], self.dxs[-1], dx)
+            d = (c_lo - c_hi) / (2 * Z95)
+            order = [d * (rho[t] - 1.0) * w for w in below] + [d]
+        else:
+            t = int(level)
+            coef = [float(np.prod(rho[k + 1:t + 1])) for k in range(t + 1)]
+            order = None
+        form = {"level": level, "coef": coef, "order": order}
+        if not latent:
+            form["noise"] = self.levels[t].noise_var()
+            form["scale"] = float(self.scale[t])
+        return form
+
+    def predict_form(self, U, form, with_terms=False):
+        """Mean and variance of a linear form (linear_form) at unit-box inputs U; latent when
+        the form has no noise; with_terms also the GP's and the order's variance terms."""
+        mv = [g.predict(U) for g in self.levels[:len(form["coef"])]]
+        mean = sum(c * m for c, (m, _) in zip(form["coef"], mv))
+        v = sum(c * c * vk for c, (_, vk) in zip(form["coef"], mv))
+        if "noise" not in form:
+            return mean, v
+        v_gp = (v + form["noise"]) * form["scale"] ** 2
+        v_order = 0.0 * v_gp
+        if form["order"] is not None:
+            v_order = sum(u * m for u, (m, _) in zip(form["order"], mv)) ** 2
+        if with_terms:
+            return mean, v_gp + v_order, v_gp, v_order
+        return mean, v_gp + v_order
+
     def predict_level(self, U, li, latent=False):
         """Mean and variance of level li (latent: without the level's noise and uncalibrated;
         else the calibrated predictive variance of a new run)."""
-        m, v = self.levels[0].predict(U)
-        for k in range(1, li + 1):
-            g = self.levels[k]
-            md, vd = g.predict(U)
-            m, v = g.rho * m + md, g.rho ** 2 * v + vd
-        if latent:
-            return m, v
-        return m, (v + self.levels[li].noise_var()) * self.scale[li] ** 2
+        return self.predict_form(U, self.linear_form(li, latent=latent))
 
     def extrapolation_coeffs(self, p, dx=0.0):
         """(a, b) of f(dx) = a f_{L-1} + b delta_L for the order p (dx below the ladder)."""
@@ -388,23 +429,7 @@ class OutputMF:
         """Mean and predictive variance of the value extrapolated to dx (default 0, the
         limit; a dx below the ladder's finest checks the extrapolation against runs there)
         (module doc); with_terms also the GP's and the order's variance terms."""
-        if not self.order:
-            raise MFError(f"{self.name}: no extrapolation: it needs three levels or a given "
-                          f"order (--order)")
-        mb, vb = self.predict_level(U, len(self.levels) - 2, latent=True)
-        md, vd = self.levels[-1].predict(U)
-        mc = self.levels[-1].rho * mb + md
-        a, b = self.extrapolation_coeffs(self.order["p"], dx)
-        mean = a * mb + b * md
-        v_gp = (a ** 2 * vb + b ** 2 * vd + self.levels[-1].noise_var()) * self.scale[-1] ** 2
-
-        def f_at(pp):
-            c = richardson_c(pp, self.dxs[-2], self.dxs[-1], dx)
-            return (1 + c) * mc - c * mb
-        v_order = ((f_at(self.order["p_lo"]) - f_at(self.order["p_hi"])) / (2 * Z95)) ** 2
-        if with_terms:
-            return mean, v_gp + v_order, v_gp, v_order
-        return mean, v_gp + v_order
+        return self.predict_form(U, self.linear_form(EXTRAPOLATED, dx), with_terms=with_terms)
 
     def sample(self, U, n_draws, level, rng):
         """Joint posterior draws (len(U) x n_draws) of a level (index) or the extrapolation
