@@ -3,6 +3,8 @@
   sweep OUT      run a scenario table (grid, random, lhs or CSV) into OUT/results.parquet
                  (or .csv); resumable; writes the report at the end
   report OUT     the PNG reports and the scenario table of OUT's results
+  page DIR       the interactive HTML page (DIR/report.html) of a study, a sweep or a mixsph
+                 run folder: predictions with sliders, risk, sensitivity, the runs
   optimise OUT   the paper's Section 2.2 procedure: mu_thr_min, then mu0_min, and the saving
   emulate ...    a Gaussian-process emulator of the FMU: fit, predict, design, validate, risk,
                  plot (python -m tools.dss emulate --help)
@@ -62,6 +64,14 @@ def build_parser():
     r.add_argument("--x", default="reservoir_level", help="parameter on the x axis (default reservoir_level)")
     r.add_argument("--y", help="output column (default max_run_up_Z when finite, else max_run_up)")
 
+    pg = sub.add_parser("page", help="the interactive HTML page of a study, sweep or mixsph run "
+                                     "folder (DIR/report.html)")
+    pg.add_argument("dir", help="a study (emulate study), a sweep (dss sweep) or the output folder "
+                                "of a mixsph run")
+    pg.add_argument("-o", "--out", help="the page (default DIR/report.html)")
+    pg.add_argument("--crest", type=float, metavar="Z",
+                    help="a sweep's elevation for the exceedance (a study has its own)")
+
     sub.add_parser("emulate", help="the FMU's emulator: fit, predict, design, validate, risk, plot "
                                    "(emulate --help)", add_help=False)
 
@@ -95,6 +105,18 @@ def cmd_report(args):
         raise UsageError(f"no results in {args.out}")
     info = report.make_report(df, args.out, crest=args.crest, x=args.x, y=args.y)
     print_report(info)
+    return 0
+
+
+def cmd_page(args):
+    from .html_report import PageError, write_page
+    if not os.path.isdir(args.dir):
+        raise UsageError(f"{args.dir}: no such folder")
+    try:
+        path = write_page(args.dir, args.out, crest=args.crest)
+    except PageError as e:
+        raise UsageError(str(e)) from None
+    print(f"dss page: wrote {path} ({os.path.getsize(path) / 1e6:.1f} MB; open it in a browser)")
     return 0
 
 
@@ -139,6 +161,8 @@ def main(argv=None):
             return cmd_sweep(args)
         if args.cmd == "report":
             return cmd_report(args)
+        if args.cmd == "page":
+            return cmd_page(args)
         return cmd_optimise(args)
     except (UsageError, ValueError, FileNotFoundError) as e:
         print(f"dss: error: {e}", file=sys.stderr)

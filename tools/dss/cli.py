@@ -14,6 +14,8 @@ import os
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 DEFAULT_FMU_CANDIDATES = ("build/LandslideWave.fmu", "build-dss/LandslideWave.fmu")
 DEFAULT_DX = 0.03          # the default coarse resolution of a sweep (m); --dx to change
+# outputs recorded over time in every run (results' column series; the runs on the page)
+MONITOR_SERIES = ("run_up", "landslide_front", "kinetic_energy", "water_kinetic_energy", "dt")
 
 
 class UsageError(Exception):
@@ -179,6 +181,9 @@ def resolve_run(args, saved=None):
         stop = float(de.stopTime) if de is not None and de.stopTime else None
         if stop is None:
             raise UsageError("the FMU has no default stop time: give --stop-time")
+    # the monitors over time the FMU has, recorded at every communication point for the runs'
+    # page (tools/dss/html_report.py)
+    series = [n for n in MONITOR_SERIES if n in var and var[n].causality == "output"]
     opts = {"stop_time": float(stop), "step": float(step), "threads": args.threads,
-            "timeout": args.timeout}
+            "timeout": args.timeout, "series": series}
     return fmu, fixed, opts, md, var, dx

@@ -263,19 +263,28 @@ def cmd_study(args):
     from .scenarios import Distribution, split_assignment
     dists = {k: Distribution(k, v) for k, v in (split_assignment(it) for it in args.dist)}
     out = args.risk_output if args.risk_output in em.models else args.output
-    r = M.exceedance(em, out, dists, {}, args.crest, level=args.level, n=args.n,
-                     seed=args.seed, z_grid=_z_grid(em, out, args.crest))
-    s = M.sobol(em, out, dists, {}, level=args.level, seed=args.seed)
+    finish_study(args.out, em, dists, out, args.crest, args.level, args.n, args.seed, t0)
+    return 0
+
+
+def finish_study(folder, em, dists, output, crest, level, n, seed, t0):
+    """A study's end: the risk at the level and the Sobol indices into FOLDER/study.json,
+    exceedance.png and the study's page FOLDER/report.html."""
+    r = M.exceedance(em, output, dists, {}, crest, level=level, n=n, seed=seed,
+                     z_grid=_z_grid(em, output, crest))
+    s = M.sobol(em, output, dists, {}, level=level, seed=seed)
     doc = {"risk": r, "sobol": s, "elapsed_s": time.monotonic() - t0,
-           "emulator": os.path.join(args.out, "mf_emulator.json")}
-    with open(os.path.join(args.out, "study.json"), "w") as f:
+           "emulator": os.path.join(folder, "mf_emulator.json")}
+    with open(os.path.join(folder, "study.json"), "w") as f:
         json.dump(E._jsonable(doc), f, indent=1)
     from . import emulate_plots as P
-    P.exceedance_plot(r, os.path.join(args.out, "exceedance.png"))
+    from .html_report import write_page
+    P.exceedance_plot(r, os.path.join(folder, "exceedance.png"))
+    page = write_page(folder)
     _print_risk(r, s)
     print(f"emulate study: done in {(time.monotonic() - t0) / 60:.1f} min; wrote "
-          f"{os.path.join(args.out, 'study.json')}, exceedance.png")
-    return 0
+          f"{os.path.join(folder, 'study.json')}, exceedance.png, {page} (open it in a browser)")
+    return doc
 
 
 def _z_grid(em, out, crest):

@@ -103,6 +103,8 @@ def cmd_sweep(args):
             print(f"  failed {rec[S.ID]}: {rec.get('error')}")
     if not args.no_report and not final.empty:
         info = report.make_report(final, args.out, crest=args.crest)
+        from .html_report import write_page
+        info["files"].append(write_page(args.out, crest=args.crest))
         print_report(info)
     return 0
 

@@ -1,0 +1,474 @@
+"""The page of a study: one self-contained HTML file (report.html) per DSS study, sweep or run.
+
+    python -m tools.dss page DIR [-o FILE]
+
+DIR is a multi-fidelity study (`emulate study`: mf_emulator.json, study.json, mfdesign.json), a
+sweep (`dss sweep`: results.parquet or results.csv) or the output folder of one `mixsph run`
+(monitors.csv, summary.json); `emulate study` and `dss sweep` write the page themselves at the
+end. The page needs no server and no network: Plotly's JavaScript bundle (from the plotly wheel)
+is inlined, the data is one JSON block in the page, and report_page.js (beside this module)
+draws it.
+
+The prediction panel evaluates the emulator in the browser from the emulator file's own fitted
+data: per delta GP its training inputs (unit box), the weights alpha = K^-1 y and the Cholesky
+factor L of K (scikit-learn's alpha_ and L_, exported bit for bit as base64 float64), its
+constant and length scales; and per output and level the linear form of the delta GPs that
+multifidelity.OutputMF.linear_form gives (the only place the recursion and the Richardson
+extrapolation are composed; Python's own predictions use it too). The browser computes the
+Matern 5/2 kernel, the weighted sums and one triangular solve per GP; tests/python/
+test_report_html.py checks the page's numbers against Python's at 20 random points to 1e-9.
+No grid: the evaluation is exact, its cost (O(n^2) per point for n runs of a level) is well
+under a millisecond per point for hundreds of runs, and the page's size grows with n^2/2
+(L's lower triangle), 1.2 MB for two outputs of a 500-run ladder (docs/dss.md).
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import glob
+import html
+import json
+import math
+import os
+import subprocess
+
+import numpy as np
+
+from .scenarios import ID
+
+PAGE = "report.html"
+SERIES_POINTS = 80          # monitors over time: at most this many points per run and series
+FRAMES = 40                 # particle animation: at most this many frames ...
+FRAME_PARTICLES = 4000      # ... of at most this many particles (every k-th particle)
+CHECK_POINTS = 3            # the page's self-check: points per output and level
+RISK_POINTS = 1000          # box points of the stated discretisation error (finest vs limit)
+_HERE = os.path.dirname(os.path.abspath(__file__))
+_ROOT = os.path.dirname(os.path.dirname(_HERE))
+
+
+class PageError(ValueError):
+    pass
+
+
+# ---- encoding ----------------------------------------------------------------------------------
+
+def f64(a) -> str:
+    """A float64 array as base64 of its little-endian bytes (exact, 10.7 bytes a number)."""
+    return base64.b64encode(np.ascontiguousarray(np.asarray(a, dtype="<f8")).tobytes()).decode()
+
+
+def _round(v, digits=6):
+    """A number for display data: 6 significant digits, None for NaN/inf."""
+    try:
+        x = float(v)
+    except (TypeError, ValueError):
+        return v
+    if not math.isfinite(x):
+        return None
+    return float(f"{x:.{digits}g}")
+
+
+def _plain(obj):
+    """JSON-ready: numpy scalars and arrays to Python, NaN to None."""
+    if isinstance(obj, dict):
+        return {str(k): _plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _plain(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        x = float(obj)
+        return x if math.isfinite(x) else None
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    return obj
+
+
+# ---- the emulator for the browser --------------------------------------------------------------
+
+def export_delta(g) -> dict:
+    """One delta GP (multifidelity.DeltaGP) as the page evaluates it: latent mean
+    k(x, X) alpha * std + mean and variance (c - |L^-1 k(x, X)|^2) std^2, k = c Matern_5/2."""
+    gp = g.gp
+    k1 = gp.kernel_.k1
+    c = float(k1.k1.constant_value)
+    ls = np.broadcast_to(np.asarray(k1.k2.length_scale, float), (gp.X_train_.shape[1],))
+    if float(k1.k2.nu) != 2.5:
+        raise PageError(f"the page evaluates Matern 5/2 kernels only (nu = {k1.k2.nu})")
+    L = np.asarray(gp.L_, float)
+    n = L.shape[0]
+    return {"n": int(n), "d": int(gp.X_train_.shape[1]), "c": c, "ls": ls.tolist(),
+            "mean": float(g.mean), "std": float(g.std),
+            "X": f64(gp.X_train_), "alpha": f64(np.ravel(gp.alpha_)),
+            "L": f64(L[np.tril_indices(n)])}
+
+
+def level_keys(em) -> list[tuple[str, str]]:
+    """(key, label) of the levels the page offers: the limit first when there is one."""
+    from . import multifidelity as M
+    keys = []
+    if any(m.order for m in em.models.values()):
+        keys.append((M.EXTRAPOLATED, "dx -> 0 (extrapolated)"))
+    last = len(em.dxs) - 1
+    for i in range(last, -1, -1):
+        keys.append((str(i), f"dx = {em.dxs[i]:g} m" + (" (finest run)" if i == last else "")))
+    return keys
+
+
+def export_mf(em) -> dict:
+    from . import multifidelity as M
+    outs = {}
+    for name, m in em.models.items():
+        forms = {}
+        for key, _ in level_keys(em):
+            if key == M.EXTRAPOLATED and not m.order:
+                continue
+            f = m.linear_form(key if key == M.EXTRAPOLATED else int(key))
+            forms[key] = {"coef": f["coef"], "order": f["order"], "noise": f["noise"],
+                          "scale": f["scale"]}
+        outs[name] = {"gps": [export_delta(g) for g in m.levels], "forms": forms,
+                      "order": m.order, "calibration": m.calibration,
+                      "kernel_family": m.kernel_family,
+                      "rho": [g.rho for g in m.levels]}
+    return {"kind": "mf", "inputs": [{"name": n, "lo": float(b[0]), "hi": float(b[1])}
+                                     for n, b in zip(em.inputs, em.box)],
+            "levels": [{"key": k, "label": lab} for k, lab in level_keys(em)],
+            "dxs": em.dxs, "outputs": outs}
+
+
+def python_predict(em, output, level_key, X):
+    """The emulator's prediction as the page's key names it (for the tests and the page's own
+    self-check numbers)."""
+    from . import multifidelity as M
+    lv = level_key if level_key == M.EXTRAPOLATED else em.dxs[int(level_key)]
+    return em.predict(np.atleast_2d(X), output, lv)
+
+
+# ---- what every page has -----------------------------------------------------------------------
+
+def versions(fmu: dict | None = None) -> dict:
+    """mixsph's version and commit (of this checkout), the FMU's model version and GUID, and the
+    Python libraries'."""
+    out = {}
+    try:
+        with open(os.path.join(_ROOT, "CMakeLists.txt")) as f:
+            for line in f:
+                if line.strip().startswith("project(mixsph VERSION"):
+                    out["mixsph"] = line.split("VERSION")[1].split()[0]
+                    break
+    except OSError:
+        pass
+    try:
+        out["commit"] = subprocess.run(["git", "-C", _ROOT, "describe", "--always", "--dirty"],
+                                       capture_output=True, text=True, timeout=10).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        pass
+    fmu = dict(fmu or {})
+    if fmu:
+        out["fmu_guid"] = fmu.get("guid")
+        out["fmu_sha256"] = fmu.get("sha256")
+        out["fmu_path"] = fmu.get("path")
+        p = fmu.get("path")
+        if p and os.path.isfile(p):
+            try:
+                from fmpy import read_model_description
+                md = read_model_description(p)
+                out["fmu_version"] = md.version
+                out["fmu_model"] = md.modelName
+                if md.guid != fmu.get("guid"):
+                    out["fmu_note"] = (f"the FMU now at {p} has GUID {md.guid}, not the one the "
+                                       f"study ran on")
+            except Exception as e:          # a broken FMU file: say so, the page still works
+                out["fmu_note"] = f"cannot read {p}: {e}"
+    import plotly
+    import sklearn
+    out["libraries"] = {"numpy": np.__version__, "scikit-learn": sklearn.__version__,
+                        "plotly": plotly.__version__}
+    return out
+
+
+def _series(text) -> dict | None:
+    """A run's recorded series (the store's JSON text) decimated to SERIES_POINTS."""
+    if not isinstance(text, str) or not text:
+        return None
+    try:
+        s = json.loads(text)
+    except ValueError:
+        return None
+    t = np.asarray(s.get("time") or [], float)
+    if t.size == 0:
+        return None
+    idx = np.unique(np.linspace(0, t.size - 1, min(SERIES_POINTS, t.size)).round().astype(int))
+    return {k: [_round(v[i]) for i in idx] for k, v in s.items() if isinstance(v, list) and len(v) == t.size}
+
+
+def runs_table(df, inputs, outputs) -> dict:
+    """The runs as the page's table: columns, rows (display precision) and each run's series."""
+    cols = [c for c in [ID, "dx"] + list(inputs) + list(outputs)
+            + ["cpu_time_s", "wall_time_s", "status", "error"] if c in df.columns]
+    cols = list(dict.fromkeys(cols))
+    rows, series = [], []
+    for rec in df.to_dict(orient="records"):
+        rows.append([_round(rec.get(c)) if c not in (ID, "status", "error") else
+                     ("" if rec.get(c) is None or (isinstance(rec.get(c), float) and rec.get(c) != rec.get(c))
+                      else str(rec.get(c))[:300]) for c in cols])
+        series.append(_series(rec.get("series")))
+    return {"columns": cols, "rows": rows, "series": series}
+
+
+# ---- a run's own files -------------------------------------------------------------------------
+
+def _mixsph_tools():
+    """tools/mixsph_tools (installed in .venv, or from this checkout's tools/)."""
+    try:
+        import mixsph_tools as mt
+    except ImportError:
+        import sys
+        sys.path.insert(0, os.path.dirname(_HERE))
+        import mixsph_tools as mt
+    return mt
+
+
+def run_data(run_dir) -> dict:
+    """Monitors, profiles and a decimated particle animation of a mixsph run folder."""
+    mt = _mixsph_tools()
+    mon_path = os.path.join(run_dir, "monitors.csv")
+    if not os.path.isfile(mon_path):
+        raise PageError(f"{run_dir}: no monitors.csv: not the output folder of a mixsph run")
+    mon = mt.read_monitors(mon_path)
+    t = np.asarray(mon["t"], float)
+    idx = np.unique(np.linspace(0, t.size - 1, min(4 * SERIES_POINTS, t.size)).round().astype(int)) \
+        if t.size else np.array([], int)
+    monitors = {k: [_round(v) for v in np.asarray(a, float)[idx]] for k, a in mon.items()}
+    summary = {}
+    sp = os.path.join(run_dir, "summary.json")
+    if os.path.isfile(sp):
+        summary = mt.read_summary(sp)
+    profiles = []
+    for p in sorted(glob.glob(os.path.join(glob.escape(run_dir), "profile_*.csv"))):
+        pr = mt.read_profile(p)
+        profiles.append({"name": pr.name, "t": pr.t, "x": [_round(v) for v in pr.x],
+                         "z": [_round(v) for v in pr.z]})
+    snaps = mt.list_snapshots(run_dir)
+    frames = []
+    if snaps:
+        pick = np.unique(np.linspace(0, len(snaps) - 1, min(FRAMES, len(snaps))).round().astype(int))
+        for i in pick:
+            ts, cols = mt.read_snapshot(snaps[i][1])
+            keep = cols["state"] != mt.STATE_LOST
+            order = np.argsort(cols["id"][keep], kind="stable")
+            x, z = cols["x"][keep][order], cols["z"][keep][order]
+            med = cols["medium"][keep][order]
+            st = cols["state"][keep][order]
+            step = max(1, int(math.ceil(len(x) / FRAME_PARTICLES)))
+            frames.append({"t": _round(ts), "x": [_round(v, 4) for v in x[::step]],
+                           "z": [_round(v, 4) for v in z[::step]],
+                           "c": [int(m) if s != mt.STATE_WALL else -1
+                                 for m, s in zip(med[::step], st[::step])]})
+    return {"path": os.path.abspath(run_dir), "summary": _plain(summary), "monitors": monitors,
+            "profiles": profiles, "frames": frames}
+
+
+# ---- the three kinds of page -------------------------------------------------------------------
+
+def _read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def _discretisation(em, output, n=RISK_POINTS, seed=0) -> dict | None:
+    """The study's discretisation error: finest level against the limit over the box."""
+    from . import multifidelity as M
+    m = em.models.get(output)
+    if m is None or not m.order:
+        return None
+    U = np.random.default_rng(seed).random((n, len(em.inputs)))
+    X = em.box[:, 0] + U * (em.box[:, 1] - em.box[:, 0])
+    fin, _ = em.predict(X, output, "finest")
+    lim, sd = em.predict(X, output, M.EXTRAPOLATED)
+    d = fin - lim
+    return {"output": output, "finest_dx": em.dxs[-1], "mean": float(np.mean(d)),
+            "mean_abs": float(np.mean(np.abs(d))), "max_abs": float(np.max(np.abs(d))),
+            "sd_limit_mean": float(np.mean(sd)), "order": m.order}
+
+
+def study_data(folder) -> dict:
+    """The page data of a multi-fidelity study folder (emulate study)."""
+    from . import multifidelity as M
+    from .store import open_store
+    ep = os.path.join(folder, "mf_emulator.json")
+    doc = _read_json(ep)
+    em = M.MFEmulator.from_json(doc)
+    study = _read_json(os.path.join(folder, "study.json")) if os.path.isfile(
+        os.path.join(folder, "study.json")) else {}
+    design = _read_json(os.path.join(folder, "mfdesign.json")) if os.path.isfile(
+        os.path.join(folder, "mfdesign.json")) else {}
+    sweep = _read_json(os.path.join(folder, "sweep.json")) if os.path.isfile(
+        os.path.join(folder, "sweep.json")) else {}
+    risk, sobol = study.get("risk") or {}, study.get("sobol") or {}
+    risk_output = risk.get("output") or next(iter(em.models))
+    df = open_store(folder).latest() if (os.path.isdir(os.path.join(folder, "results.parquet"))
+                                         or os.path.isfile(os.path.join(folder, "results.csv"))) else None
+    spec = design.get("spec") or {}
+    dists = spec.get("dists") or {}
+    inputs = []
+    for n, b in zip(em.inputs, em.box):
+        s = dists.get(n, "")
+        choices = None
+        if s.startswith("choice:"):
+            choices = [float(x) for x in s.split(":", 1)[1].split(",")]
+        inputs.append({"name": n, "lo": float(b[0]), "hi": float(b[1]), "dist": s,
+                       "choices": choices})
+    runs = None
+    cost = {}
+    if df is not None and not df.empty:
+        runs = runs_table(df, em.inputs, [o for o in ("max_run_up", "max_run_up_Z",
+                                                       "time_of_max_run_up") if o in df.columns])
+        ok = df[df["status"] == "ok"]
+        for dx in em.dxs:
+            c = ok.loc[np.isclose(ok["dx"].astype(float), dx), "cpu_time_s"].astype(float)
+            cost[f"{dx:g}"] = {"runs": int(len(c)), "median_cpu_s": _round(np.median(c)) if len(c) else None,
+                               "sum_cpu_s": _round(c.sum())}
+        cost["total_cpu_s"] = _round(df["cpu_time_s"].astype(float).sum())
+    validation = []
+    for p in sorted(glob.glob(os.path.join(glob.escape(folder), "*.json"))):
+        try:
+            v = _read_json(p)
+        except (OSError, ValueError):
+            continue
+        if isinstance(v, dict) and "metrics" in v and "level" in v:     # mf-validate --json
+            validation.append({"file": os.path.basename(p), "level": v["level"],
+                               "holdout_dx": v.get("holdout_dx"), "metrics": v["metrics"],
+                               "rms_z": v.get("rms_z")})
+    data = {
+        "kind": "study", "title": f"DSS study {os.path.basename(os.path.abspath(folder))}",
+        "folder": os.path.abspath(folder),
+        "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "emulator": export_mf(em), "inputs": inputs,
+        "risk": _plain(risk), "sobol": _plain(sobol), "risk_output": risk_output,
+        "design": _plain({"spec": spec, "stopped": design.get("stopped"),
+                          "budget_cpu_s": design.get("budget_cpu_s"),
+                          "batches": [{"kind": b.get("kind"), "n": len(b.get("ids", []))}
+                                      for b in design.get("batches", [])],
+                          "history": design.get("history", [])}),
+        "settings": _plain({k: v for k, v in sweep.items() if k != "fmu"}),
+        "cost": cost, "validation": _plain(validation),
+        "discretisation": _plain(_discretisation(em, risk_output)),
+        "versions": _plain({**versions(doc.get("fmu")), "emulator_file": doc.get("created"),
+                            "emulator_libraries": doc.get("library")}),
+        "runs": runs, "elapsed_s": study.get("elapsed_s"),
+        "checks": self_checks(em),
+    }
+    return data
+
+
+def self_checks(em, n=CHECK_POINTS, seed=1) -> list[dict]:
+    """Python's predictions at a few random points of the box, per output and level: the page
+    recomputes them when it opens and refuses to show numbers that differ (by over 1e-9)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for name in em.models:
+        for key, _ in level_keys(em):
+            X = em.box[:, 0] + rng.random((n, len(em.inputs))) * (em.box[:, 1] - em.box[:, 0])
+            try:
+                mu, sd = python_predict(em, name, key, X)
+            except Exception:        # a level this output has no extrapolation for
+                continue
+            out += [{"output": name, "level": key, "x": x.tolist(), "mean": float(m), "sd": float(s)}
+                    for x, m, s in zip(X, mu, sd)]
+    return out
+
+
+def sweep_data(folder, crest=None) -> dict:
+    """The page data of a sweep folder (dss sweep)."""
+    from .report import pick_runup, varied_params
+    from .store import open_store
+    df = open_store(folder).latest()
+    if df.empty:
+        raise PageError(f"{folder}: no results")
+    sweep = _read_json(os.path.join(folder, "sweep.json")) if os.path.isfile(
+        os.path.join(folder, "sweep.json")) else {}
+    outs = [o for o in ("max_run_up", "max_run_up_Z", "time_of_max_run_up") if o in df.columns]
+    inputs = [c for c in varied_params(df) if c not in outs and c != "series"]
+    ok = df[df["status"] == "ok"] if "status" in df.columns else df
+    ycol = None
+    if not ok.empty:
+        try:
+            ycol = pick_runup(ok)[0]
+        except ValueError:
+            ycol = None
+    fmu = {}
+    if sweep.get("fmu") and os.path.isfile(sweep["fmu"]):
+        try:
+            from .emulator import fmu_identity
+            fmu = fmu_identity(sweep["fmu"])
+        except Exception:
+            fmu = {"path": sweep["fmu"]}
+    return {"kind": "sweep", "title": f"DSS sweep {os.path.basename(os.path.abspath(folder))}",
+            "folder": os.path.abspath(folder),
+            "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+            "settings": _plain({k: v for k, v in sweep.items() if k != "fmu"}),
+            "inputs": [{"name": n, "lo": _round(ok[n].astype(float).min()) if not ok.empty else None,
+                        "hi": _round(ok[n].astype(float).max()) if not ok.empty else None,
+                        "values": int(df[n].nunique())} for n in inputs],
+            "y": ycol, "crest": crest, "runs": runs_table(df, inputs, outs),
+            "versions": _plain(versions(fmu))}
+
+
+def run_page_data(run_dir) -> dict:
+    r = run_data(run_dir)
+    return {"kind": "run", "title": f"mixsph run {os.path.basename(os.path.abspath(run_dir))}",
+            "folder": os.path.abspath(run_dir),
+            "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+            "run": r, "versions": _plain(versions())}
+
+
+def kind_of(folder) -> str:
+    if os.path.isfile(os.path.join(folder, "mf_emulator.json")):
+        return "study"
+    if os.path.isdir(os.path.join(folder, "results.parquet")) or \
+            os.path.isfile(os.path.join(folder, "results.csv")):
+        return "sweep"
+    if os.path.isfile(os.path.join(folder, "monitors.csv")):
+        return "run"
+    raise PageError(f"{folder}: neither a study (mf_emulator.json), a sweep (results.parquet or "
+                    f"results.csv) nor a mixsph run folder (monitors.csv)")
+
+
+# ---- the HTML ----------------------------------------------------------------------------------
+
+def render(data: dict) -> str:
+    """The page: Plotly's bundle, the data as one JSON block, report_page.js."""
+    from plotly.offline import get_plotlyjs
+    blob = json.dumps(_plain(data), separators=(",", ":"), allow_nan=False)
+    blob = blob.replace("</", "<\\/")            # no "</script>" inside the block
+    with open(os.path.join(_HERE, "report_page.js")) as f:
+        app = f.read()
+    with open(os.path.join(_HERE, "report_page.css")) as f:
+        css = f.read()
+    title = html.escape(data.get("title", "mixsph report"))
+    return (f"<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
+            f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n"
+            f"<title>{title}</title>\n<style>{css}</style>\n"
+            f"<script>{get_plotlyjs()}</script>\n</head>\n<body>\n"
+            f"<div id=\"page-status\" data-status=\"loading\">loading ...</div>\n"
+            f"<main id=\"app\"><h1>{title}</h1></main>\n"
+            f"<script type=\"application/json\" id=\"page-data\">{blob}</script>\n"
+            f"<script>{app}</script>\n</body></html>\n")
+
+
+def write_page(folder, out=None, crest=None) -> str:
+    """Write the page of a study, sweep or run folder (kind_of) to out (default
+    FOLDER/report.html); returns its path."""
+    kind = kind_of(folder)
+    data = {"study": study_data, "sweep": lambda f: sweep_data(f, crest),
+            "run": run_page_data}[kind](folder)
+    path = out or os.path.join(folder, PAGE)
+    tmp = path + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(render(data))
+    os.replace(tmp, path)
+    return path
