@@ -71,6 +71,10 @@ def build_parser():
     pg.add_argument("-o", "--out", help="the page (default DIR/report.html)")
     pg.add_argument("--crest", type=float, metavar="Z",
                     help="a sweep's elevation for the exceedance (a study has its own)")
+    pg.add_argument("--animate", type=int, default=3, metavar="N",
+                    help="runs of a study or sweep replayed with mixsph for a particle animation "
+                         "(the lowest, median, highest run-up; default 3; kept in DIR/replays)")
+    pg.add_argument("--mixsph", help="the mixsph executable of the replays (default build/mixsph)")
 
     sub.add_parser("emulate", help="the FMU's emulator: fit, predict, design, validate, risk, plot "
                                    "(emulate --help)", add_help=False)
@@ -113,7 +117,8 @@ def cmd_page(args):
     if not os.path.isdir(args.dir):
         raise UsageError(f"{args.dir}: no such folder")
     try:
-        path = write_page(args.dir, args.out, crest=args.crest)
+        path = write_page(args.dir, args.out, crest=args.crest, animate=args.animate,
+                          mixsph=args.mixsph)
     except PageError as e:
         raise UsageError(str(e)) from None
     print(f"dss page: wrote {path} ({os.path.getsize(path) / 1e6:.1f} MB; open it in a browser)")

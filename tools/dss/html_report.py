@@ -39,8 +39,9 @@ from .scenarios import ID
 
 PAGE = "report.html"
 SERIES_POINTS = 80          # monitors over time: at most this many points per run and series
-FRAMES = 40                 # particle animation: at most this many frames ...
-FRAME_PARTICLES = 4000      # ... of at most this many particles (every k-th particle)
+FRAMES = 25                 # particle animation: at most this many frames ...
+FRAME_PARTICLES = 2500      # ... of at most this many particles (every k-th particle)
+ANIMATE = 3                 # runs of a study or sweep replayed for their particles
 CHECK_POINTS = 3            # the page's self-check: points per output and level
 RISK_POINTS = 1000          # box points of the stated discretisation error (finest vs limit)
 _HERE = os.path.dirname(os.path.abspath(__file__))
@@ -272,6 +273,59 @@ def run_data(run_dir) -> dict:
             "profiles": profiles, "frames": frames}
 
 
+# ---- particles of a study's or sweep's runs (replayed with mixsph) ------------------------------
+
+def pick_runs(df, n) -> list[str]:
+    """n scenario ids spread over the run-up: the lowest, the highest, then the median, ... of
+    the ok runs at the finest dx."""
+    ok = df[df["status"] == "ok"] if "status" in df.columns else df
+    if ok.empty or n <= 0 or "max_run_up" not in ok.columns:
+        return []
+    if "dx" in ok.columns:
+        dx = ok["dx"].astype(float)
+        ok = ok[np.isclose(dx, dx.min())]
+    ok = ok.sort_values("max_run_up")
+    idx = np.unique(np.linspace(0, len(ok) - 1, min(n, len(ok))).round().astype(int))
+    return [str(ok.iloc[i][ID]) for i in idx]
+
+
+def animations(folder, df, settings, n, mixsph=None, log=print) -> dict:
+    """{scenario_id: {frames, max_run_up (the replay's), note}} of n runs replayed with mixsph,
+    or {'_note': why none}."""
+    import pandas as pd
+    from . import replay as RP
+    from .cli import UsageError
+    ids = pick_runs(df, n)
+    if not ids:
+        return {}
+    tab = os.path.join(folder, "scenarios.csv")
+    if not os.path.isfile(tab):
+        return {"_note": "no scenarios.csv: the runs' own parameters are unknown"}
+    sc = pd.read_csv(tab, dtype={ID: str})
+    rows = []
+    for sid in ids:
+        r = sc[sc[ID] == sid]
+        if not r.empty:
+            rows.append({k: v for k, v in r.iloc[0].to_dict().items()
+                         if not (isinstance(v, float) and math.isnan(v))})
+    try:
+        done = RP.replay(folder, rows, settings.get("fmu"), float(settings.get("stop_time") or 1.6),
+                         mixsph=mixsph, snapshots=FRAMES, log=log)
+    except UsageError as e:
+        log(f"dss page: no particle animation: {e}")
+        return {"_note": str(e)}
+    out = {}
+    for sid, run_dir in done.items():
+        try:
+            rd = run_data(run_dir)
+        except Exception as e:       # a replay's files unreadable: the page goes without it
+            log(f"dss page: replay {run_dir}: {e}")
+            continue
+        runup = ((rd["summary"].get("outputs") or {}).get("run_up") or {}).get("max")
+        out[sid] = {"frames": rd["frames"], "max_run_up": runup, "path": run_dir}
+    return out
+
+
 # ---- the three kinds of page -------------------------------------------------------------------
 
 def _read_json(path):
@@ -295,7 +349,7 @@ def _discretisation(em, output, n=RISK_POINTS, seed=0) -> dict | None:
             "sd_limit_mean": float(np.mean(sd)), "order": m.order}
 
 
-def study_data(folder) -> dict:
+def study_data(folder, animate=0, mixsph=None) -> dict:
     """The page data of a multi-fidelity study folder (emulate study)."""
     from . import multifidelity as M
     from .store import open_store
@@ -361,6 +415,7 @@ def study_data(folder) -> dict:
                             "emulator_libraries": doc.get("library")}),
         "runs": runs, "elapsed_s": study.get("elapsed_s"),
         "checks": self_checks(em),
+        "animations": animations(folder, df, sweep, animate, mixsph) if df is not None else {},
     }
     return data
 
@@ -382,7 +437,7 @@ def self_checks(em, n=CHECK_POINTS, seed=1) -> list[dict]:
     return out
 
 
-def sweep_data(folder, crest=None) -> dict:
+def sweep_data(folder, crest=None, animate=0, mixsph=None) -> dict:
     """The page data of a sweep folder (dss sweep)."""
     from .report import pick_runup, varied_params
     from .store import open_store
@@ -415,6 +470,7 @@ def sweep_data(folder, crest=None) -> dict:
                         "hi": _round(ok[n].astype(float).max()) if not ok.empty else None,
                         "values": int(df[n].nunique())} for n in inputs],
             "y": ycol, "crest": crest, "runs": runs_table(df, inputs, outs),
+            "animations": animations(folder, df, sweep, animate, mixsph),
             "versions": _plain(versions(fmu))}
 
 
@@ -460,11 +516,13 @@ def render(data: dict) -> str:
             f"<script>{app}</script>\n</body></html>\n")
 
 
-def write_page(folder, out=None, crest=None) -> str:
+def write_page(folder, out=None, crest=None, animate=ANIMATE, mixsph=None) -> str:
     """Write the page of a study, sweep or run folder (kind_of) to out (default
-    FOLDER/report.html); returns its path."""
+    FOLDER/report.html); returns its path. animate: runs of a study or sweep replayed with
+    mixsph for their particles (replay.py; kept in FOLDER/replays for the next page)."""
     kind = kind_of(folder)
-    data = {"study": study_data, "sweep": lambda f: sweep_data(f, crest),
+    data = {"study": lambda f: study_data(f, animate, mixsph),
+            "sweep": lambda f: sweep_data(f, crest, animate, mixsph),
             "run": run_page_data}[kind](folder)
     path = out or os.path.join(folder, PAGE)
     tmp = path + ".tmp"

@@ -189,9 +189,16 @@
     t.append(tb);
     const wrap = el("div", { class: "scroll" }, t);
     s.append(el("p", { class: "hint", text: `${runs.rows.length} runs; click a column to sort, a row to see the run.` }), wrap);
+    const anims = D.animations || {};
     const title = el("h3", { id: "run-title", text: "" });
     const plot = el("div", { id: "run-plot", class: "plot" });
-    s.append(title, plot);
+    const animBox = el("div", { id: "run-animation" });
+    const animIds = Object.keys(anims).filter((k) => k !== "_note");
+    s.append(el("p", { class: "hint", text: animIds.length
+      ? `The runs marked * (${animIds.length}: the lowest, median and highest run-up at the finest dx) were replayed with mixsph for their particles: click one to animate it.`
+      : "No run was replayed for its particles" + (anims._note ? ": " + anims._note : " (python -m tools.dss page DIR --animate N replays N runs).") }));
+    s.append(title, plot, animBox);
+    runs.rows.forEach((r, i) => { if (anims[r[0]]) tb.children[i].children[0].textContent = r[0] + " *"; });
     let dir = {};
     function sortBy(j) {
       dir[j] = -(dir[j] || -1);
@@ -210,6 +217,12 @@
       const ser = runs.series[i];
       const id = runs.rows[i][0];
       title.textContent = "Run " + id;
+      animBox.textContent = "";
+      const an = anims[id];
+      if (an) {
+        const yj = runs.columns.indexOf("max_run_up");
+        animation(animBox, an.frames, `Replayed with mixsph (${an.path}): its max run-up ${fmt(an.max_run_up)} m, the FMU run's ${fmt(yj >= 0 ? runs.rows[i][yj] : null)} m (the same library and scenario; the monitors' sampling may differ).`);
+      }
       if (!ser || !ser.time) {
         Plotly.purge(plot);
         plot.textContent = "This run recorded no monitors over time.";
@@ -237,6 +250,8 @@
       target.append(el("p", { text: "No particle snapshots in this run's folder." }));
       return;
     }
+    const old = document.getElementById("animation");
+    if (old) Plotly.purge(old);
     const div = el("div", { id: "animation", class: "plot" });
     target.append(div);
     if (caption) target.append(el("p", { class: "caption", text: caption }));
@@ -376,22 +391,29 @@
       const traces = [], layout = { height: 260, margin: { t: 30, l: 60, r: 10, b: 50 }, showlegend: false,
         grid: { rows: 1, columns: n, pattern: "independent" } };
       EM.inputs.forEach((inp, j) => {
-        const xs = [], m = [], lo = [], hi = [];
-        for (let k = 0; k < npts; k++) {
-          const v = inp.lo + ((inp.hi - inp.lo) * k) / (npts - 1);
+        // a choice input (saturated 0/1) only at its values; a continuous one over its box
+        const ch = (inputs[j].choices || []).slice().sort((a, b) => a - b);
+        const vals = ch.length ? ch : Array.from({ length: npts }, (_, k) => inp.lo + ((inp.hi - inp.lo) * k) / (npts - 1));
+        const xs = [], m = [], lo = [], hi = [], half = [];
+        for (const v of vals) {
           const xx = x.slice();
           xx[j] = v;
           const p = predict(out, lv, xx);
-          xs.push(v); m.push(p.mean); lo.push(p.mean - 1.959963984540054 * p.sd); hi.push(p.mean + 1.959963984540054 * p.sd);
+          xs.push(v); m.push(p.mean); half.push(1.959963984540054 * p.sd);
+          lo.push(p.mean - 1.959963984540054 * p.sd); hi.push(p.mean + 1.959963984540054 * p.sd);
         }
         const ax = j ? String(j + 1) : "";
-        traces.push({ x: xs, y: hi, mode: "lines", line: { width: 0 }, xaxis: "x" + ax, yaxis: "y" + ax, hoverinfo: "skip" });
-        traces.push({ x: xs, y: lo, mode: "lines", line: { width: 0 }, fill: "tonexty", fillcolor: "rgba(31,119,180,0.2)", xaxis: "x" + ax, yaxis: "y" + ax, name: "95 %" });
-        traces.push({ x: xs, y: m, mode: "lines", line: { color: "#1f77b4" }, xaxis: "x" + ax, yaxis: "y" + ax, name: out });
+        if (ch.length) {
+          traces.push({ x: xs, y: m, mode: "markers", marker: { color: "#1f77b4", size: 9 }, error_y: { type: "data", array: half }, xaxis: "x" + ax, yaxis: "y" + ax, name: out });
+        } else {
+          traces.push({ x: xs, y: hi, mode: "lines", line: { width: 0 }, xaxis: "x" + ax, yaxis: "y" + ax, hoverinfo: "skip" });
+          traces.push({ x: xs, y: lo, mode: "lines", line: { width: 0 }, fill: "tonexty", fillcolor: "rgba(31,119,180,0.2)", xaxis: "x" + ax, yaxis: "y" + ax, name: "95 %" });
+          traces.push({ x: xs, y: m, mode: "lines", line: { color: "#1f77b4" }, xaxis: "x" + ax, yaxis: "y" + ax, name: out });
+        }
         traces.push({ x: [x[j]], y: [predict(out, lv, x).mean], mode: "markers", marker: { color: "#d62728", size: 8 }, xaxis: "x" + ax, yaxis: "y" + ax, name: "sliders" });
         if (crest !== undefined && out === R.output)
           traces.push({ x: [inp.lo, inp.hi], y: [crest, crest], mode: "lines", line: { color: "black", dash: "dash", width: 1 }, xaxis: "x" + ax, yaxis: "y" + ax, name: "crest" });
-        layout["xaxis" + ax] = { title: { text: inp.name } };
+        layout["xaxis" + ax] = { title: { text: inp.name }, ...(ch.length ? { tickvals: ch, range: [ch[0] - 0.3 * (ch[ch.length - 1] - ch[0] || 1), ch[ch.length - 1] + 0.3 * (ch[ch.length - 1] - ch[0] || 1)] } : {}) };
         layout["yaxis" + ax] = { title: j ? undefined : { text: out } };
       });
       Plotly.react(sweepDiv, traces, layout, PLOT_CFG);
@@ -422,17 +444,16 @@
         zh.push(rh);
       }
       const traces = [
-        { type: "contour", x: xs, y: ys, z: zm, colorscale: "Viridis", colorbar: { x: 0.45, title: { text: out, side: "right" } }, contours: { showlabels: true }, xaxis: "x", yaxis: "y", name: "mean" },
-        { type: "contour", x: xs, y: ys, z: zh, colorscale: "Reds", colorbar: { x: 1.0, title: { text: "95 % half-width", side: "right" } }, xaxis: "x2", yaxis: "y2", name: "95 % half-width" },
+        { type: "contour", x: xs, y: ys, z: zm, colorscale: "Viridis", colorbar: { x: 0.4, len: 0.9, thickness: 14, title: { text: out, side: "right" } }, contours: { showlabels: true }, xaxis: "x", yaxis: "y", name: "mean" },
+        { type: "contour", x: xs, y: ys, z: zh, colorscale: "Reds", colorbar: { x: 0.97, len: 0.9, thickness: 14, title: { text: "95 % half-width", side: "right" } }, xaxis: "x2", yaxis: "y2", name: "95 % half-width" },
         { x: [x[jx]], y: [x[jy]], mode: "markers", marker: { color: "white", size: 9, line: { color: "black", width: 1 } }, xaxis: "x", yaxis: "y", name: "sliders", showlegend: false },
       ];
       if (crest !== undefined && out === R.output)
         traces.push({ type: "contour", x: xs, y: ys, z: zm, showscale: false, contours: { start: crest, end: crest, size: 1, coloring: "none", showlabels: true }, line: { color: "red", width: 2, dash: "dash" }, xaxis: "x", yaxis: "y", name: "crest", hoverinfo: "skip" });
       Plotly.react(surfDiv, traces, {
         height: 380, margin: { t: 40, l: 60, r: 40, b: 50 },
-        grid: { rows: 1, columns: 2, pattern: "independent", xgap: 0.15 },
-        xaxis: { title: { text: ix.name }, domain: [0, 0.4] }, yaxis: { title: { text: iy.name } },
-        xaxis2: { title: { text: ix.name }, domain: [0.55, 0.95] }, yaxis2: { title: { text: iy.name }, anchor: "x2" },
+        xaxis: { title: { text: ix.name }, domain: [0, 0.34] }, yaxis: { title: { text: iy.name } },
+        xaxis2: { title: { text: ix.name }, domain: [0.55, 0.89] }, yaxis2: { title: { text: iy.name }, anchor: "x2" },
         title: { text: `mean (left, crest dashed red) and 95 % half-width (right) at ${lvSel.options[lvSel.selectedIndex].text}`, font: { size: 13 } },
       }, PLOT_CFG);
     }
@@ -504,7 +525,7 @@
     is.append(table(["dx [m]", "runs", "median CPU s a run", "CPU s"], Object.entries(cost).filter(([k]) => k !== "total_cpu_s").map(([k, c]) => [k, c.runs, c.median_cpu_s, c.sum_cpu_s])));
     is.append(el("h3", { text: "versions" }), kv(versionPairs(D.versions)));
 
-    runsSection(D.runs, "Every FMU run of the study, at every level. Clicking a run shows the monitors the FMU reported at each communication step. The FMU writes no particle files, so no animation here: `python -m tools.dss page RUN_DIR` draws one for a mixsph run folder.");
+    runsSection(D.runs, "Every FMU run of the study, at every level. Clicking a run shows the monitors the FMU reported at each communication step. The FMU writes no particle files: a few runs are replayed with mixsph for theirs.");
   }
 
   // ---- the sweep page ------------------------------------------------------------------------
@@ -569,7 +590,7 @@
       Plotly.newPlot(pd, r.profiles.map((p) => ({ x: p.x, y: p.z, mode: "lines", name: `${p.name} t = ${fmt(p.t)} s`, connectgaps: false })),
         { height: 380, margin: { t: 20, l: 70, r: 20, b: 50 }, xaxis: { title: { text: "x [m]" } }, yaxis: { title: { text: "z [m]" } } }, PLOT_CFG);
     }
-    const as = section("particles", "Particles", "The particle snapshots of the run, decimated (every k-th particle, at most 40 frames): play or drag the time slider.");
+    const as = section("particles", "Particles", "The particle snapshots of the run, decimated (every k-th particle, at most 25 frames): play or drag the time slider.");
     animation(as, r.frames);
   }
 
