@@ -255,3 +255,34 @@ def test_page_refuses_a_folder_that_is_no_study_sweep_or_run(tmp_path):
                        capture_output=True, text=True, timeout=120)
     assert r.returncode == 2
     assert "neither a study (mf_emulator.json), a sweep" in r.stderr, r.stderr
+
+
+def test_every_fmu_parameter_names_its_case_key_for_the_replays():
+    from tools.dss import replay as RP
+    keys = RP.case_keys(os.path.join(ROOT, "modelDescription.xml"))
+    from fmpy import read_model_description
+    md = read_model_description(os.path.join(ROOT, "modelDescription.xml"))
+    params = {v.name for v in md.modelVariables if v.causality == "parameter"}
+    assert set(keys) == params - {"case_file", "threads"}, sorted(params - set(keys))
+    assert keys["phi"] == "parameters.phi" and keys["dx"] == "numerics.dx"
+    assert keys["implicit_viscosity"] == "numerics.viscosity"
+    assert keys["output_interval"] == "output.monitor_interval"
+
+
+def test_a_replayed_run_has_the_fmu_runs_max_run_up(tmp_path):
+    """A scenario run by the FMU and replayed with mixsph (coarse and short) gives the same max
+    run-up, and the replay has the snapshots the page animates."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from tool_helpers import built
+    from tools.dss import fmu_run, replay as RP
+    mixsph = built("mixsph")
+    fmu = built("LandslideWave.fmu")
+    scen = {"scenario_id": "r1", "reservoir_level": 0.46, "phi": 30.0, "dx": 0.05}
+    res = fmu_run.run_scenario(fmu_run.read_fmu_bytes(fmu), {k: v for k, v in scen.items()
+                                                           if k != "scenario_id"},
+                               {"stop_time": 0.4, "step": 0.05, "threads": 1})
+    assert res["status"] == "ok", res["error"]
+    done = RP.replay(str(tmp_path), [scen], fmu, 0.4, mixsph=mixsph, snapshots=4, log=print)
+    rd = H.run_data(done["r1"])
+    assert rd["summary"]["outputs"]["run_up"]["max"] == pytest.approx(res["max_run_up"], abs=1e-9)
+    assert len(rd["frames"]) == 5

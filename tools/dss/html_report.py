@@ -111,7 +111,7 @@ def level_keys(em) -> list[tuple[str, str]]:
     """(key, label) of the levels the page offers: the limit first when there is one."""
     from . import multifidelity as M
     keys = []
-    if any(m.order for m in em.models.values()):
+    if em.models and all(m.order for m in em.models.values()):
         keys.append((M.EXTRAPOLATED, "dx -> 0 (extrapolated)"))
     last = len(em.dxs) - 1
     for i in range(last, -1, -1):
