@@ -174,8 +174,8 @@ def _edit(fn):
 
 
 def _scale_length(d):
-    g = d["emulator"]["outputs"]["max_run_up_Z"]["gps"][0]
-    g["ls"] = [v * 1.001 for v in g["ls"]]
+    f = d["emulator"]["outputs"]["max_run_up_Z"]["gps"][0]["factors"][0]
+    f["ls"] = [v * 1.001 for v in f["ls"]]
 
 
 def _scale_length_no_self_check(d):
@@ -223,10 +223,12 @@ def test_the_sweep_page_sorts_its_runs_and_shows_a_runs_monitors(browser, tmp_pa
         page.click(f"#runs-table th:nth-child({j + 1})")
         hi = first()
         assert float(lo) < float(hi), (lo, hi)
-        # a run's monitors: the run-up series of the clicked run
+        # a run's monitors: the run-up series of the clicked run, drawn (after another run's)
+        page.click("#runs-table tbody tr:nth-child(2)")
         page.click("#runs-table tbody tr:nth-child(1)")
         y = page.evaluate("document.getElementById('run-plot').data.find(t => t.name === 'run_up').y")
         assert max(y) == pytest.approx(float(hi), rel=1e-5)
+        assert page.locator("#run-plot .main-svg .scatterlayer .trace").count() >= 3
         assert page.locator("#exceedance-plot .main-svg").count() > 0
         assert_page_ok(page, errors)
     finally:

@@ -40,7 +40,7 @@ from .scenarios import ID
 PAGE = "report.html"
 SERIES_POINTS = 80          # monitors over time: at most this many points per run and series
 FRAMES = 25                 # particle animation: at most this many frames ...
-FRAME_PARTICLES = 2500      # ... of at most this many particles (every k-th particle)
+FRAME_PARTICLES = 1500      # ... of at most this many particles (every k-th particle)
 ANIMATE = 3                 # runs of a study or sweep replayed for their particles
 CHECK_POINTS = 3            # the page's self-check: points per output and level
 RISK_POINTS = 1000          # box points of the stated discretisation error (finest vs limit)
@@ -90,21 +90,63 @@ def _plain(obj):
 
 # ---- the emulator for the browser --------------------------------------------------------------
 
-def export_delta(g) -> dict:
-    """One delta GP (multifidelity.DeltaGP) as the page evaluates it: latent mean
-    k(x, X) alpha * std + mean and variance (c - |L^-1 k(x, X)|^2) std^2, k = c Matern_5/2."""
-    gp = g.gp
+def _factors(k, d) -> list[dict]:
+    """The kernel factors (a product of Matern 5/2 and RBF kernels, each with its length
+    scales over the GP's d columns) of a fitted kernel without its constant."""
+    from sklearn.gaussian_process.kernels import RBF, Matern, Product
+    if isinstance(k, Product):
+        return _factors(k.k1, d) + _factors(k.k2, d)
+    ls = np.broadcast_to(np.asarray(k.length_scale, float), (d,)).tolist()
+    if isinstance(k, Matern):
+        if float(k.nu) != 2.5:
+            raise PageError(f"the page evaluates Matern 5/2 kernels only (nu = {k.nu})")
+        return [{"type": "matern52", "ls": ls}]
+    if isinstance(k, RBF):
+        return [{"type": "rbf", "ls": ls}]
+    raise PageError(f"the page cannot evaluate the kernel {k}")
+
+
+def export_gp(gp, mean, std, noise=None) -> dict:
+    """A fitted GaussianProcessRegressor whose kernel is ConstantKernel * (product of Matern 5/2
+    and RBF factors) + WhiteKernel, as the page evaluates it: latent mean k(x, X) alpha * std +
+    mean and variance (c - |L^-1 k(x, X)|^2) std^2 (its own noise, noise_level std^2, added
+    where the form says so)."""
     k1 = gp.kernel_.k1
-    c = float(k1.k1.constant_value)
-    ls = np.broadcast_to(np.asarray(k1.k2.length_scale, float), (gp.X_train_.shape[1],))
-    if float(k1.k2.nu) != 2.5:
-        raise PageError(f"the page evaluates Matern 5/2 kernels only (nu = {k1.k2.nu})")
+    d = int(gp.X_train_.shape[1])
     L = np.asarray(gp.L_, float)
     n = L.shape[0]
-    return {"n": int(n), "d": int(gp.X_train_.shape[1]), "c": c, "ls": ls.tolist(),
-            "mean": float(g.mean), "std": float(g.std),
+    return {"n": int(n), "d": d, "c": float(k1.k1.constant_value), "factors": _factors(k1.k2, d),
+            "mean": float(mean), "std": float(std), "noise": noise,
             "X": f64(gp.X_train_), "alpha": f64(np.ravel(gp.alpha_)),
             "L": f64(L[np.tril_indices(n)])}
+
+
+def export_delta(g) -> dict:
+    """One delta GP of the multi-fidelity emulator (multifidelity.DeltaGP.predict)."""
+    return export_gp(g.gp, g.mean, g.std)
+
+
+def export_sf(em) -> dict:
+    """The single-fidelity emulator (emulator.Emulator, emulate fit/design): per output its
+    GP, or one per level of the binary inputs (mode separate), routed by them; the prediction
+    is the GP's mean and its variance with its own fitted noise (OutputModel.predict)."""
+    outs = {}
+    for name, m in em.models.items():
+        keys = list(m.parts)
+        gps = [export_gp(m.parts[k], m.y_mean, m.y_std,
+                         noise=float(m.parts[k].kernel_.k2.noise_level)) for k in keys]
+        route = ({"bin": m.bin_idx, "cont": m.cont_idx,
+                  "parts": {",".join(str(int(v)) for v in k): i for i, k in enumerate(keys)}}
+                 if m.split else None)
+        cv = (em.cv.get(name) or {})
+        outs[name] = {"gps": gps, "forms": {"sf": {"coef": [1.0], "order": None, "noise": None,
+                                                   "scale": 1.0, "route": route}},
+                      "mode": m.mode,
+                      "cv": {k: cv.get(k) for k in ("n", "rmse", "rmse_pct", "max_error_pct",
+                                                    "coverage95", "folds", "mode")} if cv else None}
+    return {"kind": "sf", "inputs": [{"name": n, "lo": float(b[0]), "hi": float(b[1]), "kind": k}
+                                     for n, k, b in zip(em.inputs, em.kinds, em.box)],
+            "levels": [{"key": "sf", "label": "the runs' dx"}], "outputs": outs}
 
 
 def level_keys(em) -> list[tuple[str, str]]:
@@ -141,11 +183,18 @@ def export_mf(em) -> dict:
 
 
 def python_predict(em, output, level_key, X):
-    """The emulator's prediction as the page's key names it (for the tests and the page's own
-    self-check numbers)."""
+    """The emulator's (mean, sd) as the page's level key names it: a multi-fidelity level
+    ('extrapolated' or a level's index) or 'sf' (the single-fidelity emulator)."""
     from . import multifidelity as M
+    X = np.atleast_2d(np.asarray(X, float))
+    if level_key == "sf":
+        return em.predict(X, [output])[output]
     lv = level_key if level_key == M.EXTRAPOLATED else em.dxs[int(level_key)]
-    return em.predict(np.atleast_2d(X), output, lv)
+    return em.predict(X, output, lv)
+
+
+def page_levels(em) -> list[str]:
+    return ["sf"] if not hasattr(em, "dxs") else [k for k, _ in level_keys(em)]
 
 
 # ---- what every page has -----------------------------------------------------------------------
@@ -426,7 +475,7 @@ def self_checks(em, n=CHECK_POINTS, seed=1) -> list[dict]:
     rng = np.random.default_rng(seed)
     out = []
     for name in em.models:
-        for key, _ in level_keys(em):
+        for key in page_levels(em):
             X = em.box[:, 0] + rng.random((n, len(em.inputs))) * (em.box[:, 1] - em.box[:, 0])
             try:
                 mu, sd = python_predict(em, name, key, X)
@@ -462,7 +511,19 @@ def sweep_data(folder, crest=None, animate=0, mixsph=None) -> dict:
             fmu = fmu_identity(sweep["fmu"])
         except Exception:
             fmu = {"path": sweep["fmu"]}
-    return {"kind": "sweep", "title": f"DSS sweep {os.path.basename(os.path.abspath(folder))}",
+    extra = {}
+    ep = os.path.join(folder, "emulator.json")
+    if os.path.isfile(ep):
+        # an emulator of these runs (emulate fit / design): the prediction panel
+        from . import emulator as E
+        doc = _read_json(ep)
+        em = E.Emulator.from_json(doc)
+        extra = {"emulator": export_sf(em), "checks": self_checks(em),
+                 "emulator_inputs": [{"name": n, "lo": float(b[0]), "hi": float(b[1]),
+                                      "choices": [0.0, 1.0] if k == "binary" else None}
+                                     for n, k, b in zip(em.inputs, em.kinds, em.box)],
+                 "emulator_created": doc.get("created")}
+    return {**extra, "kind": "sweep", "title": f"DSS sweep {os.path.basename(os.path.abspath(folder))}",
             "folder": os.path.abspath(folder),
             "created": _dt.datetime.now(_dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
             "settings": _plain({k: v for k, v in sweep.items() if k != "fmu"}),

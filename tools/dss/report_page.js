@@ -85,30 +85,43 @@
   }
   function prepareGP(g, what) {
     if (!(g.n > 0 && g.d > 0)) fail(`${what}: no training runs`);
-    if (!Array.isArray(g.ls) || g.ls.length !== g.d || !g.ls.every((v) => v > 0)) fail(`${what}: length scales`);
+    if (!Array.isArray(g.factors) || !g.factors.length) fail(`${what}: no kernel factors`);
+    for (const f of g.factors) {
+      if (f.type !== "matern52" && f.type !== "rbf") fail(`${what}: unknown kernel factor ${f.type}`);
+      if (!Array.isArray(f.ls) || f.ls.length !== g.d || !f.ls.every((v) => v > 0)) fail(`${what}: length scales`);
+    }
     if (!(g.c > 0) || !(g.std > 0) || !isFinite(g.mean)) fail(`${what}: constant, mean or sd`);
+    if (g.noise !== null && g.noise !== undefined && !(g.noise >= 0)) fail(`${what}: noise`);
     const L = f64(g.L, (g.n * (g.n + 1)) / 2, what + " L");
     for (let i = 0, off = 0; i < g.n; off += ++i) if (!(L[off + i] > 0)) fail(`${what}: L is not a Cholesky factor`);
     return {
-      n: g.n, d: g.d, c: g.c, ls: g.ls, mean: g.mean, std: g.std, L: L,
+      n: g.n, d: g.d, c: g.c, factors: g.factors, mean: g.mean, std: g.std, noise: g.noise || 0, L: L,
       X: f64(g.X, g.n * g.d, what + " X"), alpha: f64(g.alpha, g.n, what + " alpha"),
       ks: new Float64Array(g.n), w: new Float64Array(g.n),
     };
   }
-  // latent mean and variance of one delta GP at unit-box inputs u: c Matern_5/2 kernel, the
+  // latent mean and variance of one GP at inputs u (its own columns of the unit box), and its
+  // own noise variance: the kernel c times Matern 5/2 and RBF factors (scikit-learn's), the
   // weights alpha and the Cholesky factor L of the fitted GP (multifidelity.DeltaGP.predict)
   function gpPredict(g, u) {
     const n = g.n, d = g.d, X = g.X, ks = g.ks, w = g.w, L = g.L;
     let m = 0;
     for (let i = 0; i < n; i++) {
-      let r2 = 0;
-      for (let j = 0; j < d; j++) {
-        const t = (u[j] - X[i * d + j]) / g.ls[j];
-        r2 += t * t;
+      let k = g.c;
+      for (const f of g.factors) {
+        let r2 = 0;
+        for (let j = 0; j < d; j++) {
+          const t = (u[j] - X[i * d + j]) / f.ls[j];
+          r2 += t * t;
+        }
+        if (f.type === "rbf") k *= Math.exp(-0.5 * r2);
+        else {
+          const r = Math.sqrt(r2) * Math.sqrt(5);
+          k *= (1 + r + (r * r) / 3) * Math.exp(-r);
+        }
       }
-      const r = Math.sqrt(r2) * Math.sqrt(5);
-      ks[i] = g.c * (1 + r + (r * r) / 3) * Math.exp(-r);
-      m += ks[i] * g.alpha[i];
+      ks[i] = k;
+      m += k * g.alpha[i];
     }
     let q = 0;
     for (let i = 0, off = 0; i < n; off += ++i) {
@@ -117,41 +130,51 @@
       w[i] = s / L[off + i];
       q += w[i] * w[i];
     }
-    return [m * g.std + g.mean, Math.max(g.c - q, 0) * g.std * g.std];
+    return [m * g.std + g.mean, Math.max(g.c - q, 0) * g.std * g.std, g.noise * g.std * g.std];
   }
 
   let EM = null;
   function prepareEmulator(e) {
-    if (!e || e.kind !== "mf") fail("no multi-fidelity emulator in the data");
-    const out = { inputs: e.inputs, levels: e.levels, outputs: {} };
+    if (!e || (e.kind !== "mf" && e.kind !== "sf")) fail("no emulator in the data");
+    const out = { kind: e.kind, inputs: e.inputs, levels: e.levels, outputs: {} };
     for (const [name, o] of Object.entries(e.outputs || {})) {
-      const gps = o.gps.map((g, k) => prepareGP(g, `${name} level ${k}`));
+      const gps = o.gps.map((g, k) => prepareGP(g, `${name} GP ${k}`));
       for (const [key, f] of Object.entries(o.forms)) {
         if (!Array.isArray(f.coef) || f.coef.length > gps.length || !f.coef.every(isFinite)) fail(`${name} ${key}: coefficients`);
         if (f.order && f.order.length !== f.coef.length) fail(`${name} ${key}: order coefficients`);
-        if (!(f.noise >= 0) || !(f.scale > 0)) fail(`${name} ${key}: noise or scale`);
+        if (!(f.noise === null || f.noise >= 0) || !(f.scale > 0)) fail(`${name} ${key}: noise or scale`);
+        if (f.route && !Object.values(f.route.parts).every((i) => gps[i])) fail(`${name} ${key}: routes`);
       }
       out.outputs[name] = { gps: gps, forms: o.forms, raw: o };
     }
     if (!Object.keys(out.outputs).length) fail("the emulator has no output");
     return out;
   }
-  // the prediction at a level: the linear form of the delta GPs that Python's
-  // OutputMF.linear_form gives (multifidelity.OutputMF.predict_form)
+  // the prediction at a level: the linear form of the GPs that Python's
+  // OutputMF.linear_form gives (multifidelity.OutputMF.predict_form); for a single-fidelity
+  // emulator one GP (the one of the binary inputs' level in mode separate) with its own noise
   function predict(output, level, x) {
     const o = EM.outputs[output];
     if (!o) throw new Error("no output " + output);
     const f = o.forms[level];
     if (!f) throw new Error("no level " + level);
-    const u = EM.inputs.map((inp, j) => (x[j] - inp.lo) / (inp.hi - inp.lo));
-    let mean = 0, v = 0, om = 0;
+    let u = EM.inputs.map((inp, j) => (x[j] - inp.lo) / (inp.hi - inp.lo));
+    let gps = o.gps;
+    if (f.route) {
+      const key = f.route.bin.map((j) => Math.round(Math.min(1, Math.max(0, u[j])))).join(",");
+      if (!(key in f.route.parts)) return { mean: NaN, sd: NaN };
+      gps = [o.gps[f.route.parts[key]]];
+      u = f.route.cont.map((j) => u[j]);
+    }
+    let mean = 0, v = 0, om = 0, own = 0;
     for (let k = 0; k < f.coef.length; k++) {
-      const [m, vk] = gpPredict(o.gps[k], u);
+      const [m, vk, nk] = gpPredict(gps[k], u);
       mean += f.coef[k] * m;
       v += f.coef[k] * f.coef[k] * vk;
+      own += f.coef[k] * f.coef[k] * nk;
       if (f.order) om += f.order[k] * m;
     }
-    const vt = (v + f.noise) * f.scale * f.scale + (f.order ? om * om : 0);
+    const vt = (v + (f.noise === null ? own : f.noise)) * f.scale * f.scale + (f.order ? om * om : 0);
     return { mean: mean, sd: Math.sqrt(vt) };
   }
   // the page's self-check: Python's predictions at a few points, recomputed here
@@ -193,11 +216,12 @@
     const title = el("h3", { id: "run-title", text: "" });
     const plot = el("div", { id: "run-plot", class: "plot" });
     const animBox = el("div", { id: "run-animation" });
+    const runNote = el("p", { class: "hint" });
     const animIds = Object.keys(anims).filter((k) => k !== "_note");
     s.append(el("p", { class: "hint", text: animIds.length
       ? `The runs marked * (${animIds.length}: the lowest, median and highest run-up at the finest dx) were replayed with mixsph for their particles: click one to animate it.`
       : "No run was replayed for its particles" + (anims._note ? ": " + anims._note : " (python -m tools.dss page DIR --animate N replays N runs).") }));
-    s.append(title, plot, animBox);
+    s.append(title, runNote, plot, animBox);
     runs.rows.forEach((r, i) => { if (anims[r[0]]) tb.children[i].children[0].textContent = r[0] + " *"; });
     let dir = {};
     function sortBy(j) {
@@ -217,6 +241,8 @@
       const ser = runs.series[i];
       const id = runs.rows[i][0];
       title.textContent = "Run " + id;
+      const oldAnim = document.getElementById("animation");
+      if (oldAnim) Plotly.purge(oldAnim);
       animBox.textContent = "";
       const an = anims[id];
       if (an) {
@@ -225,10 +251,10 @@
       }
       if (!ser || !ser.time) {
         Plotly.purge(plot);
-        plot.textContent = "This run recorded no monitors over time.";
+        runNote.textContent = "This run recorded no monitors over time.";
         return;
       }
-      plot.textContent = "";
+      runNote.textContent = "";
       const names = Object.keys(ser).filter((k) => k !== "time");
       const traces = names.map((k, j) => ({
         x: ser.time, y: ser[k], name: k, mode: "lines", xaxis: "x", yaxis: j ? "y" + (j + 1) : "y",
@@ -250,8 +276,6 @@
       target.append(el("p", { text: "No particle snapshots in this run's folder." }));
       return;
     }
-    const old = document.getElementById("animation");
-    if (old) Plotly.purge(old);
     const div = el("div", { id: "animation", class: "plot" });
     target.append(div);
     if (caption) target.append(el("p", { class: "caption", text: caption }));
@@ -267,12 +291,22 @@
       height: 420, margin: { t: 30, l: 60, r: 20, b: 40 },
       xaxis: { range: [xmin, xmax], title: { text: "x [m]" } },
       yaxis: { range: [zmin, zmax], title: { text: "z [m]" }, scaleanchor: "x" },
-      title: { text: "particles (water blue, granular brown, walls grey)", font: { size: 13 } },
+      title: { text: "particles coloured by medium (0 blue, 1 brown, 2 green; walls grey)", font: { size: 13 } },
       updatemenus: [{ type: "buttons", showactive: false, x: 0, y: -0.15, xanchor: "left", buttons: [
         { label: "play", method: "animate", args: [null, { frame: { duration: 150, redraw: true }, fromcurrent: true, transition: { duration: 0 } }] },
         { label: "pause", method: "animate", args: [[null], { mode: "immediate", frame: { duration: 0 } }] }] }],
       sliders: [{ x: 0.15, len: 0.85, y: -0.1, currentvalue: { prefix: "t = ", suffix: " s" }, steps: steps }],
     }, PLOT_CFG).then(() => Plotly.addFrames(div, frames.map((f, i) => ({ name: "f" + i, data: [tr(f)] }))));
+  }
+
+  // "start: 28 runs; 83 batches cost-aware (finest): 274 runs"
+  function groupBatches(batches) {
+    const g = [];
+    for (const b of batches) {
+      const last = g[g.length - 1];
+      if (last && last.kind === b.kind) { last.k++; last.n += b.n; } else g.push({ kind: b.kind, k: 1, n: b.n });
+    }
+    return g.map((x) => (x.k > 1 ? `${x.k} batches ${x.kind}: ${x.n} runs` : `${x.kind}: ${x.n} runs`)).join("; ");
   }
 
   // ---- versions and settings -----------------------------------------------------------------
@@ -289,40 +323,23 @@
     ];
   }
 
-  // ---- the study page ------------------------------------------------------------------------
-  function studyPage() {
-    EM = prepareEmulator(D.emulator);
-    selfCheck(D.checks);
+  // the prediction panel, the one-input sweeps and the two-input maps, all from predict():
+  // P = {riskOut, R: {crest, output, level}, inputs, sobol, caption}
+  function predictionPanel(P) {
     const outputs = Object.keys(EM.outputs);
-    const riskOut = D.risk_output && EM.outputs[D.risk_output] ? D.risk_output : outputs[0];
-    const R = D.risk || {};
-    const crest = R.crest;
-    const disc = D.discretisation;
-
-    // the answer, first
-    const head = section("answer", "The answer");
-    if (R.p !== undefined) {
-      head.append(el("p", { class: "answer", id: "answer-p", text:
-        `P(${R.output} > ${fmt(crest)}) = ${fmt(R.p, 3)} (95 % band ${fmt(R.p_lo, 3)} to ${fmt(R.p_hi, 3)}) at the level ${R.level}, over the study's input distributions.` }));
-    }
-    head.append(el("p", { class: "caption", text:
-      "The band is the emulator's uncertainty (and, at the extrapolated level, that of the order of convergence), from joint posterior draws; " +
-      (disc ? `the study's finest runs are at dx = ${fmt(disc.finest_dx)} m, and over the box they differ from the extrapolated dx -> 0 value by ${fmt(disc.mean_abs)} on average (largest ${fmt(disc.max_abs)}), with an observed order of convergence ${fmt(disc.order.p)} (95 % of the box ${fmt(disc.order.p_lo)}-${fmt(disc.order.p_hi)}). ` : "") +
-      "It does not hold the distance of a coarse ladder from the asymptotic range, nor the model's own error against the experiment (docs/validation/vajont.md)." }));
-
+    const riskOut = P.riskOut;
+    const R = P.R || {};
+    const crest = R.crest === null ? undefined : R.crest;
     // the prediction panel
-    const ps = section("predict", "Predict a scenario",
-      "Move a slider: the emulator is evaluated in this page from its fitted data (the same numbers Python predicts with, to 1e-9). " +
-      "The interval is for one new FMU run at that level (95 %); outside the study's box the emulator extrapolates and the sliders stop at the box.");
+    const ps = section("predict", "Predict a scenario", P.caption);
     const ctrl = el("div", { class: "controls" });
     const lvSel = el("select", { id: "level" }, ...EM.levels.map((l) => el("option", { value: l.key, text: l.label })));
     const outSel = el("select", { id: "output" }, ...outputs.map((o) => el("option", { value: o, text: o })));
     outSel.value = riskOut;
-    const levelKey = R.level === "extrapolated" || EM.levels.every((l) => l.key !== String(R.level)) ? EM.levels[0].key : String(R.level);
-    lvSel.value = levelKey;
+    lvSel.value = EM.levels.some((l) => l.key === String(R.level)) ? String(R.level) : EM.levels[0].key;
     ctrl.append(el("label", {}, "level ", lvSel), el("label", {}, "output ", outSel));
     const sliders = [];
-    const inputs = D.inputs || EM.inputs;
+    const inputs = P.inputs || EM.inputs;
     inputs.forEach((inp, j) => {
       const ch = inp.choices && inp.choices.length ? inp.choices.slice().sort((a, b) => a - b) : null;
       let step = (inp.hi - inp.lo) / 200;
@@ -346,13 +363,14 @@
     const sweepDiv = el("div", { id: "sweep-plot", class: "plot" });
     const axX = el("select", { id: "surf-x" }, ...EM.inputs.map((i) => el("option", { value: i.name, text: i.name })));
     const axY = el("select", { id: "surf-y" }, ...EM.inputs.map((i) => el("option", { value: i.name, text: i.name })));
-    const S = D.sobol || {};
+    const S = P.sobol || {};
     let rank = EM.inputs.map((i) => i.name);
     if (S.names && S.ST) rank = S.names.slice().sort((a, b) => S.ST[S.names.indexOf(b)] - S.ST[S.names.indexOf(a)]);
     axX.value = rank[0];
     axY.value = rank[1] || rank[0];
     const surfDiv = el("div", { id: "surface-plot", class: "plot" });
-    sw.append(sweepDiv, el("div", { class: "controls" }, el("label", {}, "map x ", axX), el("label", {}, "map y ", axY)), surfDiv);
+    const surfNote = el("p", { class: "hint" });
+    sw.append(sweepDiv, el("div", { class: "controls" }, el("label", {}, "map x ", axX), el("label", {}, "map y ", axY)), surfNote, surfDiv);
 
     function current() {
       return sliders.map((s, j) => {
@@ -422,10 +440,10 @@
       const jx = EM.inputs.findIndex((i) => i.name === axX.value), jy = EM.inputs.findIndex((i) => i.name === axY.value);
       if (jx === jy) {
         Plotly.purge(surfDiv);
-        surfDiv.textContent = "Pick two different inputs for the map.";
+        surfNote.textContent = "Pick two different inputs for the map.";
         return;
       }
-      surfDiv.textContent = "";
+      surfNote.textContent = "";
       const ix = EM.inputs[jx], iy = EM.inputs[jy], npts = 31;
       const xs = [], ys = [], zm = [], zh = [];
       for (let a = 0; a < npts; a++) xs.push(ix.lo + ((ix.hi - ix.lo) * a) / (npts - 1));
@@ -459,6 +477,33 @@
     }
     for (const e of [...sliders, lvSel, outSel, axX, axY]) e.addEventListener("input", update);
     update();
+  }
+
+  // ---- the study page ------------------------------------------------------------------------
+  function studyPage() {
+    EM = prepareEmulator(D.emulator);
+    selfCheck(D.checks);
+    const outputs = Object.keys(EM.outputs);
+    const riskOut = D.risk_output && EM.outputs[D.risk_output] ? D.risk_output : outputs[0];
+    const R = D.risk || {};
+    const crest = R.crest;
+    const disc = D.discretisation;
+
+    // the answer, first
+    const head = section("answer", "The answer");
+    if (R.p !== undefined) {
+      head.append(el("p", { class: "answer", id: "answer-p", text:
+        `P(${R.output} > ${fmt(crest)}) = ${fmt(R.p, 3)} (95 % band ${fmt(R.p_lo, 3)} to ${fmt(R.p_hi, 3)}) at the level ${R.level}, over the study's input distributions.` }));
+    }
+    head.append(el("p", { class: "caption", text:
+      "The band is the emulator's uncertainty (and, at the extrapolated level, that of the order of convergence), from joint posterior draws; " +
+      (disc ? `the study's finest runs are at dx = ${fmt(disc.finest_dx)} m, and over the box they differ from the extrapolated dx -> 0 value by ${fmt(disc.mean_abs)} on average (largest ${fmt(disc.max_abs)}), with an observed order of convergence ${fmt(disc.order.p)} (95 % of the box ${fmt(disc.order.p_lo)}-${fmt(disc.order.p_hi)}). ` : "") +
+      "It does not hold the distance of a coarse ladder from the asymptotic range, nor the model's own error against the experiment (docs/validation/vajont.md)." }));
+
+    predictionPanel({ riskOut: riskOut, R: R, inputs: D.inputs, sobol: D.sobol, caption:
+      "Move a slider: the emulator is evaluated in this page from its fitted data (the same numbers Python predicts with, to 1e-9). " +
+      "The interval is for one new FMU run at that level (95 %); outside the study's box the emulator extrapolates and the sliders stop at the box." });
+    const S = D.sobol || {};
 
     // exceedance
     if (R.curve) {
@@ -517,7 +562,7 @@
       ["levels dx [m]", (st.levels || spec.levels || []).join(", ")],
       ["stop time [s]", st.stop_time], ["communication step [s]", st.step],
       ["fixed parameters", Object.entries(st.fixed || {}).map(([k, v]) => k + " = " + v).join(", ") || "none"],
-      ["design", dg.batches ? dg.batches.map((b) => `${b.kind} (${b.n})`).join(", ") : undefined],
+      ["design", dg.batches ? groupBatches(dg.batches) : undefined],
       ["target of the design", spec.target], ["stopped", dg.stopped],
       ["CPU budget [s]", dg.budget_cpu_s], ["CPU spent [s]", cost.total_cpu_s],
       ["study's wall time [min]", D.elapsed_s ? D.elapsed_s / 60 : undefined],
@@ -537,6 +582,20 @@
     is.append(kv([["stop time [s]", st.stop_time], ["communication step [s]", st.step], ["dx [m]", st.dx],
       ["fixed parameters", Object.entries(st.fixed || {}).map(([k, v]) => k + " = " + v).join(", ") || "none"]]));
     is.append(el("h3", { text: "versions" }), kv(versionPairs(D.versions)));
+    if (D.emulator) {
+      // an emulator fitted on these runs (emulate fit / design): its panel and its CV
+      EM = prepareEmulator(D.emulator);
+      selfCheck(D.checks);
+      const outs = Object.keys(EM.outputs);
+      predictionPanel({ riskOut: outs.includes(D.y) ? D.y : outs[0], R: { crest: D.crest, output: D.y, level: "sf" },
+        inputs: D.emulator_inputs, caption:
+        `Move a slider: the emulator of these runs (emulator.json, made ${D.emulator_created || "?"}) is evaluated in this page from its fitted data (the same numbers Python predicts with, to 1e-9). ` +
+        "The interval is for one new FMU run at the runs' dx (95 %); a binary input (saturated) takes 0 or 1; the sliders stop at the emulator's box." });
+      const vs = section("validation", "How sure: the emulator's cross-validation",
+        "k-fold cross-validation on the runs (each fold's runs predicted by an emulator fitted without them): the error, in % of the output's range over the runs, and how many runs fall inside their 95 % intervals (about 95 % is calibrated).");
+      vs.append(table(["output", "mode", "runs", "folds", "RMSE", "RMSE %", "largest %", "inside 95 %"],
+        Object.entries(EM.outputs).map(([n, o]) => { const c = o.raw.cv || {}; return [n, o.raw.mode, c.n, c.folds, c.rmse, c.rmse_pct, c.max_error_pct, c.coverage95 === undefined || c.coverage95 === null ? null : (100 * c.coverage95).toFixed(0) + " %"]; })));
+    }
     const yj = runs.columns.indexOf(D.y), sj = runs.columns.indexOf("status");
     const ok = runs.rows.filter((r) => sj < 0 || r[sj] === "ok");
     if (yj >= 0 && ok.length) {
