@@ -53,15 +53,18 @@ def command(mixsph, scenario: dict, keys: dict, stop_time: float, out_dir: str,
     for name, value in scenario.items():
         if name in ("scenario_id", "case_file", "threads", "stop_time"):
             continue
-        if isinstance(value, float) and math.isnan(value):
+        if value is None or (isinstance(value, float) and math.isnan(value)):
             continue
         key = keys.get(name)
         if key is None:
             raise UsageError(f"replay: the FMU parameter {name!r} names no case key in its "
                              f"description: cannot replay it with mixsph")
-        if isinstance(value, bool):
-            value = int(value)
-        cmd += ["--set", f"{key}={value!r}" if isinstance(value, float) else f"{key}={value}"]
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            raise UsageError(f"replay: {name} = {value!r} of scenario {scenario.get('scenario_id')}"
+                             f" is not a number: mixsph --set takes numbers") from None
+        cmd += ["--set", f"{key}={int(x)}" if x.is_integer() else f"{key}={x!r}"]
     cmd += ["--set", f"numerics.t_end={stop_time!r}",
             "--set", f"output.snapshot_interval={stop_time / max(1, snapshots)!r}"]
     return cmd
