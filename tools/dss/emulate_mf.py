@@ -280,10 +280,13 @@ def finish_study(folder, em, dists, output, crest, level, n, seed, t0):
     from . import emulate_plots as P
     from .html_report import write_page
     P.exceedance_plot(r, os.path.join(folder, "exceedance.png"))
-    page = write_page(folder)
+    try:
+        page = write_page(folder) + " (open it in a browser)"
+    except Exception as e:       # the study's results are saved: the page can be made again
+        page = f"no page ({type(e).__name__}: {e}; python -m tools.dss page {folder} tries again)"
     _print_risk(r, s)
     print(f"emulate study: done in {(time.monotonic() - t0) / 60:.1f} min; wrote "
-          f"{os.path.join(folder, 'study.json')}, exceedance.png, {page} (open it in a browser)")
+          f"{os.path.join(folder, 'study.json')}, exceedance.png, {page}")
     return doc
 
 

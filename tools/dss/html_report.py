@@ -378,8 +378,11 @@ def animations(folder, df, settings, n, mixsph=None, log=print) -> dict:
 # ---- the three kinds of page -------------------------------------------------------------------
 
 def _read_json(path):
-    with open(path) as f:
-        return json.load(f)
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except ValueError as e:
+        raise PageError(f"{path}: not a JSON file ({e})") from None
 
 
 def _discretisation(em, output, n=RISK_POINTS, seed=0) -> dict | None:
@@ -404,7 +407,10 @@ def study_data(folder, animate=0, mixsph=None) -> dict:
     from .store import open_store
     ep = os.path.join(folder, "mf_emulator.json")
     doc = _read_json(ep)
-    em = M.MFEmulator.from_json(doc)
+    try:
+        em = M.MFEmulator.from_json(doc)
+    except (KeyError, ValueError) as e:
+        raise PageError(f"{ep}: not a multi-fidelity emulator this code reads ({e})") from None
     study = _read_json(os.path.join(folder, "study.json")) if os.path.isfile(
         os.path.join(folder, "study.json")) else {}
     design = _read_json(os.path.join(folder, "mfdesign.json")) if os.path.isfile(
@@ -517,7 +523,10 @@ def sweep_data(folder, crest=None, animate=0, mixsph=None) -> dict:
         # an emulator of these runs (emulate fit / design): the prediction panel
         from . import emulator as E
         doc = _read_json(ep)
-        em = E.Emulator.from_json(doc)
+        try:
+            em = E.Emulator.from_json(doc)
+        except (KeyError, ValueError) as e:
+            raise PageError(f"{ep}: not an emulator this code reads ({e})") from None
         extra = {"emulator": export_sf(em), "checks": self_checks(em),
                  "emulator_inputs": [{"name": n, "lo": float(b[0]), "hi": float(b[1]),
                                       "choices": [0.0, 1.0] if k == "binary" else None}

@@ -104,7 +104,11 @@ def cmd_sweep(args):
     if not args.no_report and not final.empty:
         info = report.make_report(final, args.out, crest=args.crest)
         from .html_report import write_page
-        info["files"].append(write_page(args.out, crest=args.crest))
+        try:
+            info["files"].append(write_page(args.out, crest=args.crest))
+        except Exception as e:   # the results are stored: the page can be made again
+            print(f"dss: warning: no page ({type(e).__name__}: {e}; python -m tools.dss page "
+                  f"{args.out} tries again)", file=sys.stderr)
         print_report(info)
     return 0
 
