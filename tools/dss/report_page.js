@@ -497,7 +497,7 @@
     }
     head.append(el("p", { class: "caption", text:
       "The band is the emulator's uncertainty (and, at the extrapolated level, that of the order of convergence), from joint posterior draws; " +
-      (disc ? `the study's finest runs are at dx = ${fmt(disc.finest_dx)} m, and over the box they differ from the extrapolated dx -> 0 value by ${fmt(disc.mean_abs)} on average (largest ${fmt(disc.max_abs)}), with an observed order of convergence ${fmt(disc.order.p)} (95 % of the box ${fmt(disc.order.p_lo)}-${fmt(disc.order.p_hi)}). ` : "") +
+      (disc ? `the study's finest runs are at dx = ${fmt(disc.finest_dx)} m, and over the box they differ from the extrapolated dx -> 0 value by ${fmt(disc.mean_abs)} m on average (largest ${fmt(disc.max_abs)} m), with an observed order of convergence ${fmt(disc.order.p)} (95 % of the box ${fmt(disc.order.p_lo)}-${fmt(disc.order.p_hi)}). ` : "") +
       "It does not hold the distance of a coarse ladder from the asymptotic range, nor the model's own error against the experiment (docs/validation/vajont.md)." }));
 
     predictionPanel({ riskOut: riskOut, R: R, inputs: D.inputs, sobol: D.sobol, caption:
