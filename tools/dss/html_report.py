@@ -467,8 +467,7 @@ def study_data(folder, animate=0, mixsph=None) -> dict:
         "design": _plain({"spec": spec, "stopped": design.get("stopped"),
                           "budget_cpu_s": design.get("budget_cpu_s"),
                           "batches": [{"kind": b.get("kind"), "n": len(b.get("ids", []))}
-                                      for b in design.get("batches", [])],
-                          "history": design.get("history", [])}),
+                                      for b in design.get("batches", [])]}),
         "settings": _plain({k: v for k, v in sweep.items() if k != "fmu"}),
         "cost": cost, "validation": _plain(validation),
         "discretisation": _plain(_discretisation(em, risk_output)),
