@@ -613,6 +613,12 @@ def cmd_design(args):
         from . import emulate_plots as P
         files.append(P.design_history(res["history"], os.path.join(args.out, "design_history.png"),
                                       target=args.target_error))
+        from .html_report import write_page
+        try:
+            files.append(write_page(args.out, crest=args.crest))
+        except Exception as e:   # the emulator and the runs are saved: the page can be made again
+            print(f"emulate design: no page ({type(e).__name__}: {e}; python -m tools.dss page "
+                  f"{args.out} tries again)", file=sys.stderr)
     for f in files:
         print(f"  wrote {f}")
     return 0

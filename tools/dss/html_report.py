@@ -507,7 +507,13 @@ def sweep_data(folder, crest=None, animate=0, mixsph=None) -> dict:
     sweep = _read_json(os.path.join(folder, "sweep.json")) if os.path.isfile(
         os.path.join(folder, "sweep.json")) else {}
     outs = [o for o in ("max_run_up", "max_run_up_Z", "time_of_max_run_up") if o in df.columns]
-    inputs = [c for c in varied_params(df) if c not in outs and c != "series"]
+    tab = os.path.join(folder, "scenarios.csv")
+    if os.path.isfile(tab):      # the scenarios' own parameters, those that vary
+        import pandas as pd
+        sc = pd.read_csv(tab, dtype={ID: str})
+        inputs = [c for c in sc.columns if c != ID and c in df.columns and sc[c].nunique() > 1]
+    else:
+        inputs = [c for c in varied_params(df) if c not in outs and c != "series"]
     ok = df[df["status"] == "ok"] if "status" in df.columns else df
     ycol = None
     if not ok.empty:
