@@ -615,7 +615,9 @@
       const div2 = el("div", { id: "exceedance-plot", class: "plot" });
       rs.append(div2);
       const n = ys.length;
-      const tr = [{ x: ys, y: ys.map((_, i) => (n - 1 - i) / n), mode: "lines", line: { shape: "hv" }, name: "P(run-up > z)" }];
+      // P(run-up > z): 1 below the smallest run, (n - 1 - i) / n from the i-th on
+      const pad = 0.02 * (ys[n - 1] - ys[0] || 1);
+      const tr = [{ x: [ys[0] - pad, ...ys], y: [1, ...ys.map((_, i) => (n - 1 - i) / n)], mode: "lines", line: { shape: "hv" }, name: "P(run-up > z)" }];
       if (D.crest !== null && D.crest !== undefined) tr.push({ x: [D.crest, D.crest], y: [0, 1], mode: "lines", line: { color: "black", dash: "dot" }, name: "crest" });
       Plotly.newPlot(div2, tr, { height: 320, margin: { t: 20, l: 70, r: 20, b: 50 }, xaxis: { title: { text: D.y } }, yaxis: { title: { text: "exceedance probability" }, range: [0, 1.02] } }, PLOT_CFG);
     }
