@@ -294,9 +294,10 @@ def test_every_fmu_parameter_names_its_case_key_for_the_replays():
     assert keys["output_interval"] == "output.monitor_interval"
 
 
-def test_a_replayed_run_has_the_fmu_runs_max_run_up(tmp_path):
+def test_a_replayed_run_has_the_fmu_runs_max_run_up(browser, tmp_path):
     """A scenario run by the FMU and replayed with mixsph (coarse and short) gives the same max
-    run-up, and the replay has the snapshots the page animates."""
+    run-up, and the replay has the snapshots the page animates; the run page of this real
+    mixsph folder opens without error."""
     sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
     from tool_helpers import built
     from tools.dss import fmu_run, replay as RP
@@ -311,3 +312,10 @@ def test_a_replayed_run_has_the_fmu_runs_max_run_up(tmp_path):
     rd = H.run_data(done["r1"])
     assert rd["summary"]["outputs"]["run_up"]["max"] == pytest.approx(res["max_run_up"], abs=1e-9)
     assert len(rd["frames"]) == 5
+    page, errors = open_page(browser, H.write_page(done["r1"]))
+    try:
+        assert_page_ok(page, errors)
+        assert page.locator("#animation .main-svg").count() > 0
+        assert page.evaluate("document.getElementById('monitor-plot').data[0].y.length") > 10
+    finally:
+        page.close()
