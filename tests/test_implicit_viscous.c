@@ -336,8 +336,8 @@ static void test_restore_continues_identically(void **state)
     assert_true(a.n == b.n);
     size_t differ = 0;
     for (size_t i = 0; i < a.n; i++)
-        differ += a.id[i] != b.id[i] || a.x[i] != b.x[i] || a.z[i] != b.z[i] || a.vx[i] != b.vx[i] ||
-                  a.vz[i] != b.vz[i] || a.p[i] != b.p[i];
+        differ += a.id[i] != b.id[i] || a.pos[0][i] != b.pos[0][i] || a.pos[a.dim - 1][i] != b.pos[b.dim - 1][i] || a.vel[0][i] != b.vel[0][i] ||
+                  a.vel[a.dim - 1][i] != b.vel[b.dim - 1][i] || a.p[i] != b.p[i];
     print_message("restored run: %llu steps, %zu of %zu particles differ\n", (unsigned long long)mixsph_sim_steps(t),
                   differ, a.n);
     assert_true(differ == 0); /* reference: the uninterrupted run; tolerance: bit-identical */

@@ -171,8 +171,8 @@ static void test_view_shows_the_view_rows(void **state)
     mixsph_particle_field f;
     assert_int_equal(mixsph_sim_particle_field_find(s, "velocity", &f), MIXSPH_OK);
     assert_true(f.components == 2 && f.type == MIXSPH_FIELD_F64 && f.n == v.n);
-    assert_ptr_equal(f.data[0], v.vx);
-    assert_ptr_equal(f.data[1], v.vz);
+    assert_ptr_equal(f.data[0], v.vel[0]);
+    assert_ptr_equal(f.data[1], v.vel[v.dim - 1]);
     assert_string_equal(f.columns, "vx,vz");
     assert_string_equal(f.unit, "m/s");
     assert_int_equal(mixsph_sim_particle_field_find(s, "id", &f), MIXSPH_OK);
@@ -184,7 +184,7 @@ static void test_view_shows_the_view_rows(void **state)
     /* by index, in table order; past the end, or a field not in the view: refused */
     assert_int_equal(mixsph_sim_particle_field(s, 0, &f), MIXSPH_OK);
     assert_string_equal(f.name, "position");
-    assert_ptr_equal(f.data[0], v.x);
+    assert_ptr_equal(f.data[0], v.pos[0]);
     assert_int_equal(mixsph_sim_particle_field(s, rows, &f), MIXSPH_ERR_ARG);
     assert_int_equal(mixsph_sim_particle_field_find(s, "acceleration", &f), MIXSPH_ERR_ARG);
     assert_int_equal(mixsph_sim_particle_field_find(s, "nonsense", &f), MIXSPH_ERR_ARG);
