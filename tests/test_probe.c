@@ -199,11 +199,11 @@ static void test_probe_refused(void **state)
 {
     (void)state;
     EXPECT_REFUSED("\"monitors\": { \"P\": { \"type\": \"pressure_probe\", \"z\": 0.1 },\n",
-                   "tank_probes.json: monitors.P.pos[0]: missing");
+                   "tank_probes.json: monitors.P.x: missing");
     EXPECT_REFUSED("\"monitors\": { \"P\": { \"type\": \"pressure_probe\", \"x\": 0.1 },\n",
-                   "tank_probes.json: monitors.P.pos[DIM_UP]: missing");
+                   "tank_probes.json: monitors.P.z: missing");
     EXPECT_REFUSED("\"monitors\": { \"P\": { \"type\": \"pressure_probe\", \"x\": \"left\", \"z\": 0.1 },\n",
-                   "monitors.P.pos[0]: expected a number");
+                   "monitors.P.x: expected a number");
     EXPECT_REFUSED("\"monitors\": { \"P\": { \"type\": \"pressure_probe\", \"x\": 0.4, \"z\": 0.1, \"wall\": \"dam\" },\n",
                    "monitors.P.wall: 'dam' is not one of the walls");
     EXPECT_REFUSED("\"monitors\": { \"P\": { \"type\": \"pressure_probe\", \"x\": 0.4, \"z\": 0.1, \"medium\": \"water\" },\n",

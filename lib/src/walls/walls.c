@@ -162,7 +162,7 @@ static int owned_by_other(const struct segment *o, double x, double z, double de
  * bisector split can leave two particles of the two strips nearly on top of each other. */
 static int near_placed(const struct particles *P, size_t first, double x, double z, double dist)
 {
-    const double *px = P->pos[0], *pz = P->pos[1];
+    const double *px = P->pos[0], *pz = P->pos[DIM_UP];
     for (size_t j = first; j < P->n; j++)
         if ((px[j] - x) * (px[j] - x) + (pz[j] - z) * (pz[j] - z) < dist * dist) return 1;
     return 0;
