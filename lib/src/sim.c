@@ -326,8 +326,11 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (!inside) return sim_fail_outside(s, i);
     }
     s->work.NB.skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
-    const double grid_lo[DIM] = {s->phys.domain[0], s->phys.domain[2]};
-    const double grid_hi[DIM] = {s->phys.domain[1], s->phys.domain[3]};
+    double grid_lo[DIM], grid_hi[DIM];
+    for (int d = 0; d < DIM; d++) {
+        grid_lo[d] = s->phys.domain[2 * d];
+        grid_hi[d] = s->phys.domain[2 * d + 1];
+    }
     if (cells_init_columns(&s->work.C, grid_lo, grid_hi, 2.0 * s->phys.h + s->work.NB.skin, SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3]);
