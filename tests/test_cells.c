@@ -91,8 +91,8 @@ static void make_particles(struct particles *P, const struct cells *C, uint64_t 
     /* already lost before the build, inside the grid: stays lost, not counted again */
     particles_push(P, (const double[DIM]){0.5 * (C->lo[0] + X1), 0.5 * (C->lo[1] + Z1)}, 1000.0, 1.0, 0, MIXSPH_STATE_LOST);
     for (size_t i = 0; i < P->n; i++) {
-        P->vx[i] = 1.0 + (double)i;
-        P->vz[i] = -2.0;
+        P->vel[0][i] = 1.0 + (double)i;
+        P->vel[DIM_UP][i] = -2.0;
     }
 }
 
@@ -128,18 +128,18 @@ static size_t check_neighbours(const struct cells *C, const struct particles *P)
     for (size_t i = 0; i < n_in; i++) {
         size_t na = 0, nb = 0;
         int ix, iz;
-        coords_2d(C, P->x[i], P->z[i], &ix, &iz);
+        coords_2d(C, P->pos[0][i], P->pos[DIM_UP][i], &ix, &iz);
         for (int row = -1; row <= 1; row++) {
             const struct range rg = row_2d(C, ix, iz, row);
             assert_true(rg.begin <= rg.end && rg.end <= n_in);
             for (size_t j = rg.begin; j < rg.end; j++) {
-                const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
+                const double rx = P->pos[0][i] - P->pos[0][j], rz = P->pos[DIM_UP][i] - P->pos[DIM_UP][j];
                 if (j != i && rx * rx + rz * rz < r2max) a[na++] = P->id[j];
             }
         }
         for (size_t j = 0; j < P->n; j++) {
             if (j == i || P->state[j] == MIXSPH_STATE_LOST) continue;
-            const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
+            const double rx = P->pos[0][i] - P->pos[0][j], rz = P->pos[DIM_UP][i] - P->pos[DIM_UP][j];
             if (rx * rx + rz * rz < r2max) b[nb++] = P->id[j];
         }
         qsort(a, na, sizeof *a, cmp_u32);
@@ -171,13 +171,13 @@ static void check_sort(const struct cells *C, const struct particles *P, const d
         assert_int_equal(seen[id], 0);
         seen[id] = 1;
         /* fields travel with the particle (bitwise; NaN compares by memcmp) */
-        assert_memory_equal(&P->x[k], &x_of_id[id], sizeof(double));
-        assert_memory_equal(&P->z[k], &z_of_id[id], sizeof(double));
+        assert_memory_equal(&P->pos[0][k], &x_of_id[id], sizeof(double));
+        assert_memory_equal(&P->pos[DIM_UP][k], &z_of_id[id], sizeof(double));
         const int where = state_of_id[id] == MIXSPH_STATE_LOST ? 0 : inside(C, x_of_id[id], z_of_id[id]);
         if (where == 1 || (where == -1 && P->state[k] != MIXSPH_STATE_LOST)) {
             assert_true(k < C->start[C->ncell]);
             assert_int_equal(P->state[k], state_of_id[id]);
-            assert_true(P->vx[k] == 1.0 + (double)id); /* push order = id; velocity kept */
+            assert_true(P->vel[0][k] == 1.0 + (double)id); /* push order = id; velocity kept */
             /* its cell holds its position: cell c = iz nx + ix with the grid's own edges */
             const uint32_t c = C->cell[k];
             assert_true(c < C->ncell);
@@ -185,15 +185,15 @@ static void check_sort(const struct cells *C, const struct particles *P, const d
             const int ix = (int)(c % (uint32_t)C->n[0]), iz = (int)(c / (uint32_t)C->n[0]);
             /* tolerance: a position on a border may fall on either side by one rounding */
             const double tol = 1e-12 * C->size;
-            assert_true(P->x[k] >= C->lo[0] + ix * C->size - tol && P->x[k] < C->lo[0] + (ix + 1) * C->size + tol);
-            assert_true(P->z[k] >= C->lo[1] + iz * C->size - tol && P->z[k] < C->lo[1] + (iz + 1) * C->size + tol);
+            assert_true(P->pos[0][k] >= C->lo[0] + ix * C->size - tol && P->pos[0][k] < C->lo[0] + (ix + 1) * C->size + tol);
+            assert_true(P->pos[DIM_UP][k] >= C->lo[1] + iz * C->size - tol && P->pos[DIM_UP][k] < C->lo[1] + (iz + 1) * C->size + tol);
             if (k > 0) assert_true(C->cell[k - 1] <= c);
             /* stable: particles of one cell keep their previous (here: id) order */
             if (k > C->start[c]) assert_true(P->id[k - 1] < id);
         } else {
             assert_true(k >= C->start[C->ncell]);
             assert_int_equal(P->state[k], MIXSPH_STATE_LOST);
-            if (state_of_id[id] != MIXSPH_STATE_LOST) assert_true(P->vx[k] == 0.0 && P->vz[k] == 0.0); /* newly lost */
+            if (state_of_id[id] != MIXSPH_STATE_LOST) assert_true(P->vel[0][k] == 0.0 && P->vel[DIM_UP][k] == 0.0); /* newly lost */
         }
     }
     free(seen);
@@ -218,8 +218,8 @@ static void run_grid(const struct grid_spec *g, uint64_t seed, size_t n_random)
     long expect_lost = 0, undecided = 0;
     for (size_t i = 0; i < n; i++) {
         assert_int_equal(P.id[i], i);
-        x[i] = P.x[i];
-        z[i] = P.z[i];
+        x[i] = P.pos[0][i];
+        z[i] = P.pos[DIM_UP][i];
         st[i] = P.state[i];
         if (st[i] == MIXSPH_STATE_LOST) continue;
         expect_lost += inside(&C, x[i], z[i]) == 0;
@@ -240,12 +240,12 @@ static void run_grid(const struct grid_spec *g, uint64_t seed, size_t n_random)
     for (size_t k = 0; k < n; k++) {
         const uint32_t id = P.id[k];
         if (P.state[k] != MIXSPH_STATE_LOST) {
-            P.x[k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
-            P.z[k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
-            P.vx[k] = 1.0 + (double)id;
+            P.pos[0][k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
+            P.pos[DIM_UP][k] += test_random_uniform(&s, -0.3, 0.3) * C.size;
+            P.vel[0][k] = 1.0 + (double)id;
         }
-        x[id] = P.x[k];
-        z[id] = P.z[k];
+        x[id] = P.pos[0][k];
+        z[id] = P.pos[DIM_UP][k];
         st[id] = P.state[k];
     }
     long expect2 = 0, undecided2 = 0;
@@ -374,7 +374,7 @@ static void test_neighbour_ranges(void **state)
             if (P.state[i] != MIXSPH_STATE_WALL) continue;
             size_t expect = 0;
             for (size_t j = 0; j < n; j++) {
-                const double rx = P.x[i] - P.x[j], rz = P.z[i] - P.z[j];
+                const double rx = P.pos[0][i] - P.pos[0][j], rz = P.pos[DIM_UP][i] - P.pos[DIM_UP][j];
                 expect += P.state[j] != MIXSPH_STATE_WALL && rx * rx + rz * rz < rc * rc;
             }
             assert_int_equal(G.start[i + 1] - G.start[i], expect);
@@ -383,8 +383,8 @@ static void test_neighbour_ranges(void **state)
         /* move every particle by less than skin / 2 */
         for (size_t i = 0; i < n; i++) {
             const double a = test_random_uniform(&seed, 0.0, 6.283185307179586), d = test_random_uniform(&seed, 0.0, 0.4999 * skin);
-            P.x[i] += d * cos(a);
-            P.z[i] += d * sin(a);
+            P.pos[0][i] += d * cos(a);
+            P.pos[DIM_UP][i] += d * sin(a);
         }
         int outside = 1;
         const double shift2 = neighbours_max_shift2(&NB, &C, &P, n, &outside, 2);
@@ -394,7 +394,7 @@ static void test_neighbour_ranges(void **state)
         for (size_t i = 0; i < n; i++)
             for (size_t j = 0; j < n; j++) {
                 if (j == i) continue;
-                const double rx = P.x[i] - P.x[j], rz = P.z[i] - P.z[j];
+                const double rx = P.pos[0][i] - P.pos[0][j], rz = P.pos[DIM_UP][i] - P.pos[DIM_UP][j];
                 if (rx * rx + rz * rz >= 4.0 * h * h) continue;
                 assert_int_equal(in_ranges(G.rng + 6 * i, 3, j), 1);
                 if (j < i) continue;

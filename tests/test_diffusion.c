@@ -106,9 +106,9 @@ static mixsph_sim *box_at_rest(const char *extra)
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        P->x[i] += uniform(-0.3, 0.3) * DX;
-        P->z[i] += uniform(-0.3, 0.3) * DX;
-        P->vx[i] = P->uvx[i] = P->vz[i] = P->uvz[i] = 0.0;
+        P->pos[0][i] += uniform(-0.3, 0.3) * DX;
+        P->pos[DIM_UP][i] += uniform(-0.3, 0.3) * DX;
+        P->vel[0][i] = P->uv[0][i] = P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = 0.0;
         P->rho[i] *= 1.0 + uniform(-0.01, 0.01);
     }
     assert_int_equal(integrate_rebuild_lists(s), MIXSPH_OK);
@@ -125,7 +125,7 @@ static double brute_force(const mixsph_sim *s, size_t i, int hydrostatic, double
     double sum = 0.0, a = 0.0;
     for (size_t j = 0; j < P->n; j++) {
         if (j == i || P->state[j] == MIXSPH_STATE_WALL || P->medium[j] != P->medium[i]) continue;
-        const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j], r = hypot(rx, rz);
+        const double rx = P->pos[0][i] - P->pos[0][j], rz = P->pos[DIM_UP][i] - P->pos[DIM_UP][j], r = hypot(rx, rz);
         if (r >= 2.0 * h) continue;
         const double F = kernel_f(&s->phys.K, r);
         const double psi = P->rho[j] - P->rho[i] - hyd * rz;

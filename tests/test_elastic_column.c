@@ -82,15 +82,15 @@ static void test_oedometric_state(void **state)
     const double margin = 3.0 * s->phys.h;
     double ztop = -INFINITY;
     for (size_t i = 0; i < P->n; i++)
-        if (P->state[i] == MIXSPH_STATE_MOBILE) ztop = fmax(ztop, P->z[i]);
+        if (P->state[i] == MIXSPH_STATE_MOBILE) ztop = fmax(ztop, P->pos[DIM_UP][i]);
     const double zs = ztop + 0.5 * DX; /* the top surface, as in test_hydrostatic */
     /* least squares sigma_zz = a + b z, and the mean ratio sigma_xx / sigma_zz */
     double n = 0, sz = 0, szz = 0, ss = 0, szs = 0, ratio = 0, worst = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        const double x = P->x[i], z = P->z[i];
+        const double x = P->pos[0][i], z = P->pos[DIM_UP][i];
         if (x < margin || x > WIDTH - margin || z < margin || z > zs - margin) continue;
-        const double s_zz = -P->p[i] + P->szz[i], s_xx = -P->p[i] + P->sxx[i];
+        const double s_zz = -P->p[i] + P->stress[SYM_ZZ][i], s_xx = -P->p[i] + P->stress[SYM_XX][i];
         const double ref = -RHO * G * (zs - z);
         n++;
         sz += z;

@@ -93,15 +93,15 @@ static void heap_displacements(const char *json, double t_end, double *largest, 
     double *x0 = calloc(n, sizeof *x0), *z0 = calloc(n, sizeof *z0), *d = calloc(n, sizeof *d);
     assert_true(x0 && z0 && d);
     for (size_t i = 0; i < n; i++) {
-        x0[P->id[i]] = P->x[i];
-        z0[P->id[i]] = P->z[i];
+        x0[P->id[i]] = P->pos[0][i];
+        z0[P->id[i]] = P->pos[DIM_UP][i];
     }
     assert_int_equal(mixsph_sim_advance_to(s, t_end), MIXSPH_OK);
     size_t k = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* no hold rule: no grain is held */
-        d[k++] = hypot(P->x[i] - x0[P->id[i]], P->z[i] - z0[P->id[i]]) / DX;
+        d[k++] = hypot(P->pos[0][i] - x0[P->id[i]], P->pos[DIM_UP][i] - z0[P->id[i]]) / DX;
     }
     qsort(d, k, sizeof *d, cmp_double);
     *largest = d[k - 1];
@@ -183,7 +183,7 @@ static void block_state(const struct particles *P, double *u, double *u_std, dou
     size_t n = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const double ui = P->vx[i] * cos(a) - P->vz[i] * sin(a), s = P->x[i] * cos(a) - P->z[i] * sin(a);
+        const double ui = P->vel[0][i] * cos(a) - P->vel[DIM_UP][i] * sin(a), s = P->pos[0][i] * cos(a) - P->pos[DIM_UP][i] * sin(a);
         su += ui;
         suu += ui * ui;
         lo = fmin(lo, s);
@@ -244,8 +244,8 @@ static double heap_flank_angle(const struct particles *P)
     for (int b = 0; b < NB; b++) top[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const int b = (int)floor((P->x[i] - x0) / DX);
-        if (b >= 0 && b < NB && P->z[i] > top[b]) top[b] = P->z[i];
+        const int b = (int)floor((P->pos[0][i] - x0) / DX);
+        if (b >= 0 && b < NB && P->pos[DIM_UP][i] > top[b]) top[b] = P->pos[DIM_UP][i];
     }
     int apex = 0;
     for (int b = 1; b < NB; b++)
@@ -288,7 +288,7 @@ static void test_repose_after_failure(void **state)
     for (size_t i = 0; i < s->phys.P.n; i++) {
         if (s->phys.P.state[i] == MIXSPH_STATE_WALL) continue;
         n++;
-        moving += hypot(s->phys.P.vx[i], s->phys.P.vz[i]) > 1e-3;
+        moving += hypot(s->phys.P.vel[0][i], s->phys.P.vel[DIM_UP][i]) > 1e-3;
     }
     print_message("heap of 45-degree slopes (%.1f on the lattice): flanks at %.2f degrees after 3 s, %.1f %% of "
                   "the grains faster than 1 mm/s\n", start, angle, 100.0 * (double)moving / (double)n);

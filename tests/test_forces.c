@@ -60,10 +60,10 @@ static int setup(void **state)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
         const struct medium *m = &s->cfg.media[P->medium[i]];
-        P->x[i] += uniform(-0.3, 0.3) * s->phys.dx;
-        P->z[i] += uniform(-0.3, 0.3) * s->phys.dx;
-        P->vx[i] = P->uvx[i] = uniform(-1.0, 1.0);
-        P->vz[i] = P->uvz[i] = uniform(-1.0, 1.0);
+        P->pos[0][i] += uniform(-0.3, 0.3) * s->phys.dx;
+        P->pos[DIM_UP][i] += uniform(-0.3, 0.3) * s->phys.dx;
+        P->vel[0][i] = P->uv[0][i] = uniform(-1.0, 1.0);
+        P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = uniform(-1.0, 1.0);
         P->rho[i] = m->rho0 * (1.0 + uniform(-0.01, 0.01));
         P->m[i] = m->rho0 * s->phys.dx * s->phys.dx * (1.0 + uniform(-0.2, 0.2));
         P->inv_m[i] = 1.0 / P->m[i];
@@ -86,7 +86,7 @@ static int teardown(void **state)
 
 static double dist2(const struct particles *P, size_t i, size_t j)
 {
-    const double rx = P->x[i] - P->x[j], rz = P->z[i] - P->z[j];
+    const double rx = P->pos[0][i] - P->pos[0][j], rz = P->pos[DIM_UP][i] - P->pos[DIM_UP][j];
     return rx * rx + rz * rz;
 }
 
@@ -163,12 +163,12 @@ static int pair_geom(const mixsph_sim *s, size_t i, size_t j, struct pair_geom *
     const struct particles *P = &s->phys.P;
     if (j == i || P->state[i] != MIXSPH_STATE_MOBILE || P->state[j] != MIXSPH_STATE_MOBILE || dist2(P, i, j) >= s->phys.K.r2max)
         return 0;
-    g->rx = P->x[i] - P->x[j];
-    g->rz = P->z[i] - P->z[j];
+    g->rx = P->pos[0][i] - P->pos[0][j];
+    g->rz = P->pos[DIM_UP][i] - P->pos[DIM_UP][j];
     g->r2 = g->rx * g->rx + g->rz * g->rz;
     g->F = kernel_f(&s->phys.K, sqrt(g->r2));
-    g->ux = P->vx[i] - P->vx[j];
-    g->uz = P->vz[i] - P->vz[j];
+    g->ux = P->vel[0][i] - P->vel[0][j];
+    g->uz = P->vel[DIM_UP][i] - P->vel[DIM_UP][j];
     g->vr = g->ux * g->rx + g->uz * g->rz;
     return 1;
 }
@@ -327,12 +327,12 @@ static void test_momentum_conservation(void **state)
         }
         /* reference: brute force over all j; tolerance 1e-12 of the sum of |pair terms| (the
          * sums differ only in order) */
-        assert_true(hypot(P->ax[i] - bx, P->az[i] - bz) <= 1e-12 * babs);
+        assert_true(hypot(P->acc[0][i] - bx, P->acc[DIM_UP][i] - bz) <= 1e-12 * babs);
         assert_true(fabs(P->drho[i] - bd) <= 1e-12 * bdabs);
         assert_int_equal(P->nneigh[i], nn); /* the spray criterion of the monitors */
-        sx += P->m[i] * P->ax[i];
-        sz += P->m[i] * P->az[i];
-        sabs += P->m[i] * hypot(P->ax[i], P->az[i]);
+        sx += P->m[i] * P->acc[0][i];
+        sz += P->m[i] * P->acc[DIM_UP][i];
+        sabs += P->m[i] * hypot(P->acc[0][i], P->acc[DIM_UP][i]);
     }
     print_message("|sum m a| = %.3e N/m, sum |m a| = %.3e N/m\n", hypot(sx, sz), sabs);
     assert_true(sabs > 0.0);
@@ -346,12 +346,12 @@ static void test_momentum_conservation(void **state)
     double *ax0 = malloc(P->n * sizeof *ax0), *az0 = malloc(P->n * sizeof *az0);
     assert_non_null(ax0);
     assert_non_null(az0);
-    memcpy(ax0, P->ax, P->n * sizeof *ax0);
-    memcpy(az0, P->az, P->n * sizeof *az0);
+    memcpy(ax0, P->acc[0], P->n * sizeof *ax0);
+    memcpy(az0, P->acc[DIM_UP], P->n * sizeof *az0);
     assert_int_equal(forces_cache_pending(s->work.forces), 0); /* used once */
     assert_int_equal(sim_momentum_pass(s), 0);
-    assert_memory_equal(ax0, P->ax, P->n * sizeof *ax0);
-    assert_memory_equal(az0, P->az, P->n * sizeof *az0);
+    assert_memory_equal(ax0, P->acc[0], P->n * sizeof *ax0);
+    assert_memory_equal(az0, P->acc[DIM_UP], P->n * sizeof *az0);
     free(ax0);
     free(az0);
 }
@@ -433,8 +433,8 @@ static void test_monaghan_at_walls(void **state)
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        P->vx[i] = P->uvx[i] = 1.0; /* sliding along the wall, +x */
-        P->vz[i] = P->uvz[i] = 0.0;
+        P->vel[0][i] = P->uv[0][i] = 1.0; /* sliding along the wall, +x */
+        P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = 0.0;
         P->rho[i] = s->cfg.media[0].rho0; /* p = 0 */
     }
     integrate_pressure_and_derived(s);
@@ -443,7 +443,7 @@ static void test_monaghan_at_walls(void **state)
         double drag = 0.0, mass = 0.0;
         size_t pairs = 0;
         for (size_t i = 0; i < P->n; i++) {
-            if (P->state[i] != MIXSPH_STATE_MOBILE || P->x[i] < 0.05 || P->x[i] > 0.25) continue; /* away from the ends */
+            if (P->state[i] != MIXSPH_STATE_MOBILE || P->pos[0][i] < 0.05 || P->pos[0][i] > 0.25) continue; /* away from the ends */
             for (size_t j = 0; j < P->n; j++) {
                 if (P->state[j] != MIXSPH_STATE_WALL || dist2(P, i, j) >= s->phys.K.r2max) continue;
                 double ax, az, dr;
@@ -453,7 +453,7 @@ static void test_monaghan_at_walls(void **state)
                      * tolerance: exactly 0 */
                     assert_true(ax == 0.0 && az == 0.0);
                 } else {
-                    const double vr = (P->vx[i] - P->vx[j]) * (P->x[i] - P->x[j]) + (P->vz[i] - P->vz[j]) * (P->z[i] - P->z[j]);
+                    const double vr = (P->vel[0][i] - P->vel[0][j]) * (P->pos[0][i] - P->pos[0][j]) + (P->vel[DIM_UP][i] - P->vel[DIM_UP][j]) * (P->pos[DIM_UP][i] - P->pos[DIM_UP][j]);
                     /* approaching wall particles resist, receding ones do not */
                     if (vr >= 0.0) assert_true(ax == 0.0 && az == 0.0);
                     else assert_true(ax < 0.0);

@@ -111,8 +111,8 @@ static void positions_by_id(const mixsph_sim *s, double **x0, double **z0)
     assert_non_null(*z0);
     for (size_t i = 0; i < v.n; i++) {
         assert_true(v.id[i] < v.n);
-        (*x0)[v.id[i]] = v.x[i];
-        (*z0)[v.id[i]] = v.z[i];
+        (*x0)[v.id[i]] = v.pos[0][i];
+        (*z0)[v.id[i]] = v.pos[v.dim - 1][i];
     }
 }
 
@@ -159,7 +159,7 @@ static void test_heap_at_rest(void **state)
         for (size_t i = 0; i < v.n; i++) {
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
             assert_true(v.state[i] != MIXSPH_STATE_LOST);
-            now = fmax(now, hypot(v.x[i] - x0[v.id[i]], v.z[i] - z0[v.id[i]]));
+            now = fmax(now, hypot(v.pos[0][i] - x0[v.id[i]], v.pos[v.dim - 1][i] - z0[v.id[i]]));
             p_mean += v.p[i] / (double)n;
         }
         worst = fmax(worst, now);
@@ -211,8 +211,8 @@ static double mobile_heap(double t_end)
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
             assert_int_equal(v.state[i], MIXSPH_STATE_MOBILE); /* premise: mobile grains */
             assert_true(v.mu[i] <= MOBILE_MU0);                 /* regimes "limited" or "frictional" */
-            assert_true(v.z[i] > 0.0);                          /* none through the floor */
-            const double d = hypot(v.x[i] - x0[v.id[i]], v.z[i] - z0[v.id[i]]);
+            assert_true(v.pos[v.dim - 1][i] > 0.0);                          /* none through the floor */
+            const double d = hypot(v.pos[0][i] - x0[v.id[i]], v.pos[v.dim - 1][i] - z0[v.id[i]]);
             now = fmax(now, d);
             mean += d / (double)n;
             limited += v.mu[i] == MOBILE_MU0;
@@ -286,7 +286,7 @@ static double implicit_heap(double mu_thr, int arithmetic_mean, int rigid, doubl
         for (size_t i = 0; i < v.n; i++) {
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
             assert_true(v.state[i] != MIXSPH_STATE_LOST);
-            now = fmax(now, hypot(v.x[i] - x0[v.id[i]], v.z[i] - z0[v.id[i]]));
+            now = fmax(now, hypot(v.pos[0][i] - x0[v.id[i]], v.pos[v.dim - 1][i] - z0[v.id[i]]));
             mobile += v.state[i] == MIXSPH_STATE_MOBILE;
             grains++;
         }
@@ -532,10 +532,10 @@ static double column_collapse(void)
     for (size_t i = 0; i < v.n; i++) {
         if (v.state[i] == MIXSPH_STATE_WALL) continue;
         assert_true(v.state[i] != MIXSPH_STATE_LOST);
-        assert_true(v.x[i] > 0.0 && v.z[i] > 0.0); /* nobody through the wall or the floor */
-        const int b = (int)floor(v.x[i] / SURF_BIN);
+        assert_true(v.pos[0][i] > 0.0 && v.pos[v.dim - 1][i] > 0.0); /* nobody through the wall or the floor */
+        const int b = (int)floor(v.pos[0][i] / SURF_BIN);
         assert_true(b >= 0 && b < NSURF);
-        top[b] = fmax(top[b], v.z[i] + 0.5 * COL_DX);
+        top[b] = fmax(top[b], v.pos[v.dim - 1][i] + 0.5 * COL_DX);
     }
     /* steepest slope over a baseline of 4 bins (4 x 2 dx = 0.1 m, bin centre to bin centre) where
      * both bins hold grains; the final height is the highest top */

@@ -79,22 +79,22 @@ static void run_tank(const mixsph_override *ov, size_t n_ov)
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
             /* none lost, none outside the tank */
             assert_int_equal(v.state[i], MIXSPH_STATE_MOBILE);
-            assert_true(v.x[i] > 0.0 && v.x[i] < TANK_WIDTH && v.z[i] > 0.0);
+            assert_true(v.pos[0][i] > 0.0 && v.pos[0][i] < TANK_WIDTH && v.pos[v.dim - 1][i] > 0.0);
             vol += mass[v.id[i]] / v.rho[i];
-            ztop = fmax(ztop, v.z[i]);
+            ztop = fmax(ztop, v.pos[v.dim - 1][i]);
         }
         double sz_top = 0.0, sp[NLAYER] = {0}, sz[NLAYER] = {0};
         int n_top = 0, cnt[NLAYER] = {0};
         for (size_t i = 0; i < v.n; i++) {
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
-            if (v.z[i] > ztop - 0.5 * DX) {
-                sz_top += v.z[i];
+            if (v.pos[v.dim - 1][i] > ztop - 0.5 * DX) {
+                sz_top += v.pos[v.dim - 1][i];
                 n_top++;
             }
-            const int b = (int)floor(v.z[i] / DX);
+            const int b = (int)floor(v.pos[v.dim - 1][i] / DX);
             assert_true(b >= 0 && b < NLAYER);
             sp[b] += v.p[i];
-            sz[b] += v.z[i];
+            sz[b] += v.pos[v.dim - 1][i];
             cnt[b]++;
         }
         assert_true(n_top >= 38); /* the top row has 40 particles */

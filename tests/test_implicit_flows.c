@@ -145,10 +145,10 @@ static double profile_error(const struct flow *f, const mixsph_sim *s)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
-        if (P->x[i] < X_LO || P->x[i] > X_HI) continue;
-        const int b = (int)floor(P->z[i] / DX);
+        if (P->pos[0][i] < X_LO || P->pos[0][i] > X_HI) continue;
+        const int b = (int)floor(P->pos[DIM_UP][i] / DX);
         assert_true(b >= 0 && b < NBIN);
-        diff[b] += (P->vx[i] - frame_vx) - f->exact(f, P->z[i], t);
+        diff[b] += (P->vel[0][i] - frame_vx) - f->exact(f, P->pos[DIM_UP][i], t);
         cnt[b]++;
     }
     double worst = 0.0;

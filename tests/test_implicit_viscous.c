@@ -89,11 +89,11 @@ static double channel_error(double mu, double t_end, double *dt_ratio)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
-        if (P->x[i] < 0.08 || P->x[i] > 0.12) continue;
-        const int b = (int)floor(P->z[i] / DX);
+        if (P->pos[0][i] < 0.08 || P->pos[0][i] > 0.12) continue;
+        const int b = (int)floor(P->pos[DIM_UP][i] / DX);
         assert_true(b >= 0 && b < NBIN);
-        const double eta = P->z[i] / H;
-        su[b] += P->vx[i];
+        const double eta = P->pos[DIM_UP][i] / H;
+        su[b] += P->vel[0][i];
         sa[b] += U_LID * eta * (3.0 * eta - 2.0);
         cnt[b]++;
     }
@@ -148,8 +148,8 @@ static mixsph_sim *box_with_shear(void)
     const size_t n = s->work.C.start[s->work.C.ncell];
     for (size_t i = 0; i < n; i++) /* a shear field that the walls resist */
         if (P->state[i] == MIXSPH_STATE_MOBILE) {
-            P->vx[i] = P->uvx[i] = 0.1 * sin(40.0 * P->z[i]);
-            P->vz[i] = P->uvz[i] = 0.05 * cos(30.0 * P->x[i]);
+            P->vel[0][i] = P->uv[0][i] = 0.1 * sin(40.0 * P->pos[DIM_UP][i]);
+            P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = 0.05 * cos(30.0 * P->pos[0][i]);
         }
     assert_true(sim_density_pass(s) >= 0);
     integrate_pressure_and_derived(s);
@@ -186,8 +186,8 @@ static void momentum_only_changed_by_walls(int preconditioner)
     assert_non_null(ux0);
     assert_non_null(uz0);
     for (size_t i = 0; i < n; i++) {
-        ux0[i] = P->vx[i];
-        uz0[i] = P->vz[i];
+        ux0[i] = P->vel[0][i];
+        uz0[i] = P->vel[DIM_UP][i];
     }
     const double factor = 10.0; /* times the explicit viscous limit */
     const struct viscous_report rep = box_solve(s, factor, preconditioner);
@@ -201,11 +201,11 @@ static void momentum_only_changed_by_walls(int preconditioner)
     double dpx = 0.0, dpz = 0.0, scale = 0.0;
     for (size_t i = 0; i < n; i++) {
         const int wall = P->state[i] == MIXSPH_STATE_WALL;
-        ux[i] = wall ? P->uvx[i] : P->vx[i];
-        uz[i] = wall ? P->uvz[i] : P->vz[i];
+        ux[i] = wall ? P->uv[0][i] : P->vel[0][i];
+        uz[i] = wall ? P->uv[DIM_UP][i] : P->vel[DIM_UP][i];
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        dpx += P->m[i] * (P->vx[i] - ux0[i]);
-        dpz += P->m[i] * (P->vz[i] - uz0[i]);
+        dpx += P->m[i] * (P->vel[0][i] - ux0[i]);
+        dpz += P->m[i] * (P->vel[DIM_UP][i] - uz0[i]);
         scale += P->m[i] * hypot(ux0[i], uz0[i]);
     }
     const double *const u[DIM] = {ux, uz};
@@ -260,8 +260,8 @@ static void test_two_level_same_solution_fewer_iterations(void **state)
     double diff = 0.0, scale = 0.0;
     for (size_t i = 0; i < n; i++)
         if (a->phys.P.state[i] == MIXSPH_STATE_MOBILE) {
-            diff = fmax(diff, hypot(a->phys.P.vx[i] - b->phys.P.vx[i], a->phys.P.vz[i] - b->phys.P.vz[i]));
-            scale = fmax(scale, hypot(a->phys.P.vx[i], a->phys.P.vz[i]));
+            diff = fmax(diff, hypot(a->phys.P.vel[0][i] - b->phys.P.vel[0][i], a->phys.P.vel[DIM_UP][i] - b->phys.P.vel[DIM_UP][i]));
+            scale = fmax(scale, hypot(a->phys.P.vel[0][i], a->phys.P.vel[DIM_UP][i]));
         }
     print_message("jacobi %d iterations, two_level %d; largest difference %.2e of the largest speed %.2e\n",
                   ra.iterations, rb.iterations, diff, scale);
@@ -336,8 +336,8 @@ static void test_restore_continues_identically(void **state)
     assert_true(a.n == b.n);
     size_t differ = 0;
     for (size_t i = 0; i < a.n; i++)
-        differ += a.id[i] != b.id[i] || a.x[i] != b.x[i] || a.z[i] != b.z[i] || a.vx[i] != b.vx[i] ||
-                  a.vz[i] != b.vz[i] || a.p[i] != b.p[i];
+        differ += a.id[i] != b.id[i] || a.pos[0][i] != b.pos[0][i] || a.pos[a.dim - 1][i] != b.pos[b.dim - 1][i] || a.vel[0][i] != b.vel[0][i] ||
+                  a.vel[a.dim - 1][i] != b.vel[b.dim - 1][i] || a.p[i] != b.p[i];
     print_message("restored run: %llu steps, %zu of %zu particles differ\n", (unsigned long long)mixsph_sim_steps(t),
                   differ, a.n);
     assert_true(differ == 0); /* reference: the uninterrupted run; tolerance: bit-identical */

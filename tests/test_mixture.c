@@ -201,8 +201,8 @@ static void impose_shear(mixsph_sim *s, double G)
 {
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
-        P->vx[i] = P->uvx[i] = G * P->z[i];
-        P->vz[i] = P->uvz[i] = 0.0;
+        P->vel[0][i] = P->uv[0][i] = G * P->pos[DIM_UP][i];
+        P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = 0.0;
     }
     integrate_pressure_and_derived(s);
 }
@@ -233,12 +233,12 @@ static struct counts check_regimes(const mixsph_sim *s, double G, const double *
         if (app >= m->paper.mu_thr) {
             assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
             assert_true(P->mu[i] == m->paper.mu_thr);
-            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->uvx[i] == 0.0 && P->uvz[i] == 0.0); /* held */
+            assert_true(P->vel[0][i] == 0.0 && P->vel[DIM_UP][i] == 0.0 && P->uv[0][i] == 0.0 && P->uv[DIM_UP][i] == 0.0); /* held */
             c.fixed++;
             continue;
         }
         assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE);
-        assert_true(P->vx[i] == G * P->z[i] && P->vz[i] == 0.0); /* a mobile grain keeps its velocity */
+        assert_true(P->vel[0][i] == G * P->pos[DIM_UP][i] && P->vel[DIM_UP][i] == 0.0); /* a mobile grain keeps its velocity */
         assert_true(P->p[i] == p0[i]);        /* and its pressure */
         if (app > m->paper.mu0) {
             assert_true(P->mu[i] == m->paper.mu0);
@@ -271,11 +271,11 @@ static long check_fixed_pressure(const mixsph_sim *s, const double *p0)
         double sw = 0.0, sp = 0.0;
         for (size_t j = 0; j < P->n; j++) {
             if (!is_grain(s, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
-            const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
+            const double r2 = (P->pos[0][i] - P->pos[0][j]) * (P->pos[0][i] - P->pos[0][j]) + (P->pos[DIM_UP][i] - P->pos[DIM_UP][j]) * (P->pos[DIM_UP][i] - P->pos[DIM_UP][j]);
             if (r2 >= s->phys.K.r2max) continue;
             const double w = kernel_w(&s->phys.K, sqrt(r2));
             sw += w;
-            sp += (p0[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
+            sp += (p0[j] + P->rho[j] * G_ACC * (P->pos[DIM_UP][j] - P->pos[DIM_UP][i])) * w;
         }
         if (sw > 0.0) {
             assert_rel(P->p[i], sp / sw, REL);
@@ -380,10 +380,10 @@ static void test_pore_pressure(void **state)
     assert_non_null(pw);
     double ztop = -INFINITY;
     for (size_t i = 0; i < P->n; i++)
-        if (is_grain(s, i)) ztop = fmax(ztop, P->z[i] + 0.5 * DX);
+        if (is_grain(s, i)) ztop = fmax(ztop, P->pos[DIM_UP][i] + 0.5 * DX);
     assert_rel(ztop, 0.1, 1e-12);
     for (size_t i = 0; i < P->n; i++)
-        if (is_grain(s, i)) pw[i] = 1000.0 * G_ACC * (ztop - P->z[i]);
+        if (is_grain(s, i)) pw[i] = 1000.0 * G_ACC * (ztop - P->pos[DIM_UP][i]);
     update(s);
     const struct counts c = check_regimes(s, 0.1, p0, pw);
     print_message("saturated bed, G = 0.1 1/s: %ld fixed, %ld limited, %ld frictional\n", c.fixed, c.limited, c.frictional);
@@ -394,14 +394,14 @@ static void test_pore_pressure(void **state)
     const struct medium *m = &s->cfg.media[1];
     for (int k = 9; k >= 0; k--) {
         for (size_t i = 0; i < P->n; i++) {
-            if (!is_grain(s, i) || fabs(P->x[i] - 0.205) > 1e-9 || fabs(P->z[i] - (k + 0.5) * DX) > 1e-9) continue;
+            if (!is_grain(s, i) || fabs(P->pos[0][i] - 0.205) > 1e-9 || fabs(P->pos[DIM_UP][i] - (k + 0.5) * DX) > 1e-9) continue;
             if (P->mu[i] == m->paper.mu0) {
-                print_message("  %.3f  %8.2f  %8.2f     (limited: mu = mu0)\n", P->z[i], p0[i], pw[i]);
+                print_message("  %.3f  %8.2f  %8.2f     (limited: mu = mu0)\n", P->pos[DIM_UP][i], p0[i], pw[i]);
                 continue;
             }
             const double sig = (P->mu[i] - m->paper.eps_f_mu_f) * 0.1 / m->granular.sin_phi;
-            print_message("  %.3f  %8.2f  %8.2f     %8.2f               %8.2f\n", P->z[i], p0[i], pw[i], sig,
-                          (m->rho0 - 1000.0) * G_ACC * (ztop - P->z[i]));
+            print_message("  %.3f  %8.2f  %8.2f     %8.2f               %8.2f\n", P->pos[DIM_UP][i], p0[i], pw[i], sig,
+                          (m->rho0 - 1000.0) * G_ACC * (ztop - P->pos[DIM_UP][i]));
         }
     }
     free(p0);
@@ -431,13 +431,13 @@ static void check_tension(const char *media, int cutoff)
     const struct medium *m = &s->cfg.media[0];
     assert_int_equal(m->tension_cutoff, cutoff);
     for (size_t i = 0; i < P->n; i++)
-        if (is_grain(s, i)) P->rho[i] = m->rho0 * (P->z[i] < 0.05 ? 0.99 : 1.01);
+        if (is_grain(s, i)) P->rho[i] = m->rho0 * (P->pos[DIM_UP][i] < 0.05 ? 0.99 : 1.01);
     integrate_pressure_and_derived(s);
     long stretched = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
         const double eos = m->c * m->c * (P->rho[i] - m->rho0); /* -688.9 or +688.9 Pa */
-        if (P->z[i] < 0.05) {
+        if (P->pos[DIM_UP][i] < 0.05) {
             stretched++;
             if (cutoff) assert_true(P->p[i] == 0.0);
             else assert_rel(P->p[i], eos, 1e-12);
@@ -477,17 +477,17 @@ static void check_hold(const char *media, int hold)
     double *x0 = calloc(P->n, sizeof *x0), *z0 = calloc(P->n, sizeof *z0);
     assert_true(x0 && z0);
     for (size_t i = 0; i < P->n; i++) {
-        x0[P->id[i]] = P->x[i];
-        z0[P->id[i]] = P->z[i];
+        x0[P->id[i]] = P->pos[0][i];
+        z0[P->id[i]] = P->pos[DIM_UP][i];
     }
     assert_int_equal(integrate_step(s), MIXSPH_OK);
     long fixed = 0, moving = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
-        assert_true(P->x[i] == x0[P->id[i]] && P->z[i] == z0[P->id[i]]); /* fixed at the step's start: not drifted */
+        assert_true(P->pos[0][i] == x0[P->id[i]] && P->pos[DIM_UP][i] == z0[P->id[i]]); /* fixed at the step's start: not drifted */
         if (P->state[i] != MIXSPH_STATE_FIXED) continue;
         fixed++;
-        if (P->vx[i] != 0.0 || P->vz[i] != 0.0) moving++;
+        if (P->vel[0][i] != 0.0 || P->vel[DIM_UP][i] != 0.0) moving++;
     }
     print_message("hold_fixed = %d: %ld grains fixed after one step, %ld of them with a nonzero velocity\n", hold, fixed,
                   moving);
@@ -531,11 +531,11 @@ static void test_density_of_a_particle_alone(void **state)
     struct particles *P = &s->phys.P;
     size_t top = P->n;
     for (size_t i = 0; i < P->n; i++)
-        if (is_grain(s, i) && (top == P->n || P->x[i] + P->z[i] > P->x[top] + P->z[top])) top = i;
+        if (is_grain(s, i) && (top == P->n || P->pos[0][i] + P->pos[DIM_UP][i] > P->pos[0][top] + P->pos[DIM_UP][top])) top = i;
     const unsigned id = P->id[top];
     const double floor_rho = P->m[top] * kernel_w(&s->phys.K, 0.0);
     P->rho[top] = 1.001 * floor_rho;
-    P->vx[top] = P->vz[top] = 40.0 / sqrt(2.0);
+    P->vel[0][top] = P->vel[DIM_UP][top] = 40.0 / sqrt(2.0);
     integrate_pressure_and_derived(s);
     const double dt = s->phys.dt;
     assert_int_equal(integrate_step(s), MIXSPH_OK);
@@ -576,10 +576,10 @@ static void slide_top(mixsph_sim *s)
 {
     struct particles *P = &s->phys.P;
     for (size_t i = 0; i < P->n; i++) {
-        const double u = is_grain(s, i) && P->z[i] >= 0.065 ? 0.05 : 0.0;
-        P->vx[i] = P->uvx[i] = u;
-        P->vz[i] = P->uvz[i] = 0.0;
-        if (is_grain(s, i)) P->state[i] = u > 0.0 && P->x[i] < 0.1 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
+        const double u = is_grain(s, i) && P->pos[DIM_UP][i] >= 0.065 ? 0.05 : 0.0;
+        P->vel[0][i] = P->uv[0][i] = u;
+        P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = 0.0;
+        if (is_grain(s, i)) P->state[i] = u > 0.0 && P->pos[0][i] < 0.1 ? MIXSPH_STATE_FIXED : MIXSPH_STATE_MOBILE;
     }
     integrate_pressure_and_derived(s);
 }
@@ -614,11 +614,11 @@ static void test_fixed_bed(void **state)
     for (size_t i = 0; i < n; i++) {
         top[i] = -1;
         if (!is_grain(on, i)) continue;
-        const double col = floor((P->x[i] - x0) / two_h);
+        const double col = floor((P->pos[0][i] - x0) / two_h);
         for (size_t j = 0; j < n; j++) {
-            if (!is_grain(on, j) || floor((P->x[j] - x0) / two_h) != col) continue;
-            const int rest = st0[j] == MIXSPH_STATE_FIXED || hypot(P->vx[j], P->vz[j]) <= V_FB;
-            if (rest && (top[i] < 0 || P->z[j] > P->z[top[i]])) top[i] = (long)j;
+            if (!is_grain(on, j) || floor((P->pos[0][j] - x0) / two_h) != col) continue;
+            const int rest = st0[j] == MIXSPH_STATE_FIXED || hypot(P->vel[0][j], P->vel[DIM_UP][j]) <= V_FB;
+            if (rest && (top[i] < 0 || P->pos[DIM_UP][j] > P->pos[DIM_UP][top[i]])) top[i] = (long)j;
         }
     }
     update(off);
@@ -630,31 +630,31 @@ static void test_fixed_bed(void **state)
         assert_true(top[i] >= 0); /* every column of the bed has grains at rest */
         const size_t k = (size_t)top[i];
         /* the top: 0.095 m in the columns with held grains (x < 0.1 m, and the column across x = 0.1 m) */
-        const int high = fabs(P->z[k] - 0.095) < 1e-9;
-        assert_true(high || fabs(P->z[k] - 0.055) < 1e-9);
-        if (P->x[i] < 0.1) assert_true(high);
-        if (P->z[i] < P->z[k] - two_h) {
+        const int high = fabs(P->pos[DIM_UP][k] - 0.095) < 1e-9;
+        assert_true(high || fabs(P->pos[DIM_UP][k] - 0.055) < 1e-9);
+        if (P->pos[0][i] < 0.1) assert_true(high);
+        if (P->pos[DIM_UP][i] < P->pos[DIM_UP][k] - two_h) {
             assert_int_equal(P->state[i], MIXSPH_STATE_FIXED);
-            assert_true(P->vx[i] == 0.0 && P->vz[i] == 0.0 && P->mu[i] == m->paper.mu_thr);
-            const double p = P->p[k] + m->rho0 * G_ACC * (P->z[k] - P->z[i]);
+            assert_true(P->vel[0][i] == 0.0 && P->vel[DIM_UP][i] == 0.0 && P->mu[i] == m->paper.mu_thr);
+            const double p = P->p[k] + m->rho0 * G_ACC * (P->pos[DIM_UP][k] - P->pos[DIM_UP][i]);
             assert_rel(P->p[i], p, REL);
             assert_rel(P->rho[i], m->rho0 + p / (m->c * m->c), 1e-12);
             if (high) frozen_left++;
             else frozen_right++;
         } else { /* the regime as without the option */
             assert_int_equal(P->state[i], Q->state[i]);
-            assert_true(P->mu[i] == Q->mu[i] && P->vx[i] == Q->vx[i] && P->rho[i] == Q->rho[i]);
+            assert_true(P->mu[i] == Q->mu[i] && P->vel[0][i] == Q->vel[0][i] && P->rho[i] == Q->rho[i]);
             if (P->state[i] == MIXSPH_STATE_MOBILE) {
                 assert_true(P->p[i] == Q->p[i]);
             } else { /* held: from its mobile neighbours (frozen grains are not mobile ones) */
                 double sw = 0.0, sp = 0.0;
                 for (size_t j = 0; j < n; j++) {
                     if (!is_grain(on, j) || P->state[j] != MIXSPH_STATE_MOBILE) continue;
-                    const double r2 = (P->x[i] - P->x[j]) * (P->x[i] - P->x[j]) + (P->z[i] - P->z[j]) * (P->z[i] - P->z[j]);
+                    const double r2 = (P->pos[0][i] - P->pos[0][j]) * (P->pos[0][i] - P->pos[0][j]) + (P->pos[DIM_UP][i] - P->pos[DIM_UP][j]) * (P->pos[DIM_UP][i] - P->pos[DIM_UP][j]);
                     if (r2 >= on->phys.K.r2max) continue;
                     const double w = kernel_w(&on->phys.K, sqrt(r2));
                     sw += w;
-                    sp += (P->p[j] + P->rho[j] * G_ACC * (P->z[j] - P->z[i])) * w;
+                    sp += (P->p[j] + P->rho[j] * G_ACC * (P->pos[DIM_UP][j] - P->pos[DIM_UP][i])) * w;
                 }
                 assert_true(sw > 0.0);
                 assert_rel(P->p[i], sp / sw, REL);

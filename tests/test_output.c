@@ -167,10 +167,10 @@ static void test_run_file_fields(void **state)
             assert_true(t_snap == mixsph_sim_time(s));
             for (size_t i = 0; i < n; i++) {
                 const size_t r = v.id[i];
-                assert_memory_equal(&pos[2 * r], &v.x[i], sizeof(double));
-                assert_memory_equal(&pos[2 * r + 1], &v.z[i], sizeof(double));
-                assert_memory_equal(&vel[2 * r], &v.vx[i], sizeof(double));
-                assert_memory_equal(&vel[2 * r + 1], &v.vz[i], sizeof(double));
+                assert_memory_equal(&pos[2 * r], &v.pos[0][i], sizeof(double));
+                assert_memory_equal(&pos[2 * r + 1], &v.pos[v.dim - 1][i], sizeof(double));
+                assert_memory_equal(&vel[2 * r], &v.vel[0][i], sizeof(double));
+                assert_memory_equal(&vel[2 * r + 1], &v.vel[v.dim - 1][i], sizeof(double));
                 assert_memory_equal(&rho[r], &v.rho[i], sizeof(double));
                 assert_memory_equal(&p[r], &v.p[i], sizeof(double));
                 assert_memory_equal(&mu[r], &v.mu[i], sizeof(double));
@@ -235,7 +235,7 @@ static void same_state(const mixsph_sim *a, const mixsph_sim *b)
     mixsph_sim_particles_view(a, &u);
     mixsph_sim_particles_view(b, &v);
     assert_int_equal(u.n, v.n);
-    const double *fu[7] = {u.x, u.z, u.vx, u.vz, u.rho, u.p, u.mu}, *fv[7] = {v.x, v.z, v.vx, v.vz, v.rho, v.p, v.mu};
+    const double *fu[7] = {u.pos[0], u.pos[u.dim - 1], u.vel[0], u.vel[u.dim - 1], u.rho, u.p, u.mu}, *fv[7] = {v.pos[0], v.pos[v.dim - 1], v.vel[0], v.vel[v.dim - 1], v.rho, v.p, v.mu};
     for (int k = 0; k < 7; k++) assert_memory_equal(fu[k], fv[k], u.n * sizeof(double));
     assert_memory_equal(u.id, v.id, u.n * sizeof(uint32_t));
     assert_memory_equal(u.state, v.state, u.n);
@@ -379,7 +379,7 @@ static void test_load_state_rewrites_snapshots(void **state)
     assert_int_equal(read_attr_ll(f, "n_snapshots"), 2);
     const hid_t g = H5Gopen2(f, "/snapshots/000001", H5P_DEFAULT);
     double *pos = read_dataset(g, "position", n, 2, H5T_FLOAT, 8, "m");
-    for (size_t i = 0; i < n; i++) assert_memory_equal(&pos[2 * v.id[i]], &v.x[i], sizeof(double));
+    for (size_t i = 0; i < n; i++) assert_memory_equal(&pos[2 * v.id[i]], &v.pos[0][i], sizeof(double));
     free(pos);
     H5Gclose(g);
     H5Fclose(f);

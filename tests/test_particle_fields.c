@@ -114,8 +114,8 @@ static void test_absent_rows_have_no_memory(void **state)
             assert_int_equal(particles_push(&P, (const double[DIM]){(double)i, -(double)i}, 1000.0, 1.0, (uint8_t)(i % 3), 0), i);
         const int implicit = (features & PARTICLE_FEATURE_IMPLICIT_VISCOUS) != 0;
         if (implicit) {
-            for (size_t i = 0; i < 40; i++) assert_true(P.visc_dvx[i] == 0.0);
-            for (size_t i = 0; i < 40; i++) P.visc_dvx[i] = 0.5 * (double)i;
+            for (size_t i = 0; i < 40; i++) assert_true(P.visc_dv[0][i] == 0.0);
+            for (size_t i = 0; i < 40; i++) P.visc_dv[0][i] = 0.5 * (double)i;
         }
         size_t perm[40];
         for (size_t k = 0; k < 40; k++) perm[k] = 39 - k;
@@ -125,10 +125,10 @@ static void test_absent_rows_have_no_memory(void **state)
         assert_int_equal(particles_copy(&Q, &P), 0);
         for (size_t k = 0; k < 40; k++) {
             const size_t i = 39 - k;
-            assert_true(Q.x[k] == (double)i && Q.z[k] == -(double)i && Q.id[k] == i && Q.medium[k] == i % 3);
-            if (implicit) assert_true(Q.visc_dvx[k] == 0.5 * (double)i);
+            assert_true(Q.pos[0][k] == (double)i && Q.pos[DIM_UP][k] == -(double)i && Q.id[k] == i && Q.medium[k] == i % 3);
+            if (implicit) assert_true(Q.visc_dv[0][k] == 0.5 * (double)i);
         }
-        assert_true(implicit ? Q.visc_dvx != NULL : Q.visc_dvx == NULL);
+        assert_true(implicit ? Q.visc_dv[0] != NULL : Q.visc_dv[0] == NULL);
         particles_free(&Q);
         particles_free(&P);
     }
@@ -171,8 +171,8 @@ static void test_view_shows_the_view_rows(void **state)
     mixsph_particle_field f;
     assert_int_equal(mixsph_sim_particle_field_find(s, "velocity", &f), MIXSPH_OK);
     assert_true(f.components == 2 && f.type == MIXSPH_FIELD_F64 && f.n == v.n);
-    assert_ptr_equal(f.data[0], v.vx);
-    assert_ptr_equal(f.data[1], v.vz);
+    assert_ptr_equal(f.data[0], v.vel[0]);
+    assert_ptr_equal(f.data[1], v.vel[v.dim - 1]);
     assert_string_equal(f.columns, "vx,vz");
     assert_string_equal(f.unit, "m/s");
     assert_int_equal(mixsph_sim_particle_field_find(s, "id", &f), MIXSPH_OK);
@@ -184,7 +184,7 @@ static void test_view_shows_the_view_rows(void **state)
     /* by index, in table order; past the end, or a field not in the view: refused */
     assert_int_equal(mixsph_sim_particle_field(s, 0, &f), MIXSPH_OK);
     assert_string_equal(f.name, "position");
-    assert_ptr_equal(f.data[0], v.x);
+    assert_ptr_equal(f.data[0], v.pos[0]);
     assert_int_equal(mixsph_sim_particle_field(s, rows, &f), MIXSPH_ERR_ARG);
     assert_int_equal(mixsph_sim_particle_field_find(s, "acceleration", &f), MIXSPH_ERR_ARG);
     assert_int_equal(mixsph_sim_particle_field_find(s, "nonsense", &f), MIXSPH_ERR_ARG);
@@ -219,8 +219,8 @@ static void test_state_holds_the_present_rows_by_name(void **state)
 {
     (void)state;
     mixsph_sim *e = make(0), *i = make(1);
-    assert_null(e->phys.P.visc_dvx);
-    assert_non_null(i->phys.P.visc_dvx);
+    assert_null(e->phys.P.visc_dv[0]);
+    assert_non_null(i->phys.P.visc_dv[0]);
     assert_int_equal(mixsph_sim_step(e), MIXSPH_OK);
     assert_int_equal(mixsph_sim_step(i), MIXSPH_OK);
     void *be, *bi;

@@ -81,10 +81,10 @@ static double free_surface(const mixsph_sim *s)
     double ztop = -INFINITY, sz = 0.0;
     int n = 0;
     for (size_t i = 0; i < v.n; i++)
-        if (v.state[i] != MIXSPH_STATE_WALL) ztop = fmax(ztop, v.z[i]);
+        if (v.state[i] != MIXSPH_STATE_WALL) ztop = fmax(ztop, v.pos[v.dim - 1][i]);
     for (size_t i = 0; i < v.n; i++)
-        if (v.state[i] != MIXSPH_STATE_WALL && v.z[i] > ztop - 0.5 * DX) {
-            sz += v.z[i];
+        if (v.state[i] != MIXSPH_STATE_WALL && v.pos[v.dim - 1][i] > ztop - 0.5 * DX) {
+            sz += v.pos[v.dim - 1][i];
             n++;
         }
     assert_true(n >= 38); /* the top row has 40 particles */

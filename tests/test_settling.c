@@ -110,9 +110,9 @@ static double buoyant_weight_error(const char *extra, double z_g)
     for (size_t i = 0; i < P->n; i++) {
         if (!is_grain(s, i)) continue;
         const struct medium *m = &s->cfg.media[P->medium[i]];
-        const double pw = pore_pressure(C, m, P->x[i], P->z[i]);
+        const double pw = pore_pressure(C, m, P->pos[0][i], P->pos[DIM_UP][i]);
         const double sigma = P->p[i] - s->cfg.p_background - pw;
-        const double want = (rho0 - RHO_W) * G_ACC * (z_g - P->z[i]);
+        const double want = (rho0 - RHO_W) * G_ACC * (z_g - P->pos[DIM_UP][i]);
         worst = fmax(worst, fabs(sigma - want));
         grains++;
     }
@@ -149,8 +149,8 @@ static void sink(int law, double t_end, double *z_hi, double *z_lo)
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || P->medium[i] != 1) continue;
         assert_true(P->state[i] != MIXSPH_STATE_LOST);
-        *z_hi = fmax(*z_hi, P->z[i]);
-        *z_lo = fmin(*z_lo, P->z[i]);
+        *z_hi = fmax(*z_hi, P->pos[DIM_UP][i]);
+        *z_lo = fmin(*z_lo, P->pos[DIM_UP][i]);
     }
     mixsph_sim_destroy(s);
 }
@@ -196,13 +196,13 @@ static double surface_grain_descent(int law, double t_end, double *above_water)
     double zg = NAN, xg = NAN;
     for (size_t i = 0; i < P->n; i++)
         if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 1) {
-            zg = P->z[i];
-            xg = P->x[i];
+            zg = P->pos[DIM_UP][i];
+            xg = P->pos[0][i];
         }
     double top = -INFINITY;
     for (size_t i = 0; i < P->n; i++)
-        if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 0 && fabs(P->x[i] - xg) <= 0.01)
-            top = fmax(top, P->z[i]);
+        if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 0 && fabs(P->pos[0][i] - xg) <= 0.01)
+            top = fmax(top, P->pos[DIM_UP][i]);
     *above_water = zg - top;
     mixsph_sim_destroy(s);
     return 0.295 - zg;

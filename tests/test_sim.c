@@ -55,7 +55,7 @@ static void snap_take(const mixsph_sim *s, struct snap *q)
     q->t = mixsph_sim_time(s);
     q->dt = mixsph_sim_dt(s);
     q->steps = mixsph_sim_steps(s);
-    const double *src[7] = {v.x, v.z, v.vx, v.vz, v.rho, v.p, v.mu};
+    const double *src[7] = {v.pos[0], v.pos[v.dim - 1], v.vel[0], v.vel[v.dim - 1], v.rho, v.p, v.mu};
     for (int k = 0; k < 7; k++) {
         q->f[k] = calloc(v.n, sizeof(double));
         assert_non_null(q->f[k]);
@@ -403,7 +403,7 @@ static double top_water_z(double level, int anchored)
     assert_int_equal(mixsph_sim_particles_view(s, &v), MIXSPH_OK);
     double top = -INFINITY;
     for (size_t i = 0; i < v.n; i++)
-        if (v.state[i] != MIXSPH_STATE_WALL) top = fmax(top, v.z[i]);
+        if (v.state[i] != MIXSPH_STATE_WALL) top = fmax(top, v.pos[v.dim - 1][i]);
     mixsph_sim_destroy(s);
     return top;
 }

@@ -89,9 +89,9 @@ static double *brute_force(const mixsph_sim *s, double f)
         double a = 0.0, u = 0.0;
         for (size_t j = 0; j < P->n; j++) {
             if (j == i || P->state[j] == MIXSPH_STATE_WALL) continue;
-            const double r = hypot(P->x[i] - P->x[j], P->z[i] - P->z[j]);
+            const double r = hypot(P->pos[0][i] - P->pos[0][j], P->pos[DIM_UP][i] - P->pos[DIM_UP][j]);
             const double w = kernel_w(&s->phys.K, r) * P->m[j] / P->rho[j];
-            a += (P->p[j] - P->p[i] + 0.5 * (P->rho[i] + P->rho[j]) * G_ACC * (P->z[j] - P->z[i])) * w;
+            a += (P->p[j] - P->p[i] + 0.5 * (P->rho[i] + P->rho[j]) * G_ACC * (P->pos[DIM_UP][j] - P->pos[DIM_UP][i])) * w;
             u += w;
         }
         out[i] = P->p[i] + f * s->cfg.media[0].c * a / u;
@@ -162,7 +162,7 @@ static void test_checkerboard_damped(void **state)
     memcpy(hyd, P->p, P->n * sizeof *hyd);
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const long ix = lround(P->x[i] / DX - 0.5), iz = lround(P->z[i] / DX - 0.5);
+        const long ix = lround(P->pos[0][i] / DX - 0.5), iz = lround(P->pos[DIM_UP][i] / DX - 0.5);
         P->rho[i] += ((ix + iz) % 2 ? -A : A) / (c * c);
     }
     integrate_pressure_and_derived(s);
@@ -181,7 +181,7 @@ static void test_checkerboard_damped(void **state)
     long n_in = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        if (P->x[i] < margin || P->x[i] > 0.4 - margin || P->z[i] < margin || P->z[i] > 0.3 - margin) continue;
+        if (P->pos[0][i] < margin || P->pos[0][i] > 0.4 - margin || P->pos[DIM_UP][i] < margin || P->pos[DIM_UP][i] > 0.3 - margin) continue;
         s0 += (before[i] - hyd[i]) * (before[i] - hyd[i]);
         s1 += (P->p[i] - hyd[i]) * (P->p[i] - hyd[i]);
         n_in++;

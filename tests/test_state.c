@@ -44,7 +44,7 @@ static int same(const mixsph_sim *a, const mixsph_sim *b)
     mixsph_sim_particles_view(a, &u);
     mixsph_sim_particles_view(b, &v);
     if (u.n != v.n) return 0;
-    const double *fu[7] = {u.x, u.z, u.vx, u.vz, u.rho, u.p, u.mu}, *fv[7] = {v.x, v.z, v.vx, v.vz, v.rho, v.p, v.mu};
+    const double *fu[7] = {u.pos[0], u.pos[u.dim - 1], u.vel[0], u.vel[u.dim - 1], u.rho, u.p, u.mu}, *fv[7] = {v.pos[0], v.pos[v.dim - 1], v.vel[0], v.vel[v.dim - 1], v.rho, v.p, v.mu};
     for (int k = 0; k < 7; k++)
         if (memcmp(fu[k], fv[k], u.n * sizeof(double)) != 0) return 0;
     if (memcmp(u.state, v.state, u.n) || memcmp(u.medium, v.medium, u.n) || memcmp(u.id, v.id, u.n * sizeof(uint32_t)))
@@ -184,7 +184,7 @@ static double plate_x(const mixsph_sim *s)
     size_t n = 0;
     for (size_t i = 0; i < v.n; i++)
         if (v.state[i] == MIXSPH_STATE_WALL && v.medium[i] == 1) {
-            sum += v.x[i];
+            sum += v.pos[0][i];
             n++;
         }
     assert_true(n > 0);
@@ -238,7 +238,7 @@ static double fastest(const mixsph_sim *s)
     mixsph_sim_particles_view(s, &v);
     double u = 0.0;
     for (size_t i = 0; i < v.n; i++)
-        if (v.state[i] <= MIXSPH_STATE_FIXED) u = fmax(u, hypot(v.vx[i], v.vz[i]));
+        if (v.state[i] <= MIXSPH_STATE_FIXED) u = fmax(u, hypot(v.vel[0][i], v.vel[v.dim - 1][i]));
     return u;
 }
 
@@ -269,8 +269,8 @@ static void test_external_velocity_jump(void **state)
         mixsph_sim_particles_view(s, &v);
         for (size_t i = 0; i < v.n; i++)
             if (v.state[i] == MIXSPH_STATE_WALL && v.medium[i] == 1) { /* the ram is the second wall */
-                assert_true(v.vx[i] == U * ux);
-                assert_true(v.vz[i] == U * uz);
+                assert_true(v.vel[0][i] == U * ux);
+                assert_true(v.vel[v.dim - 1][i] == U * uz);
             }
         const double t0 = mixsph_sim_time(s);
         double worst = 0.0;

@@ -66,7 +66,7 @@ static void run(const struct run_def *r, const int threads[3], struct state *q)
     q->n = v.n;
     q->steps = mixsph_sim_steps(s);
     q->t = mixsph_sim_time(s);
-    const double *src[N_FIELDS] = {v.x, v.z, v.vx, v.vz, v.rho, v.p, v.mu};
+    const double *src[N_FIELDS] = {v.pos[0], v.pos[v.dim - 1], v.vel[0], v.vel[v.dim - 1], v.rho, v.p, v.mu};
     for (int k = 0; k < N_FIELDS; k++) {
         q->f[k] = malloc(v.n * sizeof(double) + 1);
         assert_non_null(q->f[k]);

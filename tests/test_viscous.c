@@ -141,24 +141,24 @@ static void run_channel(const char *kernel, double h_over_dx, double p_b, struct
         for (size_t i = 0; i < v.n; i++) {
             if (v.state[i] == MIXSPH_STATE_WALL) continue;
             assert_int_equal(v.state[i], MIXSPH_STATE_MOBILE); /* none lost */
-            vmax = fmax(vmax, hypot(v.vx[i], v.vz[i]));
+            vmax = fmax(vmax, hypot(v.vel[0][i], v.vel[v.dim - 1][i]));
             srho += v.rho[i];
             nf++;
             sp_all += v.p[i];
             n_all++;
-            if (v.x[i] > X0 && v.x[i] < X1) {
-                int b = (int)floor(v.z[i] / DX);
+            if (v.pos[0][i] > X0 && v.pos[0][i] < X1) {
+                int b = (int)floor(v.pos[v.dim - 1][i] / DX);
                 assert_true(b >= 0 && b < NBIN); /* no particle crosses the floor or the lid */
-                su[b] += v.vx[i];
-                sa[b] += u_exact(v.z[i]);
-                sz[b] += v.z[i];
+                su[b] += v.vel[0][i];
+                sa[b] += u_exact(v.pos[v.dim - 1][i]);
+                sz[b] += v.pos[v.dim - 1][i];
                 cnt[b]++;
             }
-            if (v.z[i] > 0.02 && v.z[i] < 0.03 && v.x[i] > 0.15 && v.x[i] < 0.35) {
-                fx += v.x[i];
+            if (v.pos[v.dim - 1][i] > 0.02 && v.pos[v.dim - 1][i] < 0.03 && v.pos[0][i] > 0.15 && v.pos[0][i] < 0.35) {
+                fx += v.pos[0][i];
                 fp += v.p[i];
-                fxx += v.x[i] * v.x[i];
-                fxp += v.x[i] * v.p[i];
+                fxx += v.pos[0][i] * v.pos[0][i];
+                fxp += v.pos[0][i] * v.p[i];
                 fn++;
             }
         }

@@ -70,8 +70,8 @@ static void launch_in_basin(const char *placement, const char *bodies, double u,
     size_t n_fluid = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_MOBILE) continue;
-        P->vx[i] = u;
-        P->vz[i] = w;
+        P->vel[0][i] = u;
+        P->vel[DIM_UP][i] = w;
         n_fluid++;
     }
     assert_true(n_fluid > 0);
@@ -84,15 +84,15 @@ static void launch_in_basin(const char *placement, const char *bodies, double u,
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
             /* reference: the basin (docs/model.md section 8: no particle crosses a wall); none lost */
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE);
-            const double d = basin_inside_distance(P->x[i], P->z[i]);
+            const double d = basin_inside_distance(P->pos[0][i], P->pos[DIM_UP][i]);
             if (d < d_min) {
                 d_min = d;
                 t_dmin = mixsph_sim_time(s);
             }
-            z_max = fmax(z_max, P->z[i]);
-            x_max = fmax(x_max, P->x[i]);
+            z_max = fmax(z_max, P->pos[DIM_UP][i]);
+            x_max = fmax(x_max, P->pos[0][i]);
             if (!(d > 0.0))
-                print_error("particle %u at (%.6f, %.6f), %.3g m outside, t = %.5f s\n", P->id[i], P->x[i], P->z[i], -d,
+                print_error("particle %u at (%.6f, %.6f), %.3g m outside, t = %.5f s\n", P->id[i], P->pos[0][i], P->pos[DIM_UP][i], -d,
                             mixsph_sim_time(s));
             /* tolerance 0: strictly on the fluid side */
             assert_true(d > 0.0);
@@ -168,13 +168,13 @@ static void test_aligned_placement(void **state)
         n_wall++;
         volume += P->vol[i];
         int at_end = 0;
-        const double d = geom_signed_distance(&wl->line, wl->side, P->x[i], P->z[i], &at_end);
+        const double d = geom_signed_distance(&wl->line, wl->side, P->pos[0][i], P->pos[DIM_UP][i], &at_end);
         /* reference: behind the wall, within its depth, beside it (tolerance: round-off) */
         assert_false(at_end);
         assert_true(d < 0.0 && d >= -depth - 1e-12);
         double to_vertex = INFINITY;
         for (size_t k = 0; k < wl->line.n; k++)
-            to_vertex = fmin(to_vertex, hypot(P->x[i] - wl->line.x[k], P->z[i] - wl->line.z[k]));
+            to_vertex = fmin(to_vertex, hypot(P->pos[0][i] - wl->line.x[k], P->pos[DIM_UP][i] - wl->line.z[k]));
         if (to_vertex > depth + dx) { /* away from the corners: on a row, (l + 1/2) dx behind */
             const double l = -d / dx - 0.5;
             if (fabs(l - round(l)) > 1e-9) off_row++;
@@ -182,7 +182,7 @@ static void test_aligned_placement(void **state)
         }
         for (size_t j = i + 1; j < P->n; j++)
             if (P->state[j] == MIXSPH_STATE_WALL)
-                nearest = fmin(nearest, hypot(P->x[i] - P->x[j], P->z[i] - P->z[j]));
+                nearest = fmin(nearest, hypot(P->pos[0][i] - P->pos[0][j], P->pos[DIM_UP][i] - P->pos[DIM_UP][j]));
     }
     /* the band behind the wall, measured on a grid of dx / 20 independent of the placement */
     const double cell = dx / 20.0;
@@ -276,31 +276,31 @@ static void test_moving_plate(void **state)
         /* the plate follows its law: reference, the integral of the law; tolerance 1e-6 m (the
          * mid-step velocity is exact on the linear pieces; a step across a kink of the law errs
          * by about |jump of acceleration| dt^2 / 8, < 1e-8 m here, at 6 kinks) */
-        const double e = fabs(s->phys.walls.state[plate].ox - X);
+        const double e = fabs(s->phys.walls.state[plate].o[0] - X);
         err_max = fmax(err_max, e);
         assert_true(e < 1e-6);
-        assert_true(fabs(s->phys.walls.state[plate].oz) < 1e-15);
+        assert_true(fabs(s->phys.walls.state[plate].o[DIM_UP]) < 1e-15);
         for (size_t i = 0; i < P->n; i++) {
             if (P->state[i] == MIXSPH_STATE_WALL) continue;
             assert_int_equal(P->state[i], MIXSPH_STATE_MOBILE); /* none lost */
-            z_max = fmax(z_max, P->z[i]);
+            z_max = fmax(z_max, P->pos[DIM_UP][i]);
             /* in the plate's frame: the face is x' = 0 for 0 <= z <= 0.5, the fluid at x' > 0;
              * reference: docs/model.md section 8, tolerance 0 (strictly in front of the face) */
-            const double xp = P->x[i] - X;
-            if (P->z[i] <= 0.5 && xp < gap_min) {
+            const double xp = P->pos[0][i] - X;
+            if (P->pos[DIM_UP][i] <= 0.5 && xp < gap_min) {
                 gap_min = xp;
                 t_gap = t;
             }
-            if (P->z[i] <= 0.5 && !(xp > 0.0))
-                print_error("particle %u %.3g m behind the plate at z = %.4f, t = %.5f s\n", P->id[i], -xp, P->z[i], t);
-            if (P->z[i] <= 0.5) assert_true(xp > 0.0);
-            assert_true(P->z[i] > 0.0 && P->x[i] < 1.2); /* floor and far wall */
+            if (P->pos[DIM_UP][i] <= 0.5 && !(xp > 0.0))
+                print_error("particle %u %.3g m behind the plate at z = %.4f, t = %.5f s\n", P->id[i], -xp, P->pos[DIM_UP][i], t);
+            if (P->pos[DIM_UP][i] <= 0.5) assert_true(xp > 0.0);
+            assert_true(P->pos[DIM_UP][i] > 0.0 && P->pos[0][i] < 1.2); /* floor and far wall */
         }
     }
     const long clips = mixsph_sim_output_find(s, "wall_corrections");
     print_message("plate stroke %.4f m (law %.4f m, largest deviation %.2e m); closest particle %.4f dx in front "
                   "of it at t = %.4f s; highest particle z = %.3f m; %.0f wall corrections; %llu steps\n",
-                  s->phys.walls.state[plate].ox, law_displacement(t_end), err_max, gap_min / s->phys.dx, t_gap, z_max,
+                  s->phys.walls.state[plate].o[0], law_displacement(t_end), err_max, gap_min / s->phys.dx, t_gap, z_max,
                   mixsph_sim_output_value(s, (size_t)clips), (unsigned long long)mixsph_sim_steps(s));
     /* the stroke of the law: about 0.34 m at speed scale 1 (cases/vajont_padua.json), checked on the table */
     assert_true(fabs(law_displacement(t_end) / PLATE_SPEED_SCALE - 0.34) < 0.01);
@@ -317,7 +317,7 @@ static double particle_energy(const mixsph_sim *s)
     double e = 0.0;
     for (size_t i = 0; i < P->n; i++)
         if (P->state[i] != MIXSPH_STATE_WALL)
-            e += P->m[i] * (s->cfg.g * P->z[i] + 0.5 * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]));
+            e += P->m[i] * (s->cfg.g * P->pos[DIM_UP][i] + 0.5 * (P->vel[0][i] * P->vel[0][i] + P->vel[DIM_UP][i] * P->vel[DIM_UP][i]));
     return e;
 }
 
@@ -346,10 +346,10 @@ static void test_lifted_tank_work(void **state)
     const double work = mixsph_sim_output_value(s, (size_t)k), gain = particle_energy(s) - e0;
     /* the lift: 0.05 m with 40 kg/m of water: M g dz = 19.6 J/m, M v^2 / 2 = 0.2 J/m */
     print_message("lifted tank: work %.4f J/m, the water's energy gain %.4f J/m (%+.3f %%); tank raised %.4f m\n", work,
-                  gain, 100.0 * (work / gain - 1.0), s->phys.walls.state[0].oz);
+                  gain, 100.0 * (work / gain - 1.0), s->phys.walls.state[0].o[DIM_UP]);
     /* the tank follows its law: 0.01 m over the ramp, then 0.1 m/s (the mid-step velocity is exact on
      * linear pieces) */
-    assert_true(fabs(s->phys.walls.state[0].oz - (0.01 + 0.1 * (mixsph_sim_time(s) - 0.2))) < 1e-9);
+    assert_true(fabs(s->phys.walls.state[0].o[DIM_UP] - (0.01 + 0.1 * (mixsph_sim_time(s) - 0.2))) < 1e-9);
     /* reference: the energy balance W = dE + dissipated + stored, the last two >= 0 and small in a
      * slow lift; tolerance: W within [dE - 0.1 %, dE + 1 %] (measured +0.04 %; the work is summed
      * as the force at a step's start times the step's displacement, first order in dt) */

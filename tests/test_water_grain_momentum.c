@@ -81,9 +81,9 @@ static struct momentum total_momentum(const struct particles *P)
     struct momentum M = {0.0, 0.0, 0.0};
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        M.px += P->m[i] * P->vx[i];
-        M.pz += P->m[i] * P->vz[i];
-        M.scale += P->m[i] * hypot(P->vx[i], P->vz[i]);
+        M.px += P->m[i] * P->vel[0][i];
+        M.pz += P->m[i] * P->vel[DIM_UP][i];
+        M.scale += P->m[i] * hypot(P->vel[0][i], P->vel[DIM_UP][i]);
     }
     return M;
 }
@@ -94,8 +94,8 @@ static int clear_of_walls(const mixsph_sim *s)
     const struct particles *P = &s->phys.P;
     double zmin = INFINITY, zwall = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] == MIXSPH_STATE_WALL) zwall = fmax(zwall, P->z[i]);
-        else zmin = fmin(zmin, P->z[i]);
+        if (P->state[i] == MIXSPH_STATE_WALL) zwall = fmax(zwall, P->pos[DIM_UP][i]);
+        else zmin = fmin(zmin, P->pos[DIM_UP][i]);
     }
     return zmin - zwall > sqrt(s->phys.K.r2max);
 }
@@ -107,8 +107,8 @@ static void launch_grains(mixsph_sim *s, double jitter)
     uint64_t rng = 44;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL || s->cfg.media[P->medium[i]].law == LAW_NEWTONIAN) continue;
-        P->vx[i] = P->uvx[i] = 1.0 + test_random_uniform(&rng, -jitter, jitter);
-        P->vz[i] = P->uvz[i] = test_random_uniform(&rng, -jitter, jitter);
+        P->vel[0][i] = P->uv[0][i] = 1.0 + test_random_uniform(&rng, -jitter, jitter);
+        P->vel[DIM_UP][i] = P->uv[DIM_UP][i] = test_random_uniform(&rng, -jitter, jitter);
     }
 }
 
@@ -154,7 +154,7 @@ static unsigned long run_box_drift(const char *grain, const char *numerics, doub
     }
     for (size_t i = 0; i < P->n; i++)
         water_moving += P->state[i] != MIXSPH_STATE_WALL && s->cfg.media[P->medium[i]].law == LAW_NEWTONIAN &&
-                        P->vx[i] > 0.01;
+                        P->vel[0][i] > 0.01;
     print_message("%s%s: %lu steps to t = %.4f s, |P0| = %.6f kg m/s/m, S = %.6f, largest drift %.3g kg m/s/m, "
                   "largest drift / bound = %.3g, water particles pushed above 1 cm/s: %zu\n",
                   grain, numerics, steps, mixsph_sim_time(s), hypot(M0.px, M0.pz), scale, worst_drift, worst, water_moving);

@@ -69,8 +69,12 @@ class Run:
         self.granular = [kinds.get(m, "fluid") == "granular" for m in self.media]
 
     def snapshot(self, k):
+        """Snapshot k: positions in the plotted x-z plane (the first and the vertical, last,
+        component: a 3D run is seen from the side), speeds |u|, media, states, time."""
         g = self.groups[k]
-        return {name: g[name][()] for name in ("position", "velocity", "medium", "state")} | {
+        pos = g["position"][()]
+        return {name: g[name][()] for name in ("medium", "state")} | {
+            "position": pos[:, [0, pos.shape[1] - 1]], "speed": np.linalg.norm(g["velocity"][()], axis=1),
             "time": float(g.attrs["time"]), "index": k}
 
     def max_speed(self):
@@ -79,7 +83,7 @@ class Run:
             s = self.snapshot(k)
             moving = s["state"] <= FIXED
             if moving.any():
-                v = max(v, float(np.hypot(*s["velocity"][moving].T).max()))
+                v = max(v, float(s["speed"][moving].max()))
         return v
 
 
@@ -150,7 +154,7 @@ class Drawer:
         self.walls.set_offsets(pos[wall] if not self.args.no_walls else np.empty((0, 2)))
         self.pts.set_offsets(pos[part])
         if self.args.color == "speed":
-            self.pts.set_array(np.hypot(*s["velocity"][part].T))
+            self.pts.set_array(s["speed"][part])
         else:
             med = s["medium"][part]
             colours = np.where((st[part] == FIXED)[:, None], self.fixed_cols[med], self.cols[med])

@@ -151,10 +151,15 @@ long mixsph_sim_output_find(const mixsph_sim *s, const char *name);
  *  granular and wall particles, told apart by `state`); the order changes every step (sorted by
  *  cell), `id` is stable. For wall particles `medium` is the wall's index. Every field of a
  *  simulation, those a material law or a scheme declares included, is read by name or index with
- *  mixsph_sim_particle_field. */
+ *  mixsph_sim_particle_field.
+ *  Positions and velocities have `dim` components (the library's build: 2 or 3), pos[d] and
+ *  vel[d] for d < dim, the vertical one last (d = dim - 1, along which gravity acts): x, z in 2D,
+ *  x, y, z in 3D; pos[d] and vel[d] for d >= dim are NULL. */
 typedef struct {
     size_t n, n_fluid;
-    const double *x, *z, *vx, *vz, *rho, *p, *mu; /* m, m/s, kg/m3, Pa, Pa s */
+    int dim;                                      /* components of pos and vel: 2 or 3 */
+    const double *pos[3], *vel[3];                /* m, m/s */
+    const double *rho, *p, *mu;                   /* kg/m3, Pa, Pa s */
     const uint8_t *medium, *state;                /* medium index, MIXSPH_STATE_* */
     const uint32_t *id;
 } mixsph_particles_view;
@@ -193,7 +198,8 @@ mixsph_status mixsph_sim_particle_field_find(const mixsph_sim *s, const char *na
 /* ---- external wall motion (co-simulation input) ------------------------------------------- */
 
 /** Replace the prescribed motion law of the moving wall `wall` (its name in the case) by the
- *  constant velocity (vx, vz) [m/s] from now on, until mixsph_sim_release_wall_velocity. Only
+ *  constant velocity (vx, vz) [m/s] from now on, until mixsph_sim_release_wall_velocity (a wall
+ *  is a polyline of the vertical x-z plane and moves in it, in 3D too). Only
  *  walls that have a motion in the case can be driven. Returns MIXSPH_ERR_ARG for an unknown or
  *  fixed wall or a non-finite velocity. */
 mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, double vx, double vz);

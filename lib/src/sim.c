@@ -34,6 +34,7 @@ static int make_dir(const char *path)
 #endif
 }
 
+#if DIM == 2 /* bodies are polygons of the x-z plane (case input), placed on a 2D lattice */
 /* A lattice site of a body, for the hydrostatic initialisation. */
 struct site {
     long i, k;       /* lattice indices: x = (i + 1/2) dx, z = z_offset + (k + 1/2) dx */
@@ -48,13 +49,12 @@ static int site_cmp(const void *a, const void *b)
     return 0;
 }
 
-/* Is (x, z) too close to a wall, or behind one, to hold a particle? */
-static int site_blocked(const mixsph_sim *s, double x, double z)
+/* Is pos too close to a wall, or behind one, to hold a particle? */
+static int site_blocked(const mixsph_sim *s, const double pos[DIM])
 {
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         int at_end = 0;
-        double d;
-        walls_signed_distance(&s->phys.walls, w, x, z, &d, &at_end);
+        const double d = walls_distance(&s->phys.walls, w, pos, &at_end);
         if (!at_end && d < 0.5 * s->phys.dx * (1.0 - 1e-9)) return 1;
     }
     return 0;
@@ -88,7 +88,8 @@ static mixsph_status fill_bodies(mixsph_sim *s)
             return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while filling the bodies", s->cfg.origin);
         }
         for (long i = i0; i <= i1; i++) {
-            const double x = (i + 0.5) * dx, z = z_off + (k + 0.5) * dx;
+            const double pos[DIM] = {(i + 0.5) * dx, z_off + (k + 0.5) * dx};
+            const double x = pos[0], z = pos[DIM_UP];
             int medium = -1;
             size_t body = 0;
             for (size_t b = 0; b < s->cfg.n_bodies && medium < 0; b++) {
@@ -98,7 +99,7 @@ static mixsph_status fill_bodies(mixsph_sim *s)
                     body = b;
                 }
             }
-            if (medium < 0 || site_blocked(s, x, z)) continue;
+            if (medium < 0 || site_blocked(s, pos)) continue;
             per_body[body]++;
             if (n == cap) {
                 struct site *q = realloc(sites, 2 * cap * sizeof *sites);
@@ -153,57 +154,68 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     free(sites);
     return MIXSPH_OK;
 }
+#else
+static mixsph_status fill_bodies(mixsph_sim *s)
+{
+    return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: bodies: polygon bodies are 2D geometry; a 3D build cannot place them yet",
+                    s->cfg.origin);
+}
+#endif
 
 /* The domain: given in the case, or the bounding box of all geometry (moving walls swept over
- * the run) with room for the wall layers, and half the height again above for splashes. */
+ * the run) with room for the wall layers, and half the height again above for splashes. Its
+ * bounds along axis d are domain[2 d] and domain[2 d + 1] (sim_object.h). */
 static void set_domain(mixsph_sim *s)
 {
+    const struct particles *P = &s->phys.P;
+    double *dom = s->phys.domain;
     if (s->cfg.has_domain) {
         /* the case's domain bounds the fluids; the wall layers behind the walls may reach past
          * it at coarse dx (layers x dx), so it grows to hold every wall particle */
-        memcpy(s->phys.domain, s->cfg.domain, sizeof s->phys.domain);
-        for (size_t i = s->phys.n_fluid; i < s->phys.P.n; i++) {
-            s->phys.domain[0] = fmin(s->phys.domain[0], s->phys.P.x[i] - s->phys.dx);
-            s->phys.domain[1] = fmax(s->phys.domain[1], s->phys.P.x[i] + s->phys.dx);
-            s->phys.domain[2] = fmin(s->phys.domain[2], s->phys.P.z[i] - s->phys.dx);
-            s->phys.domain[3] = fmax(s->phys.domain[3], s->phys.P.z[i] + s->phys.dx);
-        }
+        memcpy(dom, s->cfg.domain, sizeof s->phys.domain);
+        for (size_t i = s->phys.n_fluid; i < P->n; i++)
+            for (int d = 0; d < DIM; d++) {
+                dom[2 * d] = fmin(dom[2 * d], P->pos[d][i] - s->phys.dx);
+                dom[2 * d + 1] = fmax(dom[2 * d + 1], P->pos[d][i] + s->phys.dx);
+            }
         return;
     }
-    double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
-    for (size_t i = 0; i < s->phys.P.n; i++) {
-        x0 = fmin(x0, s->phys.P.x[i]);
-        x1 = fmax(x1, s->phys.P.x[i]);
-        z0 = fmin(z0, s->phys.P.z[i]);
-        z1 = fmax(z1, s->phys.P.z[i]);
+    double lo[DIM], hi[DIM];
+    for (int d = 0; d < DIM; d++) {
+        lo[d] = INFINITY;
+        hi[d] = -INFINITY;
     }
+    for (size_t i = 0; i < P->n; i++)
+        for (int d = 0; d < DIM; d++) {
+            lo[d] = fmin(lo[d], P->pos[d][i]);
+            hi[d] = fmax(hi[d], P->pos[d][i]);
+        }
     /* sweep of moving walls */
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         const int mo = s->cfg.walls[w].motion;
         if (mo < 0) continue;
-        double ox = 0, oz = 0, oxmin = 0, oxmax = 0, ozmin = 0, ozmax = 0;
+        double o[DIM] = {0}, o_min[DIM] = {0}, o_max[DIM] = {0};
         const int nsub = 2000;
         const double dt = s->cfg.t_end / nsub;
         for (int k = 0; k < nsub; k++) {
-            double vx, vz;
-            motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, &vx, &vz);
-            ox += vx * dt;
-            oz += vz * dt;
-            oxmin = fmin(oxmin, ox);
-            oxmax = fmax(oxmax, ox);
-            ozmin = fmin(ozmin, oz);
-            ozmax = fmax(ozmax, oz);
+            double v[DIM];
+            motion_velocity(&s->cfg.motions[mo], (k + 0.5) * dt, v);
+            for (int d = 0; d < DIM; d++) {
+                o[d] += v[d] * dt;
+                o_min[d] = fmin(o_min[d], o[d]);
+                o_max[d] = fmax(o_max[d], o[d]);
+            }
         }
-        x0 += fmin(0.0, oxmin);
-        x1 += fmax(0.0, oxmax);
-        z0 += fmin(0.0, ozmin);
-        z1 += fmax(0.0, ozmax);
+        for (int d = 0; d < DIM; d++) {
+            lo[d] += fmin(0.0, o_min[d]);
+            hi[d] += fmax(0.0, o_max[d]);
+        }
     }
     const double pad = 2.0 * s->phys.dx;
-    s->phys.domain[0] = x0 - pad;
-    s->phys.domain[1] = x1 + pad;
-    s->phys.domain[2] = z0 - pad;
-    s->phys.domain[3] = z1 + 0.5 * (z1 - z0) + pad;
+    for (int d = 0; d < DIM; d++) {
+        dom[2 * d] = lo[d] - pad;
+        dom[2 * d + 1] = (d == DIM_UP ? hi[d] + 0.5 * (hi[d] - lo[d]) : hi[d]) + pad; /* room for splashes */
+    }
 }
 
 /* The states of the material laws the media use, and the velocity gradient when one asks for it. */
@@ -227,9 +239,13 @@ static mixsph_status create_laws(mixsph_sim *s)
             const int wall = P->state[i] == MIXSPH_STATE_WALL;
             const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
             P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
-            P->wall_nx[i] = P->wall_nz[i] = 0.0;
-            if (wall && w->slip == WALL_FREE_SLIP)
-                walls_normal(&s->phys.walls, particles_wall_index(P, i), P->x[i], P->z[i], &P->wall_nx[i], &P->wall_nz[i]);
+            double n[DIM] = {0.0};
+            if (wall && w->slip == WALL_FREE_SLIP) {
+                double pos[DIM];
+                for (int d = 0; d < DIM; d++) pos[d] = P->pos[d][i];
+                walls_normal(&s->phys.walls, particles_wall_index(P, i), pos, n);
+            }
+            for (int d = 0; d < DIM; d++) P->wall_n[d][i] = n[d];
             P->wall_friction[i] = !wall ? 0.0 : isnan(w->friction_deg) ? -1.0 : tan(w->friction_deg * GEOM_PI / 180.0);
         }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
@@ -270,6 +286,15 @@ static void set_scheme_params(mixsph_sim *s)
     };
 }
 
+/* The failure of a particle i outside the domain: "a particle at (x, z) lies outside it". */
+static mixsph_status sim_fail_outside(mixsph_sim *s, size_t i)
+{
+    char at[3 * 32] = "";
+    for (int d = 0; d < DIM; d++)
+        snprintf(at + strlen(at), sizeof at - strlen(at), "%s%g", d ? ", " : "", s->phys.P.pos[d][i]);
+    return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%s) lies outside it", s->cfg.origin, at);
+}
+
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
@@ -284,6 +309,9 @@ static mixsph_status sim_init(mixsph_sim *s)
     const long n_wall = walls_generate(&s->phys.walls, s->phys.dx, &s->interrupt, &s->phys.P);
     if (n_wall == WALLS_INTERRUPTED)
         return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while placing the wall particles", s->cfg.origin);
+    if (n_wall == WALLS_NOT_IN_3D)
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: walls: polyline walls are 2D geometry; a 3D build cannot place them yet",
+                        s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->phys.n_wall = (size_t)n_wall;
     set_domain(s);
@@ -291,22 +319,25 @@ static mixsph_status sim_init(mixsph_sim *s)
     set_scheme_params(s);
     if (!(s->work.forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
     const double *dom = s->cfg.has_domain ? s->cfg.domain : s->phys.domain;
-    for (size_t i = 0; i < s->phys.n_fluid; i++) /* fluids come first until the first sort */
-        if (!(s->phys.P.x[i] >= dom[0] && s->phys.P.x[i] < dom[1] && s->phys.P.z[i] >= dom[2] && s->phys.P.z[i] < dom[3]))
-            return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
-                            s->phys.P.x[i], s->phys.P.z[i]);
+    for (size_t i = 0; i < s->phys.n_fluid; i++) { /* fluids come first until the first sort */
+        int inside = 1;
+        for (int d = 0; d < DIM; d++)
+            inside &= s->phys.P.pos[d][i] >= dom[2 * d] && s->phys.P.pos[d][i] < dom[2 * d + 1];
+        if (!inside) return sim_fail_outside(s, i);
+    }
     s->work.NB.skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
-    const double grid_lo[DIM] = {s->phys.domain[0], s->phys.domain[2]};
-    const double grid_hi[DIM] = {s->phys.domain[1], s->phys.domain[3]};
+    double grid_lo[DIM], grid_hi[DIM];
+    for (int d = 0; d < DIM; d++) {
+        grid_lo[d] = s->phys.domain[2 * d];
+        grid_hi[d] = s->phys.domain[2 * d + 1];
+    }
     if (cells_init_columns(&s->work.C, grid_lo, grid_hi, 2.0 * s->phys.h + s->work.NB.skin, SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3]);
     if (cells_build(&s->work.C, &s->phys.P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
     s->phys.n_lost = 0;
     for (size_t i = 0; i < s->phys.P.n; i++)
-        if (s->phys.P.state[i] == MIXSPH_STATE_LOST)
-            return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%g, %g) lies outside it", s->cfg.origin,
-                            s->phys.P.x[i], s->phys.P.z[i]);
+        if (s->phys.P.state[i] == MIXSPH_STATE_LOST) return sim_fail_outside(s, i);
     if (sim_interrupted(s)) return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted after sorting the particles", s->cfg.origin);
     if (neighbours_build(&s->work.NB, &s->work.C, &s->phys.P, s->work.C.start[s->work.C.ncell], 2.0 * s->phys.h + s->work.NB.skin, SIM_THREADS(s)) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the neighbour lists");
@@ -627,10 +658,13 @@ mixsph_status mixsph_sim_set_wall_velocity(mixsph_sim *s, const char *wall, doub
         return SIM_FAIL(s, MIXSPH_ERR_ARG, "wall %s: external velocity (%g, %g) m/s is not finite", wall, vx, vz);
     const long w = sim_moving_wall(s, wall);
     if (w < 0) return MIXSPH_ERR_ARG;
-    s->phys.walls.state[w].ext = 1;
-    s->phys.walls.state[w].ext_vx = vx;
-    s->phys.walls.state[w].ext_vz = vz;
-    walls_change_velocity(&s->phys.walls, (size_t)w, vx, vz, 0.0, 0.0, &s->phys.P);
+    struct wall_state *ws = &s->phys.walls.state[w];
+    const double a[DIM] = {0.0};
+    ws->ext = 1;
+    for (int d = 0; d < DIM; d++) ws->ext_v[d] = 0.0;
+    ws->ext_v[0] = vx; /* a wall moves in the x-z plane of its polyline (walls.h) */
+    ws->ext_v[DIM_UP] = vz;
+    walls_change_velocity(&s->phys.walls, (size_t)w, ws->ext_v, a, &s->phys.P);
     return MIXSPH_OK;
 }
 
@@ -642,10 +676,10 @@ mixsph_status mixsph_sim_release_wall_velocity(mixsph_sim *s, const char *wall)
     if (w < 0) return MIXSPH_ERR_ARG;
     if (s->phys.walls.state[w].ext) {
         const struct motion *law = &s->cfg.motions[s->cfg.walls[w].motion];
-        double vx, vz, ax, az;
-        motion_velocity(law, s->phys.t, &vx, &vz);
-        motion_acceleration(law, s->phys.t, &ax, &az);
-        walls_change_velocity(&s->phys.walls, (size_t)w, vx, vz, ax, az, &s->phys.P);
+        double v[DIM], a[DIM];
+        motion_velocity(law, s->phys.t, v);
+        motion_acceleration(law, s->phys.t, a);
+        walls_change_velocity(&s->phys.walls, (size_t)w, v, a, &s->phys.P);
     }
     s->phys.walls.state[w].ext = 0;
     return MIXSPH_OK;
@@ -678,10 +712,11 @@ mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_vi
     const struct particles *P = &s->phys.P;
     v->n = P->n;
     v->n_fluid = s->phys.n_fluid;
-    v->x = P->x;
-    v->z = P->z;
-    v->vx = P->vx;
-    v->vz = P->vz;
+    v->dim = DIM;
+    for (int d = 0; d < 3; d++) {
+        v->pos[d] = d < DIM ? P->pos[d] : NULL;
+        v->vel[d] = d < DIM ? P->vel[d] : NULL;
+    }
     v->rho = P->rho;
     v->p = P->p;
     v->mu = P->mu;

@@ -40,7 +40,7 @@ struct sim_physics {
     struct kernel K;
     double dx, h;
     double c_max;                 /* highest sound speed [m/s] */
-    double domain[4];             /* x_min, x_max, z_min, z_max [m] */
+    double domain[2 * DIM];       /* bounds along axis d: domain[2 d] .. domain[2 d + 1] (x_min, x_max, z_min, z_max in 2D) [m] */
     struct particles P;
     size_t n_fluid, n_wall;       /* fluid/granular and wall particles */
     struct walls walls;           /* the walls' definitions and moving states */

@@ -5,7 +5,8 @@
     summ = mt.read_summary("out/x/summary.json")        # dict; JSON null -> nan in "outputs"
     prof = mt.find_profile("out/x", "interface", 0.5)   # Profile or None (not written)
     t, snap = mt.read_snapshot("out/x/snap_0003.csv")  # (time, {"x": array, ...}); list_snapshots
-                                                        # gives run.h5 snapshots of --no-csv runs
+                                                        # gives run.h5 snapshots of --no-csv runs;
+                                                        # snapshot_dim(snap): 2, or 3 (with "y")
 
 Every reader raises ``ToolError`` with a message naming the file and what is wrong; the scripts
 catch it and print it (no traceback for a user's mistake).
@@ -155,30 +156,46 @@ def first_time_below(t, v, threshold):
 
 
 _SNAP_HEAD = re.compile(r"#\s*t\s*=\s*([-+0-9.eE]+)\s*s")
-# The columns every snapshot has, in this order (the core fields of the particle-field table,
-# lib/src/core/particle_fields.c); a snapshot of a simulation whose material law or scheme
-# declares fields of its own has more, named by its header. tests/python/test_particle_fields.py
-# checks this against the C table.
+# The columns every snapshot has, in this order in 2D (the core fields of the particle-field table,
+# lib/src/core/particle_fields.c; a 3D snapshot also has y after x and vy after vx); a snapshot of
+# a simulation whose material law or scheme declares fields of its own has more, named by its
+# header. tests/python/test_particle_fields.py checks this against the C table.
 SNAP_COLUMNS = ("id", "x", "z", "vx", "vz", "rho", "p", "mu", "medium", "state")
+# The axes of a vector's components by dimension, the vertical last (lib/src/core/dim.h): a run's
+# dimension is the number of components of its positions (snapshot_dim).
+AXES = {2: ("x", "z"), 3: ("x", "y", "z")}
+# The components of a symmetric tensor (the deviatoric stress) in the order of dim.h: the 2D
+# (plane strain) ones, the out-of-plane yy included, then the two that vanish in 2D.
+SYM_AXES = ("xx", "xz", "zz", "yy", "xy", "yz")
+SYM_N = {2: 4, 3: 6}
 # run.h5 datasets whose columns are not the dataset's own name (a scalar dataset named as its
-# column, e.g. a law's "sxx", needs no entry; a vector dataset without one gives NAME_0, NAME_1,
-# ...). tests/python/test_particle_fields.py checks every row of the C table against it.
-H5_COLUMNS = {
-    "position": ("x", "z"),
-    "velocity": ("vx", "vz"),
-    "density": ("rho",),
-    "pressure": ("p",),
-    "viscosity": ("mu",),
-    "mass": ("m",),
-}
+# column, e.g. a law's "tau_y", needs no entry; another dataset of several components gives NAME_0,
+# NAME_1, ...): scalars by their column, vectors (DIM components) and symmetric tensors (SYM_N)
+# by the prefix of their columns. tests/python/test_particle_fields.py checks every row of the C
+# table against them. A run.h5 of format 1 held the stress as the scalars sxx, sxz, szz, syy:
+# they are read as the columns of the same names.
+H5_SCALARS = {"density": "rho", "pressure": "p", "viscosity": "mu", "mass": "m"}
+H5_VECTORS = {"position": "", "velocity": "v"}
+H5_TENSORS = {"stress": "s"}
 
 
-def h5_columns(name, components):
-    """The snapshot columns of a run.h5 dataset `name` of `components` components (1: scalar)."""
-    cols = H5_COLUMNS.get(name)
-    if cols is not None and len(cols) == components:
-        return cols
+def h5_columns(name, components, dim=2):
+    """The snapshot columns of a run.h5 dataset `name` of `components` components (1: scalar) in a
+    run of dimension `dim` (snapshot_dim)."""
+    if components == 1 and name in H5_SCALARS:
+        return (H5_SCALARS[name],)
+    if name in H5_VECTORS and components == dim:
+        return tuple(H5_VECTORS[name] + a for a in AXES[dim])
+    if name in H5_TENSORS and components == SYM_N[dim]:
+        return tuple(H5_TENSORS[name] + a for a in SYM_AXES[:components])
     return (name,) if components == 1 else tuple(f"{name}_{k}" for k in range(components))
+
+
+def snapshot_dim(snap):
+    """The dimension (2 or 3) of a snapshot as read_snapshot returns it: 3 when it has y."""
+    return 3 if "y" in snap else 2
+
+
 STATE_MOBILE, STATE_FIXED, STATE_WALL, STATE_LOST = 0, 1, 2, 3
 
 
@@ -233,6 +250,10 @@ def _read_h5_snapshot(ref):
     try:
         with h5py.File(path, "r", locking=False) as f:
             g = f["snapshots"][name]
+            dim = g["position"].shape[1] if g["position"].ndim == 2 else 0
+            if dim not in AXES:
+                raise ToolError(f"{path}: snapshot {name}: positions of shape {g['position'].shape}, "
+                                f"expected (n, 2) or (n, 3)")
             cols = {}
             for dname, d in g.items():
                 if not isinstance(d, h5py.Dataset) or d.ndim not in (1, 2):
@@ -240,7 +261,7 @@ def _read_h5_snapshot(ref):
                 v = d[()]
                 if d.ndim == 1:
                     v = v[:, None]
-                for k, col in enumerate(h5_columns(dname, v.shape[1])):
+                for k, col in enumerate(h5_columns(dname, v.shape[1], dim)):
                     cols[col] = v[:, k]
             t = float(g.attrs["time"])
     except (OSError, KeyError) as e:

@@ -604,10 +604,10 @@ static mixsph_status read_domain_rules(const struct case_reader *r, const struct
         geom_grow_box(&bd->polygon, &x0, &x1, &z0, &z1);
         z0 = fmax(z0, bd->z_min);
         z1 = fmin(z1, bd->z_max);
-        const double *d = c->domain;
-        if (!(x1 > d[0] && x0 < d[1] && z1 > d[2] && z0 < d[3] && z1 > z0))
+        const double *d = c->domain, *dz = &c->domain[2 * DIM_UP];
+        if (!(x1 > d[0] && x0 < d[1] && z1 > dz[0] && z0 < dz[1] && z1 > z0))
             return FAIL(r, "%s: bodies.%s: lies wholly outside the domain [%g, %g] x [%g, %g] (within its z_min..z_max)",
-                        r->origin, bd->name, d[0], d[1], d[2], d[3]);
+                        r->origin, bd->name, d[0], d[1], dz[0], dz[1]);
     }
     return MIXSPH_OK;
 }
@@ -663,7 +663,7 @@ static mixsph_status read_root(const struct case_reader *r, const cJSON *root, s
     const cJSON *d = item(root, "domain");
     if (d) {
         TRY(case_schema_read(r, d, "domain", section("domain"), 0, c));
-        if (!(c->domain[1] > c->domain[0]) || !(c->domain[3] > c->domain[2]))
+        if (!(c->domain[1] > c->domain[0]) || !(c->domain[2 * DIM_UP + 1] > c->domain[2 * DIM_UP]))
             return FAIL(r, "%s: domain: expected x_min < x_max and z_min < z_max", r->origin);
         c->has_domain = 1;
     }

@@ -108,7 +108,8 @@ struct case_def {
                                    (enum viscous_preconditioner of viscous.h) */
     double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
     int has_domain;
-    double domain[4];         /* x_min, x_max, z_min, z_max [m]; particles leaving it are lost */
+    double domain[2 * DIM];   /* bounds along axis d: domain[2 d] .. domain[2 d + 1] [m] (the case gives x and
+                                 z: x_min, x_max, z_min, z_max in 2D); particles leaving it are lost */
     double monitor_interval;  /* [s] */
     double snapshot_interval; /* [s], 0 = none */
     /* the resource budget (budget.h): limits on what the case asks for, checked from the case

@@ -168,15 +168,16 @@ static const struct case_key numerics_keys[] = {
      .meaning = "limit of the resource budget: time steps to t_end, estimated from criterion (4) at rest"},
 };
 
-#define DOMAIN_FIELD(k) (offsetof(struct case_def, domain) + (k) * sizeof(double) + 1)
+/* bound k (0: min, 1: max) along axis d of case_def.domain */
+#define DOMAIN_FIELD(d, k) (offsetof(struct case_def, domain) + (2 * (d) + (k)) * sizeof(double) + 1)
 static const struct case_key domain_keys[] = {
-    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0),
+    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0, 0),
      .meaning = "left end"},
-    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(1),
+    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0, 1),
      .meaning = "right end, > x_min"},
-    {.key = "z_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(2),
+    {.key = "z_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(DIM_UP, 0),
      .meaning = "bottom"},
-    {.key = "z_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(3),
+    {.key = "z_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(DIM_UP, 1),
      .meaning = "top, > z_min"},
 };
 

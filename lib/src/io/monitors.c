@@ -1,8 +1,8 @@
 /* monitors.c - outputs sampled during the run: diagnostics (kinetic energy, mass, time step,
  * lost particles, wall corrections, speed, grains held fixed) and the case's monitors:
  *   front          - the largest (+x) or smallest (-x) x of a medium's particles in the region;
- *   max_elevation  - the highest z of a medium's particles in the region (the run-up when the
- *                    region covers the opposite slope);
+ *   max_elevation  - the highest z (the vertical component, DIM_UP) of a medium's particles in
+ *                    the region (the run-up when the region covers the opposite slope);
  *   wall_pressure  - the highest pressure of the first layer of a wall's particles in the region;
  *   wall_work      - the work a wall has done on the particles since t = 0 (walls.h, walls_move);
  *   pressure_probe - the fluid's pressure at a point, as SPH codes' gauges read it (DualSPHysics's
@@ -28,7 +28,10 @@
  * particles of its own medium within the kernel support 2h (counted in the last pass).
  * Samples are taken every output.monitor_interval of simulated time; the extremes over the
  * samples and their times are kept, and each sample is a row of monitors.csv when an output
- * folder is set. */
+ * folder is set.
+ * A monitor's region, point and bins are case input in the vertical x-z plane (2D): they are
+ * compared with components 0 (x) and DIM_UP (z) of the particles' positions; in 3D a region
+ * spans every y and a point lies at y = 0. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -78,38 +81,50 @@ static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffi
     memcpy(s->out.name[s->out.n++], name, CASE_NAME_LEN);
 }
 
+/* A point of the x-z plane (case input) as a position. */
+static void plane_point(double x, double z, double pos[DIM])
+{
+    for (int d = 0; d < DIM; d++) pos[d] = 0.0;
+    pos[0] = x;
+    pos[DIM_UP] = z;
+}
+
+/* The position pos of particle i. */
+static void position_of(const struct particles *P, size_t i, double pos[DIM])
+{
+    for (int d = 0; d < DIM; d++) pos[d] = P->pos[d][i];
+}
+
 /* The point a pressure probe reads at now [m]: its point in the flow; on a wall, the point of the
  * wall nearest to the sensor (both moved with the wall), moved into the fluid along the wall's
  * normal by the standoff. */
-static void probe_point(const mixsph_sim *s, const struct monitor_def *md, double *x, double *z)
+static void probe_point(const mixsph_sim *s, const struct monitor_def *md, double pos[DIM])
 {
-    *x = md->point_x;
-    *z = md->point_z;
+    plane_point(md->point_x, md->point_z, pos);
     if (md->wall < 0) return;
     const struct walls *W = &s->phys.walls;
-    const double xs = md->point_x + W->state[md->wall].ox, zs = md->point_z + W->state[md->wall].oz;
-    double d, nx, nz;
+    for (int d = 0; d < DIM; d++) pos[d] += W->state[md->wall].o[d];
+    double n[DIM];
     int at_end;
-    walls_signed_distance(W, (size_t)md->wall, xs, zs, &d, &at_end);
-    walls_normal(W, (size_t)md->wall, xs, zs, &nx, &nz);
-    const double move = PROBE_WALL_STANDOFF_OVER_H * s->phys.h - d; /* d: the sensor's distance from the wall */
-    *x = xs + move * nx;
-    *z = zs + move * nz;
+    const double dist = walls_distance(W, (size_t)md->wall, pos, &at_end); /* the sensor's distance from the wall */
+    walls_normal(W, (size_t)md->wall, pos, n);
+    const double move = PROBE_WALL_STANDOFF_OVER_H * s->phys.h - dist;
+    for (int d = 0; d < DIM; d++) pos[d] += move * n[d];
 }
 
-/* The fluid's pressure at (x, z) [Pa]: the Shepard-normalised kernel interpolation over the
+/* The fluid's pressure at pos [Pa]: the Shepard-normalised kernel interpolation over the
  * non-wall particles (head of the file), 0 when dry. The candidates are those of the cell
  * list's stencil around the point: the cells describe the positions of the last build, and no
  * particle has moved skin/2 since, so every particle now within 2h of the point is in it. */
-static double probe_pressure(const mixsph_sim *s, const double pt[DIM])
+static double probe_pressure(const mixsph_sim *s, const double pos[DIM])
 {
     const struct cells *C = &s->work.C;
     const struct particles *P = &s->phys.P;
     const struct kernel *K = &s->phys.K;
     for (int d = 0; d < DIM; d++)
-        if (!(pt[d] >= C->lo[d])) return 0.0; /* a moving wall's probe carried off the grid */
+        if (!(pos[d] >= C->lo[d])) return 0.0; /* a moving wall's probe carried off the grid */
     int c[DIM];
-    cells_coords(C, pt, c);
+    cells_coords(C, pos, c);
     for (int d = 0; d < DIM; d++)
         if (c[d] >= C->n[d]) return 0.0;
     double sw = 0.0, swp = 0.0;
@@ -118,7 +133,7 @@ static double probe_pressure(const mixsph_sim *s, const double pt[DIM])
         for (size_t j = rg.begin; j < rg.end; j++) {
             if (P->state[j] > MIXSPH_STATE_FIXED) continue;
             double r2 = 0.0;
-            for (int d = 0; d < DIM; d++) r2 += (pt[d] - P->pos[d][j]) * (pt[d] - P->pos[d][j]);
+            for (int d = 0; d < DIM; d++) r2 += (pos[d] - P->pos[d][j]) * (pos[d] - P->pos[d][j]);
             if (r2 >= K->r2max) continue;
             const double w = kernel_w(K, sqrt(r2)) * P->m[j] / P->rho[j];
             sw += w;
@@ -134,10 +149,12 @@ static mixsph_status probe_check(mixsph_sim *s, const struct monitor_def *md)
 {
     const struct case_def *c = &s->cfg;
     if (md->wall >= 0) {
-        double d;
         int at_end;
         const struct wall_state *ws = &s->phys.walls.state[md->wall]; /* the point is given at t = 0 */
-        walls_signed_distance(&s->phys.walls, (size_t)md->wall, md->point_x + ws->ox, md->point_z + ws->oz, &d, &at_end);
+        double sensor[DIM];
+        plane_point(md->point_x, md->point_z, sensor);
+        for (int k = 0; k < DIM; k++) sensor[k] += ws->o[k];
+        const double d = walls_distance(&s->phys.walls, (size_t)md->wall, sensor, &at_end);
         if (at_end || !(fabs(d) <= 0.5 * s->phys.dx))
             return SIM_FAIL(s, MIXSPH_ERR_CASE,
                             "%s: monitors.%s: the point (%g, %g) is not on the wall '%s' (%.3g m from it%s); a "
@@ -145,13 +162,16 @@ static mixsph_status probe_check(mixsph_sim *s, const struct monitor_def *md)
                             c->origin, md->name, md->point_x, md->point_z, c->walls[md->wall].name, fabs(d),
                             at_end ? ", beyond its end" : "", 0.5 * s->phys.dx);
     }
-    double x, z;
-    probe_point(s, md, &x, &z);
+    double pos[DIM];
+    probe_point(s, md, pos);
     const double *dom = c->has_domain ? c->domain : s->phys.domain;
-    if (!(x >= dom[0] && x < dom[1] && z >= dom[2] && z < dom[3]))
+    int inside = 1;
+    for (int d = 0; d < DIM; d++) inside &= pos[d] >= dom[2 * d] && pos[d] < dom[2 * d + 1];
+    const double *dz = &dom[2 * DIM_UP];
+    if (!inside)
         return SIM_FAIL(s, MIXSPH_ERR_CASE,
                         "%s: monitors.%s: the point the probe reads at, (%g, %g), is outside the domain [%g, %g] x "
-                        "[%g, %g]", c->origin, md->name, x, z, dom[0], dom[1], dom[2], dom[3]);
+                        "[%g, %g]", c->origin, md->name, pos[0], pos[DIM_UP], dom[0], dom[1], dz[0], dz[1]);
     return MIXSPH_OK;
 }
 
@@ -187,9 +207,19 @@ mixsph_status monitors_init(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-static int in_region(const struct monitor_def *md, double x, double z)
+/* Whether particle i lies in the region of a monitor (bounds of x and z). */
+static int in_region(const struct monitor_def *md, const struct particles *P, size_t i)
 {
+    const double x = P->pos[0][i], z = P->pos[DIM_UP][i];
     return x >= md->x_min && x <= md->x_max && z >= md->z_min && z <= md->z_max;
+}
+
+/* |v|^2 of particle i */
+static double speed2(const struct particles *P, size_t i)
+{
+    double v2 = 0.0;
+    for (int d = 0; d < DIM; d++) v2 += P->vel[d][i] * P->vel[d][i];
+    return v2;
 }
 
 static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
@@ -198,10 +228,11 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
     double best = NAN;
     if (md->kind == MONITOR_WALL_PRESSURE) {
         for (size_t i = 0; i < P->n; i++) {
-            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P->x[i], P->z[i])) continue;
-            double d;
+            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P, i)) continue;
             int at_end;
-            walls_signed_distance(&s->phys.walls, (size_t)md->wall, P->x[i], P->z[i], &d, &at_end);
+            double pos[DIM];
+            position_of(P, i, pos);
+            const double d = walls_distance(&s->phys.walls, (size_t)md->wall, pos, &at_end);
             if (d < -s->phys.dx) continue; /* first layer only */
             if (isnan(best) || P->p[i] > best) best = P->p[i];
         }
@@ -209,22 +240,21 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
     }
     if (md->kind == MONITOR_WALL_WORK) return s->phys.walls.state[md->wall].work;
     if (md->kind == MONITOR_PRESSURE_PROBE) {
-        double x, z;
-        probe_point(s, md, &x, &z);
-        const double pt[DIM] = {x, z};
-        return probe_pressure(s, pt);
+        double pos[DIM];
+        probe_point(s, md, pos);
+        return probe_pressure(s, pos);
     }
     if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
         double e = 0.0;
         for (size_t i = 0; i < P->n; i++)
-            if (P->state[i] <= MIXSPH_STATE_FIXED && P->medium[i] == md->medium && in_region(md, P->x[i], P->z[i]))
-                e += 0.5 * P->m[i] * (P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i]);
+            if (P->state[i] <= MIXSPH_STATE_FIXED && P->medium[i] == md->medium && in_region(md, P, i))
+                e += 0.5 * P->m[i] * speed2(P, i);
         return e;
     }
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
-        const double v = md->kind == MONITOR_FRONT ? md->direction * P->x[i] : P->z[i];
+        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P, i)) continue;
+        const double v = md->kind == MONITOR_FRONT ? md->direction * P->pos[0][i] : P->pos[DIM_UP][i];
         if (isnan(best) || v > best) best = v;
     }
     if (md->kind == MONITOR_FRONT && !isnan(best)) best *= md->direction;
@@ -274,7 +304,7 @@ double monitors_value(const mixsph_sim *s, size_t k)
     double ke = 0.0, mass = 0.0, vmax = 0.0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED) continue;
-        const double v2 = P->vx[i] * P->vx[i] + P->vz[i] * P->vz[i];
+        const double v2 = speed2(P, i);
         ke += 0.5 * P->m[i] * v2;
         mass += P->m[i];
         if (v2 > vmax) vmax = v2;
@@ -306,10 +336,11 @@ static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, 
     for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P->x[i], P->z[i])) continue;
-        size_t b = (size_t)((P->x[i] - md->x_min) / md->bin);
+        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P, i)) continue;
+        size_t b = (size_t)((P->pos[0][i] - md->x_min) / md->bin);
         if (b >= nb) b = nb - 1;
-        if (P->z[i] + 0.5 * s->phys.dx > top[b]) top[b] = P->z[i] + 0.5 * s->phys.dx;
+        const double top_i = P->pos[DIM_UP][i] + 0.5 * s->phys.dx;
+        if (top_i > top[b]) top[b] = top_i;
     }
     char path[700];
     snprintf(path, sizeof path, "%s/profile_%s_%s.csv", s->out.dir, md->name, tag);

@@ -17,8 +17,8 @@
  *                       granular and wall), row k = the particle of id k: the rows of the
  *                       particle-field table marked PF_HDF5 the simulation has, in table order
  *                       (core/particle_fields.c), today
- *       position  (n, 2) float64 [m]      x, z
- *       velocity  (n, 2) float64 [m/s]    vx, vz
+ *       position  (n, D) float64 [m]      x, z (D = 2); x, y, z in a 3D build (D = 3)
+ *       velocity  (n, D) float64 [m/s]    vx, vz; vx, vy, vz
  *       density   (n)    float64 [kg/m^3]
  *       pressure  (n)    float64 [Pa]
  *       viscosity (n)    float64 [Pa s]
@@ -39,9 +39,9 @@
  * file can be read while the run goes on (what a reader sees is consistent between snapshots).
  *
  * run.xdmf: XDMF 3 (XDMF 2 attribute names, which readers of both accept), a temporal
- * collection of uniform grids, one per snapshot: Polyvertex topology, XY geometry (x, z: in
- * ParaView x to the right and z up: the PF_GEOMETRY row), the other datasets as node attributes
- * (Scalar, Vector for 2 components, Matrix for more).
+ * collection of uniform grids, one per snapshot: Polyvertex topology, XY geometry in 2D (x, z: in
+ * ParaView x to the right and z up), XYZ in 3D (the PF_GEOMETRY row), the other datasets as node
+ * attributes (Scalar, Vector for DIM components, Matrix for the others).
  *
  * checkpoint files (mixsph_sim_write_checkpoint): an HDF5 file with the dataset /state (uint8,
  * the buffer of mixsph_sim_save_state: case text, overrides, every particle field and counter,
@@ -79,7 +79,7 @@
 
 #define RUN_FILE "run.h5"
 #define XDMF_FILE "run.xdmf"
-#define RUN_FORMAT_VERSION 1
+#define RUN_FORMAT_VERSION 2 /* 2: the deviatoric stress one dataset "stress" (n, SYM_N) (in 1: sxx, sxz, szz, syy) */
 
 struct snap_rec {
     long index;     /* snapshot index (group name) */
@@ -460,12 +460,13 @@ static void xdmf_item(FILE *f, const char *indent, size_t n, int comps, const ch
             RUN_FILE, index, field);
 }
 
-/* A field as a node attribute: Scalar, Vector (2 components, as x and z) or Matrix (others). */
+/* A field as a node attribute: Scalar, Vector (DIM components, as the geometry's axes) or Matrix
+ * (others). */
 static void xdmf_attribute(FILE *f, const struct snap_rec *r, const struct particle_field *pf)
 {
     const unsigned m = pf->components;
     fprintf(f, "        <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", pf->name,
-            m == 1 ? "Scalar" : m == 2 ? "Vector" : "Matrix");
+            m == 1 ? "Scalar" : m == DIM ? "Vector" : "Matrix");
     xdmf_item(f, "          ", r->n, m > 1 ? (int)m : 0, pf->type == PF_F64 ? "Float" : "UInt",
               (int)particle_field_size(pf->type), r->index, pf->name);
     fprintf(f, "        </Attribute>\n");
@@ -493,8 +494,8 @@ static int xdmf_write(const mixsph_sim *s, const struct output *o)
     FILE *f = fopen(tmp, "w");
     if (!f) return -1;
     fprintf(f, "<?xml version=\"1.0\" ?>\n<!-- mixsph run of case %s: particles as a time series of point clouds; the "
-               "data are in %s (x, z -> X, Y) -->\n",
-            s->cfg.name, RUN_FILE);
+               "data are in %s (%s) -->\n",
+            s->cfg.name, RUN_FILE, DIM == 2 ? "x, z -> X, Y" : "x, y, z -> X, Y, Z");
     fprintf(f, "<Xdmf Version=\"3.0\">\n  <Domain>\n    <Grid Name=\"particles\" GridType=\"Collection\" "
                "CollectionType=\"Temporal\">\n");
     for (size_t k = 0; k < o->n_snaps; k++) {
@@ -505,7 +506,7 @@ static int xdmf_write(const mixsph_sim *s, const struct output *o)
         fprintf(f, "          <DataItem Dimensions=\"%zu 1\" NumberType=\"UInt\" Precision=\"4\" "
                    "Format=\"HDF\">%s:/xdmf/vertices_%zu</DataItem>\n",
                 r->n, RUN_FILE, r->n);
-        fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"XY\">\n");
+        fprintf(f, "        </Topology>\n        <Geometry GeometryType=\"%s\">\n", DIM == 2 ? "XY" : "XYZ");
         for (size_t k = 0; k < particle_field_count; k++) {
             const struct particle_field *pf = &particle_fields[k];
             if ((pf->where & (PF_HDF5 | PF_GEOMETRY)) == (PF_HDF5 | PF_GEOMETRY) &&

@@ -2,7 +2,7 @@
  * checkpoint and restart). Public API of mixsph.h.
  *
  * Layout (native byte order, checked by a marker): a header "MIXSPHST", format version, byte
- * order marker; the case text, origin and overrides the simulation was created from; the
+ * order marker, the dimension of the build (DIM); the case text, origin and overrides the simulation was created from; the
  * scalar state (time, step, time step, counters, output extremes and schedule); the walls'
  * displacement, velocity, external drive and work; the particle fields the particle-field table marks
  * PF_STATE and the simulation has, in table order, each as its name, component count, element
@@ -21,11 +21,12 @@
 #include "status.h"
 
 #define STATE_MAGIC "MIXSPHST"
-#define STATE_VERSION 8u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
+#define STATE_VERSION 9u /* 2: neighbour build positions (Verlet ranges); 3: implicit viscous increments;
                             4: the increments of the implicit step's first stage; 5: those of the
                             step before (the warm starts' extrapolation); 6: the particle fields of
                             the particle-field table, each named; 7: the walls' work; 8: the
-                            excluded particles' count, mass and energy */
+                            excluded particles' count, mass and energy; 9: the dimension in the
+                            header, the stress one field of SYM_N components */
 #define STATE_ORDER 0x01020304u
 
 /* ---- writer ------------------------------------------------------------------------------- */
@@ -127,7 +128,7 @@ static const char *get_str(struct reader *r, size_t *n)
 static void put_source(struct writer *w, const mixsph_sim *s)
 {
     put(w, STATE_MAGIC, 8);
-    const uint32_t head[2] = {STATE_VERSION, STATE_ORDER};
+    const uint32_t head[3] = {STATE_VERSION, STATE_ORDER, DIM};
     put(w, head, sizeof head);
     put_str(w, s->case_text);
     put_str(w, s->case_origin);
@@ -167,8 +168,11 @@ static void put_dynamic(struct writer *w, const mixsph_sim *s)
     put_u64(w, s->cfg.n_walls);
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
         const struct wall_state *ws = &s->phys.walls.state[k];
-        const double v[9] = {ws->ox, ws->oz, ws->vx, ws->vz, ws->ax, ws->az, ws->ext_vx, ws->ext_vz, ws->work};
-        put(w, v, sizeof v);
+        put(w, ws->o, sizeof ws->o);
+        put(w, ws->v, sizeof ws->v);
+        put(w, ws->a, sizeof ws->a);
+        put(w, ws->ext_v, sizeof ws->ext_v);
+        put_f64(w, ws->work);
         put_u64(w, (uint64_t)ws->ext);
     }
     const struct particles *P = &s->phys.P;
@@ -214,10 +218,10 @@ void mixsph_state_free(void *buf) { free(buf); }
 /* Check header and checksum; leave the reader after the header. */
 static mixsph_status check_header(struct reader *r, char *err, size_t err_len)
 {
-    if (!r->buf || r->len < 8 + 8 + 8)
+    if (!r->buf || r->len < 8 + 12 + 8)
         return status_set(err, err_len, MIXSPH_ERR_ARG, "state: %zu bytes is too short to be a mixsph state", r->len);
     char magic[8];
-    uint32_t head[2];
+    uint32_t head[3]; /* version, byte order, dimension: a state of another version is refused on its version */
     get(r, magic, 8);
     get(r, head, sizeof head);
     if (memcmp(magic, STATE_MAGIC, 8) != 0) return status_set(err, err_len, MIXSPH_ERR_ARG, "state: not a mixsph state (bad marker)");
@@ -226,6 +230,8 @@ static mixsph_status check_header(struct reader *r, char *err, size_t err_len)
     if (head[0] != STATE_VERSION)
         return status_set(err, err_len, MIXSPH_ERR_ARG, "state: format version %u, this build reads version %u", head[0],
                           STATE_VERSION);
+    if (head[2] != DIM)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "state: saved by a %uD build, this build is %dD", head[2], DIM);
     uint64_t sum;
     memcpy(&sum, r->buf + r->len - 8, 8);
     if (sum != fnv1a(r->buf, r->len - 8))
@@ -309,17 +315,11 @@ static mixsph_status read_dynamic(struct reader *r, mixsph_sim *s)
     if (get_u64(r) != s->cfg.n_walls) return SIM_FAIL(s, MIXSPH_ERR_ARG, "state: wall count differs from the case's");
     for (size_t k = 0; k < s->cfg.n_walls; k++) {
         struct wall_state *ws = &s->phys.walls.state[k];
-        double v[9];
-        get(r, v, sizeof v);
-        ws->ox = v[0];
-        ws->oz = v[1];
-        ws->vx = v[2];
-        ws->vz = v[3];
-        ws->ax = v[4];
-        ws->az = v[5];
-        ws->ext_vx = v[6];
-        ws->ext_vz = v[7];
-        ws->work = v[8];
+        get(r, ws->o, sizeof ws->o);
+        get(r, ws->v, sizeof ws->v);
+        get(r, ws->a, sizeof ws->a);
+        get(r, ws->ext_v, sizeof ws->ext_v);
+        ws->work = get_f64(r);
         ws->ext = get_u64(r) != 0;
     }
     struct particles *P = &s->phys.P;

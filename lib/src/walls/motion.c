@@ -28,32 +28,38 @@ static void motion_locate(const struct motion *m, double tl, size_t *k, double *
     *f = (tl - m->t[lo]) / (m->t[lo + 1] - m->t[lo]);
 }
 
-void motion_velocity(const struct motion *m, double t, double *vx, double *vz)
+/* The table's in-plane components (x, z) as a DIM vector (motion.h). */
+static void plane_vector(double x, double z, double v[DIM])
 {
-    size_t k;
-    double f;
-    int outside;
-    motion_locate(m, t / m->time_scale, &k, &f, &outside);
-    if (outside) {
-        *vx = m->speed_scale * m->vx[k];
-        *vz = m->speed_scale * m->vz[k];
-        return;
-    }
-    *vx = m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k]));
-    *vz = m->speed_scale * (m->vz[k] + f * (m->vz[k + 1] - m->vz[k]));
+    for (int d = 0; d < DIM; d++) v[d] = 0.0;
+    v[0] = x;
+    v[DIM_UP] = z;
 }
 
-void motion_acceleration(const struct motion *m, double t, double *ax, double *az)
+void motion_velocity(const struct motion *m, double t, double v[DIM])
 {
     size_t k;
     double f;
     int outside;
     motion_locate(m, t / m->time_scale, &k, &f, &outside);
     if (outside) {
-        *ax = *az = 0.0;
+        plane_vector(m->speed_scale * m->vx[k], m->speed_scale * m->vz[k], v);
+        return;
+    }
+    plane_vector(m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k])),
+                 m->speed_scale * (m->vz[k] + f * (m->vz[k + 1] - m->vz[k])), v);
+}
+
+void motion_acceleration(const struct motion *m, double t, double a[DIM])
+{
+    size_t k;
+    double f;
+    int outside;
+    motion_locate(m, t / m->time_scale, &k, &f, &outside);
+    if (outside) {
+        plane_vector(0.0, 0.0, a);
         return;
     }
     const double dt = (m->t[k + 1] - m->t[k]) * m->time_scale;
-    *ax = m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt;
-    *az = m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt;
+    plane_vector(m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt, m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt, a);
 }

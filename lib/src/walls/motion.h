@@ -1,9 +1,12 @@
 /* motion.h - a prescribed motion law: a velocity table, linear between its rows, stretched in
- * time and scaled in speed (docs/cases.md, "motions"); the walls move by it. */
+ * time and scaled in speed (docs/cases.md, "motions"); the walls move by it. The table gives the
+ * velocity in the vertical x-z plane of the walls' polylines (case input, 2D): as a DIM vector it
+ * is (vx, vz) in 2D, (vx, 0, vz) in 3D. */
 #ifndef MIXSPH_MOTION_H
 #define MIXSPH_MOTION_H
 #include <stddef.h>
 
+#include "dim.h"
 #include "schema.h" /* SCHEMA_NAME_LEN */
 
 struct motion {
@@ -14,9 +17,9 @@ struct motion {
     double time_scale;        /* the law is stretched in time by this [-] */
 };
 
-/** Velocity of a motion law at time t (linear between rows, held at the ends). */
-void motion_velocity(const struct motion *m, double t, double *vx, double *vz);
-/** Acceleration of a motion law at time t (slope of the current interval). */
-void motion_acceleration(const struct motion *m, double t, double *ax, double *az);
+/** Velocity v of a motion law at time t (linear between rows, held at the ends). */
+void motion_velocity(const struct motion *m, double t, double v[DIM]);
+/** Acceleration a of a motion law at time t (slope of the current interval). */
+void motion_acceleration(const struct motion *m, double t, double a[DIM]);
 
 #endif

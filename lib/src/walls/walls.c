@@ -21,16 +21,36 @@
 #include "mixsph.h"
 #include "team.h"
 
-void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end)
+/* a . b, summed in the order of the components (the 2D code's a[0] b[0] + a[1] b[1]) */
+static inline double dot(const double a[DIM], const double b[DIM])
 {
-    const struct wall *wl = &W->def[w];
-    *d = geom_signed_distance(&wl->line, wl->side, x - W->state[w].ox, z - W->state[w].oz, at_end);
+    double s = a[0] * b[0];
+    for (int d = 1; d < DIM; d++) s += a[d] * b[d];
+    return s;
 }
 
-void walls_normal(const struct walls *W, size_t w, double x, double z, double *nx, double *nz)
+/* A vector of the walls' x-z plane (walls.h) as a DIM vector. */
+static inline void from_plane(double x, double z, double v[DIM])
+{
+    for (int d = 0; d < DIM; d++) v[d] = 0.0;
+    v[0] = x;
+    v[DIM_UP] = z;
+}
+
+double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end)
 {
     const struct wall *wl = &W->def[w];
-    geom_side_normal(&wl->line, wl->side, x - W->state[w].ox, z - W->state[w].oz, nx, nz);
+    const double *o = W->state[w].o;
+    return geom_signed_distance(&wl->line, wl->side, pos[0] - o[0], pos[DIM_UP] - o[DIM_UP], at_end);
+}
+
+void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double n[DIM])
+{
+    const struct wall *wl = &W->def[w];
+    const double *o = W->state[w].o;
+    double nx, nz;
+    geom_side_normal(&wl->line, wl->side, pos[0] - o[0], pos[DIM_UP] - o[DIM_UP], &nx, &nz);
+    from_plane(nx, nz, n);
 }
 
 void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
@@ -41,8 +61,8 @@ void walls_init(struct walls *W, const struct wall *def, size_t n, const struct 
     for (size_t w = 0; w < n; w++) {
         const int mo = def[w].motion;
         if (mo < 0) continue;
-        motion_velocity(&motions[mo], 0.0, &W->state[w].vx, &W->state[w].vz);
-        motion_acceleration(&motions[mo], 0.0, &W->state[w].ax, &W->state[w].az);
+        motion_velocity(&motions[mo], 0.0, W->state[w].v);
+        motion_acceleration(&motions[mo], 0.0, W->state[w].a);
     }
 }
 
@@ -50,23 +70,26 @@ void walls_init(struct walls *W, const struct wall *def, size_t n, const struct 
  * this a grain held fixed beside a wall that jumps to a new speed keeps its state (its strain rate
  * reads the old mirror) and then takes the new velocity difference with the viscosity mu_thr,
  * over a time step made for mu0 (an impulsive push of 1.5 m/s threw such grains at 20 m/s). */
-void walls_change_velocity(struct walls *W, size_t w, double vx, double vz, double ax, double az, struct particles *P)
+void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const double a[DIM], struct particles *P)
 {
-    struct wall_state *ws = W->state;
+    struct wall_state *ws = &W->state[w];
     const double mirror = W->def[w].slip == WALL_NO_SLIP ? 2.0 : 0.0; /* d u_g / d v_w */
-    const double dvx = vx - ws[w].vx, dvz = vz - ws[w].vz;
-    ws[w].vx = vx;
-    ws[w].vz = vz;
-    ws[w].ax = ax;
-    ws[w].az = az;
+    double dv[DIM];
+    for (int d = 0; d < DIM; d++) {
+        dv[d] = v[d] - ws->v[d];
+        ws->v[d] = v[d];
+        ws->a[d] = a[d];
+    }
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL || particles_wall_index(P, i) != w) continue;
-        P->vx[i] = vx;
-        P->vz[i] = vz;
-        P->uvx[i] += mirror * dvx;
-        P->uvz[i] += mirror * dvz;
+        for (int d = 0; d < DIM; d++) {
+            P->vel[d][i] = v[d];
+            P->uv[d][i] += mirror * dv[d];
+        }
     }
 }
+
+#if DIM == 2 /* the placement along polylines (walls.h) */
 
 /* Whether (x, z) lies behind a fixed wall before w, within the layers' depth: among fixed walls a
  * site is filled once (a site behind two walls). */
@@ -91,8 +114,7 @@ static long push_wall_particle(const struct wall_state *ws, size_t w, double x, 
     if (j == (size_t)-1) return -1;
     P->vol[j] = vol;
     P->m[j] = 0.0;
-    P->vx[j] = P->uvx[j] = ws[w].vx;
-    P->vz[j] = P->uvz[j] = ws[w].vz;
+    for (int d = 0; d < DIM; d++) P->vel[d][j] = P->uv[d][j] = ws[w].v[d];
     return (long)j;
 }
 
@@ -140,8 +162,9 @@ static int owned_by_other(const struct segment *o, double x, double z, double de
  * bisector split can leave two particles of the two strips nearly on top of each other. */
 static int near_placed(const struct particles *P, size_t first, double x, double z, double dist)
 {
+    const double *px = P->pos[0], *pz = P->pos[DIM_UP];
     for (size_t j = first; j < P->n; j++)
-        if ((P->x[j] - x) * (P->x[j] - x) + (P->z[j] - z) * (P->z[j] - z) < dist * dist) return 1;
+        if ((px[j] - x) * (px[j] - x) + (pz[j] - z) * (pz[j] - z) < dist * dist) return 1;
     return 0;
 }
 
@@ -212,9 +235,9 @@ static long walls_generate_aligned(const struct walls *W, double dx, const mixsp
     return added;
 }
 
-long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt, struct particles *P)
+static long walls_generate_lattice(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
+                                   struct particles *P)
 {
-    if (W->placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(W, dx, interrupt, P);
     const struct wall_state *ws = W->state;
     const double depth = W->layers * dx, z_off = geom_lattice_z_offset(W->lattice_z0, dx);
     long added = 0;
@@ -244,17 +267,28 @@ long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *in
     }
     return added;
 }
+#endif
+
+long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt, struct particles *P)
+{
+#if DIM == 2
+    if (W->placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(W, dx, interrupt, P);
+    return walls_generate_lattice(W, dx, interrupt, P);
+#else
+    (void)dx, (void)interrupt, (void)P;
+    return W->n > 0 ? WALLS_NOT_IN_3D : 0;
+#endif
+}
 
 /* The velocity of a moving wall at the end of the step from t_from by dt: its motion law's, or
  * an external velocity (co-simulation input), which is constant over the step. */
 static void step_end_velocity(const struct motion *m, const struct wall_state *ws, double t_from, double dt,
-                              double *vx, double *vz)
+                              double v[DIM])
 {
     if (ws->ext) {
-        *vx = ws->ext_vx;
-        *vz = ws->ext_vz;
+        for (int d = 0; d < DIM; d++) v[d] = ws->ext_v[d];
     } else {
-        motion_velocity(m, t_from + dt, vx, vz);
+        motion_velocity(m, t_from + dt, v);
     }
 }
 
@@ -267,26 +301,27 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
 {
     struct wall_state *wstate = W->state;
     int moving = 0;
-    double dxw[WALLS_MAX] = {0}, dzw[WALLS_MAX] = {0}, fx[WALLS_MAX] = {0}, fz[WALLS_MAX] = {0};
+    double shift[WALLS_MAX][DIM] = {{0}}, force[WALLS_MAX][DIM] = {{0}};
     for (size_t w = 0; w < W->n; w++) {
         const int mo = W->def[w].motion;
         if (mo < 0) continue;
         const struct motion *m = &W->motions[mo];
         struct wall_state *ws = &wstate[w];
-        double vx, vz;
-        step_end_velocity(m, ws, t_from, dt, &ws->vx, &ws->vz);
+        double v[DIM]; /* the velocity over the step */
+        step_end_velocity(m, ws, t_from, dt, ws->v);
         if (ws->ext) {
-            vx = ws->vx;
-            vz = ws->vz;
-            ws->ax = ws->az = 0.0;
+            for (int d = 0; d < DIM; d++) {
+                v[d] = ws->v[d];
+                ws->a[d] = 0.0;
+            }
         } else {
-            motion_velocity(m, t_from + 0.5 * dt, &vx, &vz);
-            motion_acceleration(m, t_from + dt, &ws->ax, &ws->az);
+            motion_velocity(m, t_from + 0.5 * dt, v);
+            motion_acceleration(m, t_from + dt, ws->a);
         }
-        dxw[w] = vx * dt;
-        dzw[w] = vz * dt;
-        ws->ox += dxw[w];
-        ws->oz += dzw[w];
+        for (int d = 0; d < DIM; d++) {
+            shift[w][d] = v[d] * dt;
+            ws->o[d] += shift[w][d];
+        }
         moving = 1;
     }
     if (!moving) return;
@@ -294,45 +329,49 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
         const size_t w = particles_wall_index(P, i);
         if (W->def[w].motion < 0) continue;
-        fx[w] += P->ax[i];
-        fz[w] += P->az[i];
-        P->x[i] += dxw[w];
-        P->z[i] += dzw[w];
-        P->vx[i] = wstate[w].vx;
-        P->vz[i] = wstate[w].vz;
+        for (int d = 0; d < DIM; d++) {
+            force[w][d] += P->acc[d][i];
+            P->pos[d][i] += shift[w][d];
+            P->vel[d][i] = wstate[w].v[d];
+        }
     }
-    for (size_t w = 0; w < W->n; w++) wstate[w].work -= fx[w] * dxw[w] + fz[w] * dzw[w];
+    for (size_t w = 0; w < W->n; w++) wstate[w].work -= dot(force[w], shift[w]);
 }
 
-void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
-                double *x1, double *z1, double *vx, double *vz, long *clips)
+void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], double gap, const double p0[DIM],
+                           double p1[DIM], double v[DIM], long *clips)
 {
     for (int pass = 0; pass < 4; pass++) {
         int hit = 0;
         for (size_t w = 0; w < W->n && !hit; w++) {
             const struct wall *wl = &W->def[w];
             const struct wall_state *ws = &W->state[w];
-            /* the path in the frame of the wall */
-            const double ax = x0 - ox_old[w], az = z0 - oz_old[w];
-            const double bx = *x1 - ws->ox, bz = *z1 - ws->oz;
+            /* the path a -> b in the frame of the wall, and its step */
+            double a[DIM], b[DIM], step[DIM];
+            for (int d = 0; d < DIM; d++) {
+                a[d] = p0[d] - o_old[w][d];
+                b[d] = p1[d] - ws->o[d];
+                step[d] = b[d] - a[d];
+            }
             for (size_t k = 0; k + 1 < wl->line.n; k++) {
                 const double cx = wl->line.x[k], cz = wl->line.z[k];
                 const double ex = wl->line.x[k + 1] - cx, ez = wl->line.z[k + 1] - cz;
                 double sc;
-                if (!geom_path_crosses(ax, az, bx, bz, cx, cz, cx + ex, cz + ez, &sc)) continue;
+                if (!geom_path_crosses(a[0], a[DIM_UP], b[0], b[DIM_UP], cx, cz, cx + ex, cz + ez, &sc)) continue;
                 /* fluid-side unit normal of this segment */
                 const double len = hypot(ex, ez);
-                const double nx = -ez / len * wl->side, nz = ex / len * wl->side;
+                double n[DIM];
+                from_plane(-ez / len * wl->side, ex / len * wl->side, n);
                 /* only a crossing from the fluid side into the wall counts */
-                if ((bx - ax) * nx + (bz - az) * nz >= 0.0) continue;
-                const double px = ax + sc * (bx - ax), pz = az + sc * (bz - az);
-                *x1 = px + gap * nx + ws->ox;
-                *z1 = pz + gap * nz + ws->oz;
-                const double vn = (*vx - ws->vx) * nx + (*vz - ws->vz) * nz;
-                if (vn < 0.0) {
-                    *vx -= vn * nx;
-                    *vz -= vn * nz;
+                if (dot(step, n) >= 0.0) continue;
+                double dv[DIM];
+                for (int d = 0; d < DIM; d++) {
+                    p1[d] = a[d] + sc * step[d] + gap * n[d] + ws->o[d];
+                    dv[d] = v[d] - ws->v[d];
                 }
+                const double vn = dot(dv, n);
+                if (vn < 0.0)
+                    for (int d = 0; d < DIM; d++) v[d] -= vn * n[d];
                 (*clips)++;
                 hit = 1;
                 break;
@@ -342,12 +381,18 @@ void walls_clip(const struct walls *W, const double *ox_old, const double *oz_ol
     }
 }
 
-/* The kernel weight of a non-wall neighbour at (rx, rz) from a wall particle in the
- * extrapolation onto it. */
-static inline double extrapolation_weight(const struct kernel *K, int wendland, double rx, double rz)
+/* The kernel weight of a non-wall neighbour j from wall particle i in the extrapolation onto i;
+ * r = x_i - x_j. */
+static inline double extrapolation_weight(const struct kernel *K, int wendland, const double r[DIM])
 {
-    const double q = kernel_q(K, rx * rx + rz * rz);
+    const double q = kernel_q(K, dot(r, r));
     return wendland ? kernel_w_q(K, q, 1) : kernel_w_q(K, q, 0);
+}
+
+/* r = x_i - x_j of particles i and j. */
+static inline void separation(const struct particles *P, size_t i, size_t j, double r[DIM])
+{
+    for (int d = 0; d < DIM; d++) r[d] = P->pos[d][i] - P->pos[d][j];
 }
 
 /* A wall particle's velocity in the viscous terms from the fluid's kernel average: the mirror
@@ -358,15 +403,16 @@ static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
     return noslip ? 2.0 * v_wall - v_fluid : v_fluid;
 }
 
-/* A free-slip wall particle's velocity seen by a solid, which has a stress: besides the fluid's
+/* A free-slip wall particle's velocity v seen by a solid, which has a stress: besides the fluid's
  * tangential velocity, its normal velocity mirrored about the wall's, so that a solid pressing
- * on the wall is strained by it (its velocity gradient) as by its mirror image. (nx, nz) = 0
- * leaves (*vx, *vz) as they are. */
-static inline void mirror_normal_velocity(double nx, double nz, double vx_wall, double vz_wall, double *vx, double *vz)
+ * on the wall is strained by it (its velocity gradient) as by its mirror image. n = 0 leaves v
+ * as it is. */
+static inline void mirror_normal_velocity(const double n[DIM], const double v_wall[DIM], double v[DIM])
 {
-    const double vn = (*vx - vx_wall) * nx + (*vz - vz_wall) * nz;
-    *vx -= 2.0 * vn * nx;
-    *vz -= 2.0 * vn * nz;
+    double dv[DIM];
+    for (int d = 0; d < DIM; d++) dv[d] = v[d] - v_wall[d];
+    const double vn = dot(dv, n);
+    for (int d = 0; d < DIM; d++) v[d] -= 2.0 * vn * n[d];
 }
 
 /* The arguments of a parallel loop of this file (core/team.h). */
@@ -379,9 +425,9 @@ struct wall_loop {
     const struct particles *cP;
     struct wall_mirror *M;
     const struct wall_mirror *cM;
-    const double *vx_wall, *vz_wall;
+    const double (*v_wall)[DIM];
     double c;
-    double *vx, *vz;
+    double *const *v;
 };
 static void mirror_weights_range(void *arg, size_t b, size_t e);
 static void mirror_apply_range(void *arg, size_t b, size_t e);
@@ -400,35 +446,39 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
         const size_t w = particles_wall_index(P, i);
         const struct wall_state *ws = &wstate[w];
-        /* g - a_w, with g = (0, -g) */
-        const double gx = -ws->ax, gz = -g - ws->az;
-        const double xi = P->x[i], zi = P->z[i];
-        double sw = 0.0, sp = 0.0, svx = 0.0, svz = 0.0, srho = 0.0;
+        /* g - a_w, with g = -g e_up */
+        double ga[DIM];
+        for (int d = 0; d < DIM; d++) ga[d] = -ws->a[d];
+        ga[DIM_UP] = -g - ws->a[DIM_UP];
+        double sw = 0.0, sp = 0.0, sv[DIM] = {0.0}, srho = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) { /* the non-wall neighbours */
             const size_t j = G->list[k];
-            const double rx = xi - P->x[j], rz = zi - P->z[j];
-            const double wgt = extrapolation_weight(K, wendland, rx, rz);
+            double r[DIM];
+            separation(P, i, j, r);
+            const double wgt = extrapolation_weight(K, wendland, r);
             sw += wgt;
-            sp += (P->p[j] + P->rho[j] * (gx * rx + gz * rz)) * wgt;
-            svx += P->vx[j] * wgt;
+            sp += (P->p[j] + P->rho[j] * dot(ga, r)) * wgt;
+            for (int d = 0; d < DIM; d++) sv[d] += P->vel[d][j] * wgt;
             srho += P->rho[j] * wgt;
-            svz += P->vz[j] * wgt;
         }
         const int noslip = W->def[w].slip == WALL_NO_SLIP;
+        double uv[DIM];
         if (sw > 0.0) {
             const double pw = sp / sw;
             P->p[i] = pw > 0.0 ? pw : 0.0;
-            P->uvx[i] = mirror_velocity(noslip, ws->vx, svx / sw);
-            P->uvz[i] = mirror_velocity(noslip, ws->vz, svz / sw);
-            if (P->wall_nx && !noslip) /* a wall that mirrors a solid's stress (particles.h) */
-                mirror_normal_velocity(P->wall_nx[i], P->wall_nz[i], ws->vx, ws->vz, &P->uvx[i], &P->uvz[i]);
+            for (int d = 0; d < DIM; d++) uv[d] = mirror_velocity(noslip, ws->v[d], sv[d] / sw);
+            if (P->wall_n[0] && !noslip) { /* a wall that mirrors a solid's stress (particles.h) */
+                double n[DIM];
+                for (int d = 0; d < DIM; d++) n[d] = P->wall_n[d][i];
+                mirror_normal_velocity(n, ws->v, uv);
+            }
             P->rho[i] = srho / sw;
         } else {
             P->p[i] = 0.0;
             P->rho[i] = rho_alone;
-            P->uvx[i] = ws->vx;
-            P->uvz[i] = ws->vz;
+            for (int d = 0; d < DIM; d++) uv[d] = ws->v[d];
         }
+        for (int d = 0; d < DIM; d++) P->uv[d][i] = uv[d];
         P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
         P->inv_rho[i] = 1.0 / P->rho[i];
     }
@@ -447,8 +497,7 @@ void walls_mirror_free(struct wall_mirror *M)
 {
     if (!M) return;
     free(M->weight);
-    free(M->cx);
-    free(M->cz);
+    for (int d = 0; d < DIM; d++) free(M->c[d]);
     free(M->sign);
     free(M->rows);
     free(M);
@@ -465,12 +514,11 @@ static int mirror_reserve(struct wall_mirror *M, size_t n, size_t n_list)
     }
     if (M->cap_n < n) {
         const size_t cap = n + n / 4 + 64;
-        double *cx = realloc(M->cx, cap * sizeof(double));
-        if (!cx) return -1;
-        M->cx = cx;
-        double *cz = realloc(M->cz, cap * sizeof(double));
-        if (!cz) return -1;
-        M->cz = cz;
+        for (int d = 0; d < DIM; d++) {
+            double *c = realloc(M->c[d], cap * sizeof(double));
+            if (!c) return -1;
+            M->c[d] = c;
+        }
         signed char *sg = realloc(M->sign, cap);
         if (!sg) return -1;
         M->sign = sg;
@@ -507,8 +555,9 @@ static void mirror_weights_range(void *arg, size_t b, size_t e)
         const size_t i = M->rows[r];
         double sw = 0.0;
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
-            const size_t j = G->list[k];
-            M->weight[k] = extrapolation_weight(K, wendland, P->x[i] - P->x[j], P->z[i] - P->z[j]);
+            double r[DIM];
+            separation(P, i, G->list[k], r);
+            M->weight[k] = extrapolation_weight(K, wendland, r);
             sw += M->weight[k];
         }
         const int noslip = W->def[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
@@ -527,13 +576,12 @@ static void mirror_at_range(void *arg, size_t b, size_t e)
     const struct walls *W = L->W;
     const struct particles *P = L->cP;
     struct wall_mirror *M = L->M;
-    const double *vx = L->vx_wall, *vz = L->vz_wall;
+    const double (*v)[DIM] = L->v_wall;
     for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
         const size_t w = particles_wall_index(P, i);
         const int noslip = W->def[w].slip == WALL_NO_SLIP;
-        M->cx[i] = M->sign[i] ? mirror_velocity(noslip, vx[w], 0.0) : vx[w];
-        M->cz[i] = M->sign[i] ? mirror_velocity(noslip, vz[w], 0.0) : vz[w];
+        for (int d = 0; d < DIM; d++) M->c[d][i] = M->sign[i] ? mirror_velocity(noslip, v[w][d], 0.0) : v[w][d];
     }
 }
 
@@ -541,21 +589,20 @@ void walls_mirror_at(struct wall_mirror *M, const struct walls *W, const struct 
                      int n_threads)
 {
     const struct wall_state *wstate = W->state;
-    double vx[WALLS_MAX], vz[WALLS_MAX];
+    double v[WALLS_MAX][DIM];
     for (size_t w = 0; w < W->n; w++) {
         const int mo = W->def[w].motion;
-        vx[w] = wstate[w].vx;
-        vz[w] = wstate[w].vz;
-        if (mo >= 0 && dt > 0.0) step_end_velocity(&W->motions[mo], &wstate[w], t_from, dt, &vx[w], &vz[w]);
+        for (int d = 0; d < DIM; d++) v[w][d] = wstate[w].v[d];
+        if (mo >= 0 && dt > 0.0) step_end_velocity(&W->motions[mo], &wstate[w], t_from, dt, v[w]);
     }
-    struct wall_loop L = {.W = W, .cP = P, .M = M, .vx_wall = vx, .vz_wall = vz};
+    struct wall_loop L = {.W = W, .cP = P, .M = M, .v_wall = (const double (*)[DIM])v};
     team_for(n_threads, M->n_rows, mirror_at_range, &L);
 }
 
-void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
-                        double *vz, int n_threads)
+void walls_mirror_fill(const struct wall_mirror *M, const struct gather *G, int with_constant, double *const v[DIM],
+                       int n_threads)
 {
-    struct wall_loop L = {.cM = M, .G = G, .c = with_constant ? 1.0 : 0.0, .vx = vx, .vz = vz};
+    struct wall_loop L = {.cM = M, .G = G, .c = with_constant ? 1.0 : 0.0, .v = v};
     team_for(n_threads, M->n_rows, mirror_apply_range, &L);
 }
 
@@ -565,16 +612,46 @@ static void mirror_apply_range(void *arg, size_t b, size_t e)
     const struct wall_mirror *M = L->cM;
     const struct gather *G = L->G;
     const double c = L->c;
-    double *vx = L->vx, *vz = L->vz;
+    double *const *v = L->v;
     for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
-        double ax = 0.0, az = 0.0;
+        double av[DIM] = {0.0}; /* a u */
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
             const size_t j = G->list[k];
-            ax += M->weight[k] * vx[j];
-            az += M->weight[k] * vz[j];
+            for (int d = 0; d < DIM; d++) av[d] += M->weight[k] * v[d][j];
         }
-        vx[i] = c * M->cx[i] + M->sign[i] * ax;
-        vz[i] = c * M->cz[i] + M->sign[i] * az;
+        for (int d = 0; d < DIM; d++) v[d][i] = c * M->c[d][i] + M->sign[i] * av[d];
     }
 }
+
+#if DIM == 2
+void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end)
+{
+    const double pos[DIM] = {x, z};
+    *d = walls_distance(W, w, pos, at_end);
+}
+
+void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
+                double *x1, double *z1, double *vx, double *vz, long *clips)
+{
+    double o_old[WALLS_MAX][DIM];
+    for (size_t w = 0; w < W->n; w++) {
+        o_old[w][0] = ox_old[w];
+        o_old[w][1] = oz_old[w];
+    }
+    const double p0[DIM] = {x0, z0};
+    double p1[DIM] = {*x1, *z1}, v[DIM] = {*vx, *vz};
+    walls_keep_fluid_side(W, (const double (*)[DIM])o_old, gap, p0, p1, v, clips);
+    *x1 = p1[0];
+    *z1 = p1[1];
+    *vx = v[0];
+    *vz = v[1];
+}
+
+void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
+                        double *vz, int n_threads)
+{
+    double *const v[DIM] = {vx, vz};
+    walls_mirror_fill(M, G, with_constant, v, n_threads);
+}
+#endif

@@ -1,11 +1,17 @@
 /* walls.h - walls from polylines (docs/model.md section 8, docs/numerics.md): layers of wall
  * particles behind each polyline, their motion, the extrapolation of the fluid's state onto
  * them, and the geometric guard against crossings. A wall treatment plugs in here: it owns the
- * wall particles' p, rho, m and viscous velocity (uvx, uvz), which the pair loops read. */
+ * wall particles' p, rho, m and viscous velocity (uv), which the pair loops read.
+ *
+ * A wall is a polyline of the case (2D geometry input) in the vertical x-z plane: its distance,
+ * normal and crossings are taken in that plane, over components 0 and DIM_UP of a position, and
+ * its normal has no other component. In 3D (DIM = 3) the placement of wall particles along a
+ * polyline is not available yet (walls_generate refuses walls), so no 3D run has a wall. */
 #ifndef MIXSPH_WALLS_H
 #define MIXSPH_WALLS_H
 #include <stddef.h>
 
+#include "dim.h"
 #include "kernel.h"
 #include "mixsph.h" /* mixsph_interrupt */
 #include "neighbours.h"
@@ -14,11 +20,15 @@
 
 /* The moving state of one wall. */
 struct wall_state {
-    double ox, oz;   /* displacement of the wall since t = 0 [m] */
-    double vx, vz;   /* current velocity [m/s] */
-    double ax, az;   /* current acceleration [m/s2] */
-    int ext;         /* driven by an external velocity (ext_vx, ext_vz) instead of its motion law */
-    double ext_vx, ext_vz; /* [m/s] */
+#if DIM == 2 /* transitional: schemes/ still reads the displacement as (ox, oz) */
+    union { double o[DIM]; struct { double ox, oz; }; };
+#else
+    double o[DIM];   /* displacement of the wall since t = 0 [m] */
+#endif
+    double v[DIM];   /* current velocity [m/s] */
+    double a[DIM];   /* current acceleration [m/s2] */
+    int ext;         /* driven by an external velocity (ext_v) instead of its motion law */
+    double ext_v[DIM]; /* [m/s] */
     double work;     /* the work it has done on the particles since t = 0 [J/m] (walls_move) */
 };
 
@@ -37,7 +47,7 @@ struct walls {
     int layers;                     /* layers of wall particles behind each wall */
     int placement;                  /* enum wall_placement */
     double lattice_z0;              /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
-    double g;                       /* gravity [m/s2] along -z, in the extrapolated pressure */
+    double g;                       /* gravity [m/s2] along -e_up, in the extrapolated pressure */
     double rho_alone;               /* density of a wall particle with no fluid around it [kg/m3] */
     struct wall_state state[WALLS_MAX];
 };
@@ -47,41 +57,41 @@ struct walls {
 void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
                 int placement, double lattice_z0, double g, double rho_alone);
 
-/** Give moving wall w the velocity (vx, vz) and acceleration (ax, az) from now on, between two
- *  steps: its state, its particles' velocity and their velocity in the viscous terms (the mirror
- *  of the last wall pass, which the next regime decision reads) change with it. */
-void walls_change_velocity(struct walls *W, size_t w, double vx, double vz, double ax,
-                           double az, struct particles *P);
+/** Give moving wall w the velocity v and acceleration a from now on, between two steps: its
+ *  state, its particles' velocity and their velocity in the viscous terms (the mirror of the
+ *  last wall pass, which the next regime decision reads) change with it. */
+void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const double a[DIM],
+                           struct particles *P);
 
 #define WALLS_INTERRUPTED (-2L)
+#define WALLS_NOT_IN_3D (-3L) /* walls_generate: polyline walls are placed in 2D only (for now) */
 
 /** Append the wall particles of every wall of the case at spacing dx (W->layers layers
  *  deep, placed as W->placement says); their `medium` field holds their wall's index and
  *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row,
  *  or every segment when aligned. Returns the number added, -1 when out of memory,
- *  WALLS_INTERRUPTED when the host asked to stop. */
+ *  WALLS_INTERRUPTED when the host asked to stop, WALLS_NOT_IN_3D for any wall in 3D. */
 long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
 
-/** Signed distance of (x, z) to wall w at its current position (< 0 behind it), and whether the
+/** Signed distance of pos to wall w at its current position (< 0 behind it) [m], and whether the
  *  closest point is an end of the polyline. */
-void walls_signed_distance(const struct walls *W, size_t w, double x, double z,
-                           double *d, int *at_end);
+double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end);
 
-/** The unit normal of wall w toward its fluid at the point of the wall nearest to (x, z). */
-void walls_normal(const struct walls *W, size_t w, double x, double z, double *nx, double *nz);
+/** The unit normal n of wall w toward its fluid at the point of the wall nearest to pos. */
+void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double n[DIM]);
 
 /** Move the walls and their particles from t_from by dt. */
 void walls_move(struct walls *W, struct particles *P, double t_from, double dt);
 
-/** Keep a particle moving (x0,z0) -> (*x1,*z1) on the fluid side of every wall: a crossing is
- *  put back at `gap` from the wall and loses its velocity into it (counted in *clips).
- *  ox_old/oz_old: the walls' displacements at the start of the step (walls already moved). */
-void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old,
-                double gap, double x0, double z0, double *x1, double *z1, double *vx, double *vz, long *clips);
+/** Keep a particle moving p0 -> p1 on the fluid side of every wall: a crossing is put back at
+ *  `gap` from the wall (p1 changed) and loses its velocity v into it (counted in *clips).
+ *  o_old: the walls' displacements at the start of the step (walls already moved). */
+void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], double gap, const double p0[DIM],
+                           double p1[DIM], double v[DIM], long *clips);
 
 /** The state of the first n particles' wall particles from the fluid around them (Adami et
- *  al. 2012): pressure, viscous (mirror) velocity uvx/uvz, density and the mass the artificial
+ *  al. 2012): pressure, viscous (mirror) velocity uv, density and the mass the artificial
  *  viscosity sees. Needs the gather lists of G. */
 void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K,
                              const struct gather *G, double dx, struct particles *P, size_t n, int n_threads);
@@ -94,7 +104,7 @@ void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K,
  * velocity at the end of the step; a wall particle with no non-wall neighbour takes v_w. */
 struct wall_mirror {
     double *weight;      /* a_gk, aligned with the gather list */
-    double *cx, *cz;     /* c_g [m/s] */
+    double *c[DIM];      /* c_g [m/s] */
     signed char *sign;   /* s_g */
     size_t *rows;        /* the wall particles among the first n, in order */
     size_t n_rows;
@@ -115,9 +125,18 @@ int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struc
 void walls_mirror_at(struct wall_mirror *M, const struct walls *W,
                      const struct particles *P, double t_from, double dt, int n_threads);
 
-/** Overwrite the wall rows of (vx, vz) with the map of their non-wall rows: c_g + s_g a u
- *  (with_constant) or s_g a u (its linear part). */
+/** Overwrite the wall rows of the velocity components v[d] with the map of their non-wall rows:
+ *  c_g + s_g a u (with_constant) or s_g a u (its linear part). */
+void walls_mirror_fill(const struct wall_mirror *M, const struct gather *G, int with_constant, double *const v[DIM],
+                       int n_threads);
+
+#if DIM == 2
+/* Transitional: the (x, z) forms schemes/ still calls, on top of the functions above. */
+void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end);
+void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
+                double *x1, double *z1, double *vx, double *vz, long *clips);
 void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
                         double *vz, int n_threads);
+#endif
 
 #endif
