@@ -641,6 +641,7 @@ static void test_table_defaults(void **state)
     free(k);
     assert_true(c.g == 9.81);
     assert_true(c.h_over_dx == 1.3 && c.cfl == 0.1 && c.cfl_visc == 0.05 && c.wall_layers == 3);
+    assert_true(c.eta2_over_h2 == 0.01);
     assert_int_equal(c.kernel, 0);
     assert_true(c.p_background == 0.0 && c.pressure_smoothing == 0.0 && c.fixed_bed_speed == -1.0);
     assert_true(c.av_wall == 1 && c.av_mixed == 0 && c.av_separating == 0);
@@ -891,7 +892,7 @@ static double other_value(const struct case_key *k, double now)
 
 /* Every numerics key a struct of the step reads arrives there when the simulation is created: each
  * set to a value other than its default, the struct's member equals the case's (the copy of sim.c
- * is generated from the same rows). */
+ * is generated from the same rows); and the derived eta2 follows eta2_over_h2. */
 static void test_numerics_reach_the_step(void **state)
 {
     (void)state;
@@ -905,7 +906,7 @@ static void test_numerics_reach_the_step(void **state)
     size_t n = 0;
     for (size_t i = 0; i < sec->n_keys; i++) {
         const struct case_key *k = &sec->keys[i];
-        if (!numerics_read_by_step[i]) continue;
+        if (!numerics_read_by_step[i] && strcmp(k->key, "eta2_over_h2") != 0) continue;
         assert_true(n < 64);
         double now = 0.0;
         assert_int_equal(case_schema_stored_number(k, &base, &now), 0);
@@ -916,7 +917,7 @@ static void test_numerics_reach_the_step(void **state)
         n++;
     }
     case_free(&base);
-    assert_true(n >= 16);
+    assert_true(n >= 17);
     mixsph_sim *s = NULL;
     assert_int_equal(mixsph_sim_create_from_text(BASE, ORIGIN, ov, n, &s, err, sizeof err), MIXSPH_OK);
     const struct case_def *c = &s->cfg;
@@ -932,6 +933,7 @@ static void test_numerics_reach_the_step(void **state)
 #define NUMERICS_KEY CHECK_COPIED
 #include "numerics_keys.def"
 #undef NUMERICS_KEY
+    assert_true(s->scheme.pair.eta2 == c->eta2_over_h2 * s->phys.h * s->phys.h && c->eta2_over_h2 != 0.01);
     mixsph_sim_destroy(s);
 }
 

@@ -253,7 +253,7 @@ static void set_scheme_params(mixsph_sim *s)
         .implicit = c->viscosity_implicit,
         .excluded_limit = (long)floor(c->excluded_max * (double)s->phys.n_fluid),
         .pair = {.K = s->phys.K,
-                 .eta2 = 0.01 * s->phys.h * s->phys.h,
+                 .eta2 = c->eta2_over_h2 * s->phys.h * s->phys.h,
                  .g = c->g,
                  .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0},
     };
