@@ -20,6 +20,8 @@
 #include "case.h"
 #include "case_schema.h"
 #include "mixsph.h"
+#include "numerics_keys.h"
+#include "sim_object.h"
 
 #define ORIGIN "tiny.json"
 
@@ -639,6 +641,7 @@ static void test_table_defaults(void **state)
     free(k);
     assert_true(c.g == 9.81);
     assert_true(c.h_over_dx == 1.3 && c.cfl == 0.1 && c.cfl_visc == 0.05 && c.wall_layers == 3);
+    assert_true(c.eta2_over_h2 == 0.01);
     assert_int_equal(c.kernel, 0);
     assert_true(c.p_background == 0.0 && c.pressure_smoothing == 0.0 && c.fixed_bed_speed == -1.0);
     assert_true(c.av_wall == 1 && c.av_mixed == 0 && c.av_separating == 0);
@@ -863,6 +866,77 @@ static void test_lobovsky_case(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* Each row of core/numerics_keys.def that a struct of the step reads (in the order of the
+ * numerics table, which is the rows' order): 1 if a struct reads it, 0 if only the creation. */
+#define READ_BY_STEP(type, member, read_by, as, ...)                                     \
+    (0 NUMERICS_IF_READ_BY(read_by, SCHEME, +1) NUMERICS_IF_READ_BY(read_by, PAIR, +1) \
+       NUMERICS_IF_READ_BY(read_by, VISCOUS, +1)),
+static const int numerics_read_by_step[] = {
+#define NUMERICS_KEY READ_BY_STEP
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
+};
+
+/* A value of a key's type, inside its range and not its default (BASE's for the keys it gives). */
+static double other_value(const struct case_key *k, double now)
+{
+    if (k->type == CASE_BOOL) return now == 0.0 ? 1.0 : 0.0;
+    if (k->type == CASE_CHOICE) {
+        for (const struct case_choice *c = k->choices; c->name; c++)
+            if (c->value != (int)now) return c->value;
+        return now;
+    }
+    const double v = now > k->lo ? 0.5 * (k->lo + now) : now + fmin(1.0, 0.5 * (k->hi - now));
+    return k->type == CASE_INTEGER ? ceil(v) : v;
+}
+
+/* Every numerics key a struct of the step reads arrives there when the simulation is created: each
+ * set to a value other than its default, the struct's member equals the case's (the copy of sim.c
+ * is generated from the same rows); and the derived eta2 follows eta2_over_h2. */
+static void test_numerics_reach_the_step(void **state)
+{
+    (void)state;
+    const struct case_section *sec = case_schema_find("numerics");
+    assert_int_equal(sec->n_keys, sizeof numerics_read_by_step / sizeof numerics_read_by_step[0]);
+    struct case_def base;
+    char err[512] = "";
+    assert_int_equal(case_parse(BASE, ORIGIN, NULL, 0, &base, err, sizeof err), MIXSPH_OK);
+    mixsph_override ov[64];
+    char keys[64][64];
+    size_t n = 0;
+    for (size_t i = 0; i < sec->n_keys; i++) {
+        const struct case_key *k = &sec->keys[i];
+        if (!numerics_read_by_step[i] && strcmp(k->key, "eta2_over_h2") != 0) continue;
+        assert_true(n < 64);
+        double now = 0.0;
+        assert_int_equal(case_schema_stored_number(k, &base, &now), 0);
+        snprintf(keys[n], sizeof keys[n], "numerics.%s", k->key);
+        ov[n] = (mixsph_override){keys[n], other_value(k, now)};
+        print_message("  %s = %g (was %g)\n", ov[n].key, ov[n].value, now);
+        assert_true(ov[n].value != now);
+        n++;
+    }
+    case_free(&base);
+    assert_true(n >= 17);
+    mixsph_sim *s = NULL;
+    assert_int_equal(mixsph_sim_create_from_text(BASE, ORIGIN, ov, n, &s, err, sizeof err), MIXSPH_OK);
+    const struct case_def *c = &s->cfg;
+    for (size_t k = 0; k < n; k++) {
+        double got = 0.0;
+        assert_int_equal(case_number(c, ov[k].key, &got, err, sizeof err), MIXSPH_OK);
+        assert_true(got == ov[k].value);
+    }
+#define CHECK_COPIED(type, member, read_by, as, ...)                                   \
+    NUMERICS_IF_READ_BY(read_by, SCHEME, assert_true(s->scheme.as == c->member);)      \
+    NUMERICS_IF_READ_BY(read_by, PAIR, assert_true(s->scheme.pair.as == c->member);)   \
+    NUMERICS_IF_READ_BY(read_by, VISCOUS, assert_true(s->scheme.viscous.as == c->member);)
+#define NUMERICS_KEY CHECK_COPIED
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
+    assert_true(s->scheme.pair.eta2 == c->eta2_over_h2 * s->phys.h * s->phys.h && c->eta2_over_h2 != 0.01);
+    mixsph_sim_destroy(s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -889,6 +963,7 @@ int main(void)
         cmocka_unit_test(test_d50_refused),
         cmocka_unit_test(test_granular_law_by_number),
         cmocka_unit_test(test_table_rows),
+        cmocka_unit_test(test_numerics_reach_the_step),
         cmocka_unit_test(test_parameters),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -253,7 +253,13 @@ static mixsph_status create_laws(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-/* The time schemes' parameters from the case and the laws' features (after create_laws). */
+/* The time schemes' parameters from the case and the laws' features (after create_laws): the
+ * values derived from the case, then each `numerics` key its reader struct holds, as its row of
+ * core/numerics_keys.def says. */
+#define COPY_NUMERICS_KEY(type, member, read_by, as, ...)                         \
+    NUMERICS_IF_READ_BY(read_by, SCHEME, s->scheme.as = c->member;)                \
+    NUMERICS_IF_READ_BY(read_by, PAIR, s->scheme.pair.as = c->member;)             \
+    NUMERICS_IF_READ_BY(read_by, VISCOUS, s->scheme.viscous.as = c->member;)
 static void set_scheme_params(mixsph_sim *s)
 {
     const struct case_def *c = &s->cfg;
@@ -261,29 +267,15 @@ static void set_scheme_params(mixsph_sim *s)
         .media = c->media,
         .n_media = c->n_media,
         .implicit = c->viscosity_implicit,
-        .held_grains_rigid = c->held_grains_rigid,
-        .cfl = c->cfl,
-        .cfl_visc = c->cfl_visc,
-        .p_background = c->p_background,
-        .pressure_smoothing = c->pressure_smoothing,
-        .density_bound = c->density_bound,
         .excluded_limit = (long)floor(c->excluded_max * (double)s->phys.n_fluid),
         .pair = {.K = s->phys.K,
-                 .eta2 = 0.01 * s->phys.h * s->phys.h,
+                 .eta2 = c->eta2_over_h2 * s->phys.h * s->phys.h,
                  .g = c->g,
-                 .av_wall = c->av_wall,
-                 .av_mixed = c->av_mixed,
-                 .av_separating = c->av_separating,
-                 .implicit_viscosity = c->viscosity_implicit,
-                 .arithmetic_mean = c->viscosity_arithmetic,
-                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0,
-                 .p_background = c->p_background,
-                 .diffusion = c->density_diffusion,
-                 .diffusion_form = c->density_diffusion_form},
-        .viscous = {.preconditioner = c->viscous_preconditioner,
-                    .tolerance = c->viscous_tolerance,
-                    .max_iterations = c->viscous_max_iterations},
+                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0},
     };
+#define NUMERICS_KEY COPY_NUMERICS_KEY
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
 }
 
 /* The failure of a particle i outside the domain: "a particle at (x, z) lies outside it". */

@@ -1,8 +1,8 @@
 /* schema.h - the rows of a keyed table: what a key of a case file is ({key, type, range, default,
  * unit, meaning} and the field of a struct it fills), grouped in sections. The table-driven reader
  * is io/case_schema.h; the tables live with what they configure (the case's own sections in
- * io/case_schema.c, a material law's keys in its module under laws/), so a law's keys are rows
- * of its own module. Types only: no code, no dependency. */
+ * io/case_schema.c, the numerical parameters in core/numerics_keys.def, a material law's keys in
+ * its module under laws/), so a law's keys are rows of its own module. Types only: no code, no dependency. */
 #ifndef MIXSPH_SCHEMA_H
 #define MIXSPH_SCHEMA_H
 #include <stddef.h>

@@ -7,6 +7,7 @@
 #include "geometry.h"
 #include "medium.h"
 #include "mixsph.h"
+#include "numerics_keys.h"
 #include "wall_def.h"
 
 #define CASE_NAME_LEN MEDIUM_NAME_LEN /* names of all entries */
@@ -78,45 +79,18 @@ struct case_def {
     char origin[256];         /* file name, for messages */
     char name[CASE_NAME_LEN];
     double g;                 /* gravity magnitude [m/s2], acting along -z */
-    double dx;                /* particle spacing [m] */
-    double h_over_dx;         /* h = h_over_dx dx */
-    double cfl, cfl_visc;     /* time-step coefficients of (4) */
-    double t_end;             /* [s] */
-    int wall_layers;          /* layers of wall particles behind each wall */
-    int wall_placement;       /* numerics.wall_placement: enum wall_placement of walls.h */
-    double lattice_z0;        /* a layer boundary of the particle lattice [m] (geom_lattice_z_offset) */
-    int kernel;               /* enum kernel_type */
-    double pressure_smoothing; /* theta_P of the partial pressure smoothing (0: off; SPHERA's Vajont input: 0.4) */
-    double density_diffusion; /* delta of the density diffusion in the continuity equation (0: off; default 0.1) */
-    int density_diffusion_form; /* numerics.density_diffusion_form: enum density_diffusion_form of forces.h */
-    double density_bound;     /* |rho/rho0 - 1| beyond which a particle is excluded (0: off) */
-    double excluded_max;      /* fraction of the non-wall particles that may be excluded before the run stops */
-    double fixed_bed_speed;   /* SPHERA's fixed bed (mixture.c): speed [m/s] at or below which a grain counts as
-                                 bed; < 0: off (the default) */
-    int av_wall;              /* artificial viscosity between fluid and wall particles (default 1) */
-    int av_mixed;             /* ... between particles of different media (default 0: same medium only) */
-    int av_separating;        /* ... also on separating pairs (default 0: approaching pairs only) */
-    int viscosity_implicit;   /* numerics.viscosity: 0 "explicit" (in the momentum pass, dt bound (4)),
-                                 1 "implicit" (viscous.h: SDIRK2, no viscous dt bound) */
-    int viscosity_arithmetic; /* numerics.viscosity_mean: 0 "harmonic" (model.md [V]), 1 "arithmetic"
-                                 (implicit only) */
-    int held_grains_rigid;    /* numerics.held_grains: 0 "solved" (unknowns of the implicit viscous solve),
-                                 1 "rigid" (prescribed at rest in it, judged on one explicit step's kick) */
-    double viscous_tolerance; /* implicit: relative residual at which the solve stops [-] */
-    int viscous_max_iterations; /* implicit: iteration budget of one solve */
-    int viscous_preconditioner; /* implicit: numerics.viscous_preconditioner, 0 "jacobi", 1 "two_level"
-                                   (enum viscous_preconditioner of viscous.h) */
-    double p_background;      /* background pressure added by the EOS [Pa] (confined flows; 0 with free surfaces) */
+    /* every key of `numerics`, as the member its row names (core/numerics_keys.def: what each
+     * holds, its unit and who reads it) */
+#define NUMERICS_KEY NUMERICS_MEMBER_OF_CASE
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
     int has_domain;
     double domain[2 * DIM];   /* bounds along axis d: domain[2 d] .. domain[2 d + 1] [m] (the case gives x and
                                  z: x_min, x_max, z_min, z_max in 2D); particles leaving it are lost */
     double monitor_interval;  /* [s] */
     double snapshot_interval; /* [s], 0 = none */
-    /* the resource budget (budget.h): limits on what the case asks for, checked from the case
-     * alone before anything is allocated; numerics.max_* and output.max_* */
-    double max_particles;       /* fluid, granular and wall particles [-] */
-    double max_lattice_sites;   /* lattice sites scanned to fill the bodies and walls [-] */
-    double max_steps;           /* estimated time steps to t_end [-] */
+    /* the resource budget (budget.h) beyond numerics.max_*: limits on what the case asks for,
+     * checked from the case alone before anything is allocated */
     double max_monitor_rows;    /* rows of monitors.csv [-] */
     double max_profile_bins;    /* bins of one profile monitor [-] */
     double max_snapshot_bytes;  /* bytes of all particle snapshots (CSV and HDF5) [B] */

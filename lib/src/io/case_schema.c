@@ -1,7 +1,8 @@
 /* case_schema.c - the key tables of a case file and the table-driven reading of one section.
  * Each table row says what a key is (type, range, default, unit, meaning) and which field of
- * struct case_def (case.h) it fills; tests/case_docs.c prints the same rows as the key tables of
- * docs/cases.md, and CTest (case_docs) fails when the document differs. Physics: docs/model.md
+ * struct case_def (case.h) it fills (the rows of `numerics` are those of core/numerics_keys.def, which
+ * also give the parameter structs of the step their members); tests/case_docs.c prints the same
+ * rows as the key tables of docs/cases.md, and CTest (case_docs) fails when the document differs. Physics: docs/model.md
  * (1 kernel, 3 EOS, 4 time step, 5 mixture, 6 regimes, 8 walls, 9 reported quantities).
  * Messages have the form "<file>: <key path>: <what was expected>". */
 #include "case_schema.h"
@@ -73,99 +74,13 @@ static const struct case_key top_keys[] = {
     {.key = "output", .type = CASE_OBJECT, .meaning = "output intervals and the limits of the output's size"},
 };
 
+/* The rows of numerics_keys.def, each filling its member of struct case_def. */
+#define NUMERICS_SCHEMA_ROW(type_, member, read_by, as, ...) \
+    {.type = CASE_##type_, .field = CASE_FIELD(case_def, member), __VA_ARGS__},
 static const struct case_key numerics_keys[] = {
-    {.key = "dx", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 10, 0), .unit = "m",
-     .field = CASE_FIELD(case_def, dx), .meaning = "particle spacing"},
-    {.key = "h_over_dx", .type = CASE_NUMBER, RANGE(1, 0, 3, 0), DEF(1.3), .unit = "-",
-     .field = CASE_FIELD(case_def, h_over_dx), .meaning = "smoothing length h = h_over_dx dx"},
-    {.key = "cfl", .type = CASE_NUMBER, RANGE(0, 1, 1, 0), DEF(0.1), .unit = "-", .field = CASE_FIELD(case_def, cfl),
-     .meaning = "coefficient of the acoustic (CFL) time-step limit"},
-    {.key = "cfl_visc", .type = CASE_NUMBER, RANGE(0, 1, 1, 0), DEF(0.05), .unit = "-",
-     .field = CASE_FIELD(case_def, cfl_visc), .meaning = "coefficient of the viscous time-step limit"},
-    {.key = "t_end", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e6, 0), .unit = "s",
-     .field = CASE_FIELD(case_def, t_end), .meaning = "end time"},
-    {.key = "lattice_z0", .type = CASE_NUMBER, ANYWHERE, DEF(0), .unit = "m", .field = CASE_FIELD(case_def, lattice_z0),
-     .meaning = "a height at which the particle lattice has a layer boundary: bodies and walls are filled at "
-                "z = z0 + (k + 1/2) dx (x = (i + 1/2) dx), so a flat top at z0, such as a reservoir level "
-                "(\"$reservoir_level\"), holds exactly its water at any dx"},
-    {.key = "wall_layers", .type = CASE_INTEGER, RANGE(1, 0, 8, 0), DEF(3), .unit = "-",
-     .field = CASE_FIELD(case_def, wall_layers),
-     .meaning = "layers of wall particles behind each wall; at least ⌈2 h_over_dx⌉, to cover the kernel support 2h"},
-    {.key = "wall_placement", .type = CASE_CHOICE, DEF(0), .choices = wall_placements, .numeric_choice = 1,
-     .field = CASE_FIELD(case_def, wall_placement),
-     .meaning = "where wall particles sit: lattice (the sites of the bodies' lattice behind each wall) or aligned "
-                "(rows parallel to each segment at (l + 1/2) dx behind it, fans at the walls' inner corners; below)"},
-    {.key = "kernel", .type = CASE_CHOICE, DEF(0), .choices = kernels, .field = CASE_FIELD(case_def, kernel),
-     .meaning = "SPH kernel, support 2h (cubic_spline: the cubic B-spline)"},
-    {.key = "background_pressure", .type = CASE_NUMBER, RANGE(0, 0, 1e9, 0), DEF(0), .unit = "Pa",
-     .field = CASE_FIELD(case_def, p_background),
-     .meaning = "pressure added by the equation of state, for confined flows without a free surface; "
-                "subtracted again in the grains' effective stress"},
-    {.key = "pressure_smoothing", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0), .unit = "-",
-     .field = CASE_FIELD(case_def, pressure_smoothing),
-     .meaning = "θ_P of the partial pressure smoothing (below); 0: off"},
-    {.key = "density_diffusion", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0.1), .unit = "-",
-     .field = CASE_FIELD(case_def, density_diffusion),
-     .meaning = "δ of the density diffusion in the continuity equation (delta-SPH, below), between particles of "
-                "one fluid medium (grains take none); 0: off (the bundled cases of the paper's tables set 0)"},
-    {.key = "density_diffusion_form", .type = CASE_CHOICE, DEF(0), .choices = diffusion_forms, .numeric_choice = 1,
-     .field = CASE_FIELD(case_def, density_diffusion_form),
-     .meaning = "the density difference the diffusion acts on: hydrostatic (less its hydrostatic part, so a column "
-                "at rest is left at rest; Fourtakas et al. 2019) or molteni (the whole difference; Molteni & "
-                "Colagrossi 2009)"},
-    {.key = "density_bound", .type = CASE_NUMBER, RANGE(0, 0, 1, 1), DEF(0.3), .unit = "-",
-     .field = CASE_FIELD(case_def, density_bound),
-     .meaning = "a particle whose density departs from its medium's ρ0 by more than this fraction is excluded from "
-                "the run (below; counted in `excluded_particles`); 0: off, a non-positive density stops the run "
-                "(the bundled cases of the paper's tables set 0)"},
-    {.key = "excluded_max", .type = CASE_NUMBER, RANGE(0, 0, 1, 0), DEF(0.01), .unit = "-",
-     .field = CASE_FIELD(case_def, excluded_max),
-     .meaning = "the fraction of the case's particles (walls not counted) that may be excluded; one more stops the "
-                "run as unstable"},
-    {.key = "fixed_bed_speed", .type = CASE_NUMBER, RANGE(-1, 0, 100, 0), DEF(-1), .def_text = "-1 (off)",
-     .unit = "m/s", .field = CASE_FIELD(case_def, fixed_bed_speed),
-     .meaning = "the fixed bed (below): speed at or below which a grain counts as bed; negative: off"},
-    {.key = "av_wall", .type = CASE_BOOL, DEF(1), .field = CASE_FIELD(case_def, av_wall),
-     .meaning = "Monaghan artificial viscosity between a particle and wall particles (below)"},
-    {.key = "av_mixed", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_mixed),
-     .meaning = "the Monaghan term also between particles of different media (below)"},
-    {.key = "av_separating", .type = CASE_BOOL, DEF(0), .field = CASE_FIELD(case_def, av_separating),
-     .meaning = "the Monaghan term also on separating pairs, not only approaching ones (below)"},
-    {.key = "viscosity", .type = CASE_CHOICE, DEF(0), .choices = viscous_schemes, .numeric_choice = 1,
-     .field = CASE_FIELD(case_def, viscosity_implicit),
-     .meaning = "the laminar viscous term: explicit (in the momentum pass, time step bounded by cfl_visc) or "
-                "implicit (SDIRK2 with the walls in the solve, by BiCGSTAB; no viscous time-step bound)"},
-    {.key = "viscosity_mean", .type = CASE_CHOICE, DEF(0), .choices = viscosity_means, .numeric_choice = 1,
-     .field = CASE_FIELD(case_def, viscosity_arithmetic),
-     .meaning = "the pair viscosity of the laminar term between particles of different viscosities: harmonic, "
-                "2 mu_i mu_j / (mu_i + mu_j), or arithmetic, (mu_i + mu_j) / 2 (Morris et al. 1997; implicit "
-                "viscosity only)"},
-    {.key = "held_grains", .type = CASE_CHOICE, DEF(0), .choices = held_grain_modes, .numeric_choice = 1,
-     .field = CASE_FIELD(case_def, held_grains_rigid),
-     .meaning = "implicit viscosity: grains held fixed are unknowns of the viscous solve (solved) or prescribed "
-                "at rest in it and judged on the velocity one explicit time step of their forces gives them "
-                "(rigid, as the explicit scheme judges them)"},
-    {.key = "viscous_tolerance", .type = CASE_NUMBER, RANGE(0, 1, 1e-2, 0), DEF(1e-6), .unit = "-",
-     .field = CASE_FIELD(case_def, viscous_tolerance),
-     .meaning = "implicit viscosity: relative residual ‖b − A u‖ / ‖b‖ at which a solve stops"},
-    {.key = "viscous_max_iterations", .type = CASE_INTEGER, RANGE(1, 0, 100000, 0), DEF(500), .unit = "-",
-     .field = CASE_FIELD(case_def, viscous_max_iterations),
-     .meaning = "implicit viscosity: iteration budget of one solve; a solve that does not reach its tolerance "
-                "within it stops the run"},
-    {.key = "viscous_preconditioner", .type = CASE_CHOICE, DEF(1), .choices = viscous_preconditioners,
-     .numeric_choice = 1, .field = CASE_FIELD(case_def, viscous_preconditioner),
-     .meaning = "implicit viscosity: preconditioner of BiCGSTAB, jacobi (the diagonal) or two_level (the "
-                "diagonal plus a coarse correction on groups of cells; fewer iterations in granular flows)"},
-    {.key = "max_particles", .type = CASE_NUMBER, RANGE(1, 0, 1e12, 0), DEF(1e7), .unit = "-",
-     .field = CASE_FIELD(case_def, max_particles),
-     .meaning = "limit of the resource budget (below): fluid, granular and wall particles, estimated from the "
-                "bodies' areas and the walls' lengths and layers"},
-    {.key = "max_lattice_sites", .type = CASE_NUMBER, RANGE(1, 0, 1e15, 0), DEF(1e9), .unit = "-",
-     .field = CASE_FIELD(case_def, max_lattice_sites),
-     .meaning = "limit of the resource budget: lattice sites scanned to fill the bodies' and walls' bounding boxes"},
-    {.key = "max_steps", .type = CASE_NUMBER, RANGE(1, 0, 1e15, 0), DEF(1e9), .unit = "-",
-     .field = CASE_FIELD(case_def, max_steps),
-     .meaning = "limit of the resource budget: time steps to t_end, estimated from criterion (4) at rest"},
+#define NUMERICS_KEY NUMERICS_SCHEMA_ROW
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
 };
 
 /* bound k (0: min, 1: max) along axis d of case_def.domain */

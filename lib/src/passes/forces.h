@@ -12,6 +12,7 @@
 #include "cells.h"
 #include "kernel.h"
 #include "neighbours.h"
+#include "numerics_keys.h"
 #include "particles.h"
 #include "velocity_gradient.h"
 
@@ -19,24 +20,18 @@
  * neutral (the chunked pair loops read them with zero weight). */
 #define FORCES_PAD 16
 
-/* Constants of the pair terms. */
+/* Constants of the pair terms: what the creation derives for them (sim.c), then the `numerics` keys
+ * whose rows of core/numerics_keys.def are read by PAIR, as the members those rows name. */
 struct forces_params {
     struct kernel K;
     double eta2;        /* eta^2 of the Morris and Monaghan terms [m2] */
     double g;           /* gravity [m/s2] */
-    int av_wall;        /* artificial viscosity between particles and walls */
-    int av_mixed;       /* ... between particles of different media too */
-    int av_separating;  /* ... for separating pairs too */
-    int implicit_viscosity; /* the momentum pass leaves the viscous term out and stores its
-                               couplings for forces_viscous_apply (docs/numerics.md) */
-    int arithmetic_mean;    /* the pair viscosity is (mu_i + mu_j) / 2, not the harmonic mean */
     int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
                                stress (P->stress; a law with LAW_HAS_STRESS) and bounds the
                                shear of no-slip walls on elastic-plastic grains (wall friction) */
-    double p_background;    /* the equation of state's background pressure [Pa] (not an effective
-                               normal stress: left out of the wall friction's bound) */
-    double diffusion;       /* delta of the density diffusion of the continuity pass (0: off) */
-    int diffusion_form;     /* enum density_diffusion_form */
+#define NUMERICS_KEY NUMERICS_MEMBER_OF_PAIR
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
 };
 
 /* What the density diffusion acts on (numerics.density_diffusion_form, docs/numerics.md). */

@@ -6,6 +6,7 @@
 
 #include "forces.h"
 #include "medium.h"
+#include "numerics_keys.h"
 #include "viscous.h"
 
 struct scheme_params {
@@ -13,12 +14,12 @@ struct scheme_params {
     size_t n_media;
     int implicit;                 /* numerics.viscosity = "implicit": symplectic Euler around the
                                      implicit viscous step; else the explicit leapfrog */
-    int held_grains_rigid;        /* numerics.held_grains = "rigid" (implicit scheme) */
-    double cfl, cfl_visc;         /* the coefficients of criterion (4) */
-    double p_background;          /* added by the equation of state [Pa] */
-    double pressure_smoothing;    /* theta_P of the partial pressure smoothing (0: off) */
-    double density_bound;         /* |rho/rho0 - 1| beyond which a particle is excluded (0: off) */
     long excluded_limit;          /* particles that may be excluded; one more stops the run */
+    /* the `numerics` keys whose rows of core/numerics_keys.def are read by SCHEME, as the members
+     * those rows name */
+#define NUMERICS_KEY NUMERICS_MEMBER_OF_SCHEME
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
     struct forces_params pair;    /* what the pair loops read */
     struct viscous_params viscous; /* the implicit viscous step's solver */
 };

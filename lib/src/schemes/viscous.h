@@ -16,6 +16,7 @@
 #include <stddef.h>
 
 #include "forces.h"
+#include "numerics_keys.h"
 #include "walls.h"
 
 struct viscous_solver;
@@ -30,11 +31,12 @@ struct viscous_report {
     int converged;     /* residual <= tolerance */
 };
 
-/* The solver's numerical parameters (numerics.viscous_*), fixed for a run. */
+/* The solver's numerical parameters, fixed for a run: the `numerics` keys whose rows of
+ * core/numerics_keys.def are read by VISCOUS, as the members those rows name. */
 struct viscous_params {
-    int preconditioner;  /* enum viscous_preconditioner */
-    double tolerance;    /* relative residual at which a stage's solve stops [-] */
-    int max_iterations;  /* iteration budget of one solve */
+#define NUMERICS_KEY NUMERICS_MEMBER_OF_VISCOUS
+#include "numerics_keys.def"
+#undef NUMERICS_KEY
 };
 
 struct viscous_solver *viscous_create(void);
