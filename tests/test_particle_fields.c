@@ -26,9 +26,9 @@
 static void test_every_member_has_one_row(void **state)
 {
     (void)state;
-    /* the arrays are the members from x to the end of the struct (particles.h): their number,
+    /* the arrays are the members from pos to the end of the struct (particles.h): their number,
      * and each one's offset at most once among the rows */
-    const size_t first = offsetof(struct particles, x), n_arrays = (sizeof(struct particles) - first) / sizeof(void *);
+    const size_t first = offsetof(struct particles, pos), n_arrays = (sizeof(struct particles) - first) / sizeof(void *);
     assert_int_equal((sizeof(struct particles) - first) % sizeof(void *), 0);
     size_t seen = 0;
     unsigned char *hit = calloc(n_arrays, 1);

@@ -12,46 +12,36 @@
 
 #include "dim.h"
 
-/* A vector field: DIM component arrays. The 2D build still also names them (x, z) while the
- * code moves to components (transitional). */
-#if DIM == 2
-#define PARTICLES_VECTOR(v, a, b) union { double *v[DIM]; struct { double *a, *b; }; }
-#define PARTICLES_STRESS(s) union { double *s[SYM_N]; struct { double *sxx, *sxz, *szz, *syy; }; }
-#else
-#define PARTICLES_VECTOR(v, a, b) double *v[DIM]
-#define PARTICLES_STRESS(s) double *s[SYM_N]
-#endif
-
 struct particles {
     size_t n, cap;
     unsigned features;    /* PARTICLE_FEATURE_* of the simulation: the table rows it has (set before
                            * the first particles_alloc; the arrays of the other rows stay NULL) */
-    PARTICLES_VECTOR(pos, x, z);    /* position [m] */
-    PARTICLES_VECTOR(vel, vx, vz);  /* velocity [m/s]; walls: the wall's prescribed velocity */
-    PARTICLES_VECTOR(uv, uvx, uvz); /* velocity seen by viscous terms [m/s]: walls: no-slip mirror velocity */
+    double *pos[DIM];    /* position [m] */
+    double *vel[DIM];  /* velocity [m/s]; walls: the wall's prescribed velocity */
+    double *uv[DIM]; /* velocity seen by viscous terms [m/s]: walls: no-slip mirror velocity */
     double *rho;          /* density [kg/m3] */
     double *p;            /* pressure [Pa]; walls: extrapolated (Adami et al. 2012) */
     double *m;            /* mass [kg] (per unit depth in 2D) */
     double *vol;          /* volume m/rho [m^DIM, per unit depth in 2D] */
     double *mu;           /* dynamic viscosity [Pa s] */
-    PARTICLES_VECTOR(acc, ax, az); /* acceleration [m/s2] */
+    double *acc[DIM]; /* acceleration [m/s2] */
     double *drho;         /* density rate [kg/m3/s] */
     double *tag;          /* medium index as a number, -1 for walls (branch-free pair loops) */
     double *inv_rho;      /* 1 / rho [m3/kg] */
     double *inv_m;        /* 1 / m [1/kg]; 0 for walls (they take no acceleration) */
     double *avc;          /* alpha_M c h of the particle's medium [m2/s]; 0 if no artificial viscosity */
-    PARTICLES_VECTOR(visc_dv, visc_dvx, visc_dvz);   /* velocity change of the last implicit viscous
+    double *visc_dv[DIM];   /* velocity change of the last implicit viscous
                                                       * step [m/s] (its warm start) */
-    PARTICLES_VECTOR(visc_d1, visc_d1x, visc_d1z);   /* ... of that step's first stage (viscous.h) [m/s] */
-    PARTICLES_VECTOR(visc_dvp, visc_dvpx, visc_dvpz); /* visc_dv of the step before the last (the warm
+    double *visc_d1[DIM];   /* ... of that step's first stage (viscous.h) [m/s] */
+    double *visc_dvp[DIM]; /* visc_dv of the step before the last (the warm
                                                        * starts' linear extrapolation) [m/s] */
-    PARTICLES_VECTOR(visc_d1p, visc_d1px, visc_d1pz); /* visc_d1 of the step before the last [m/s] */
-    PARTICLES_STRESS(stress); /* deviatoric stress [Pa] (tension positive), SYM_N components in the
+    double *visc_d1p[DIM]; /* visc_d1 of the step before the last [m/s] */
+    double *stress[SYM_N]; /* deviatoric stress [Pa] (tension positive), SYM_N components in the
                                * order of dim.h (in 2D with the out-of-plane yy of plane strain);
                                * laws with LAW_HAS_STRESS, 0 elsewhere and on walls */
     double *wall_rough;   /* wall particles: 1 on a no-slip wall, 0 on a free-slip one; 0 for the
                            * others [-] (a wall's friction applies to rough walls only) */
-    PARTICLES_VECTOR(wall_n, wall_nx, wall_nz); /* free-slip wall particles: their wall's unit normal
+    double *wall_n[DIM]; /* free-slip wall particles: their wall's unit normal
                                                  * toward the solid, across which they mirror the stress
                                                  * of the solid they meet (no shear); 0 for the others
                                                  * (a no-slip wall takes the stress as it is) */

@@ -151,9 +151,10 @@ static void near_wall_range(void *arg, size_t b, size_t e)
         int close = 0;
         if (P->state[i] != MIXSPH_STATE_WALL)
             for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
-                double d;
+                double pos[DIM];
                 int at_end;
-                walls_signed_distance(&s->phys.walls, w, P->pos[0][i], P->pos[DIM_UP][i], &d, &at_end);
+                for (int k = 0; k < DIM; k++) pos[k] = P->pos[k][i];
+                const double d = walls_distance(&s->phys.walls, w, pos, &at_end);
                 close = !(fabs(d) > reach); /* NaN counts as close */
             }
         s->work.near_wall[i] = (uint8_t)close;
@@ -451,7 +452,7 @@ struct drift_loop {
     mixsph_sim *s;
     double dt;                /* the drift [s] */
     double half_kick;         /* the kick before it [s] (0: none) */
-    const double *ox_old, *oz_old; /* the walls' displacements before they moved (walls_clip) */
+    const double (*o_old)[DIM]; /* the walls' displacements before they moved (walls_keep_fluid_side) */
     size_t n_active;
     long clips;               /* + particles put back on their side of a wall */
     double shift2;            /* max squared displacement since the last build [m2] */
@@ -481,11 +482,12 @@ static void drift_range(void *arg, size_t b, size_t e)
             double v[DIM];
             for (int d = 0; d < DIM; d++) v[d] = P->vel[d][i] + kick * P->acc[d][i];
             if (st == MIXSPH_STATE_MOBILE) { /* fixed grains are not moved */
-                double x1[DIM];
-                for (int d = 0; d < DIM; d++) x1[d] = P->pos[d][i] + dt * v[d];
-                if (s->work.near_wall[i])
-                    walls_clip(&s->phys.walls, L->ox_old, L->oz_old, gap, P->pos[0][i], P->pos[DIM_UP][i], &x1[0],
-                               &x1[DIM_UP], &v[0], &v[DIM_UP], &clips);
+                double x0[DIM], x1[DIM];
+                for (int d = 0; d < DIM; d++) {
+                    x0[d] = P->pos[d][i];
+                    x1[d] = x0[d] + dt * v[d];
+                }
+                if (s->work.near_wall[i]) walls_keep_fluid_side(&s->phys.walls, L->o_old, gap, x0, x1, v, &clips);
                 for (int d = 0; d < DIM; d++) P->pos[d][i] = x1[d];
             }
             for (int d = 0; d < DIM; d++) P->vel[d][i] = P->uv[d][i] = v[d];
@@ -505,7 +507,7 @@ static void drift_range(void *arg, size_t b, size_t e)
     team_or_int(&L->outside, outside);
 }
 
-/* The walls move over dt (their displacements before it kept in *ox_old, *oz_old), then every
+/* The walls move over dt (their displacements before it kept in o_old), then every
  * particle takes `half_kick` of its acceleration (the explicit scheme's first half kick; 0: none)
  * and drifts with the result (grains held fixed are not moved; walls kept uncrossed); time
  * advances; the neighbour lists are rebuilt when a particle has moved skin/2 since their build
@@ -513,13 +515,11 @@ static void drift_range(void *arg, size_t b, size_t e)
 static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
 {
     struct particles *P = &s->phys.P;
-    double ox_old[WALLS_MAX], oz_old[WALLS_MAX];
-    for (size_t w = 0; w < s->phys.walls.n; w++) {
-        ox_old[w] = s->phys.walls.state[w].ox;
-        oz_old[w] = s->phys.walls.state[w].oz;
-    }
+    double o_old[WALLS_MAX][DIM];
+    for (size_t w = 0; w < s->phys.walls.n; w++)
+        for (int d = 0; d < DIM; d++) o_old[w][d] = s->phys.walls.state[w].o[d];
     walls_move(&s->phys.walls, P, s->phys.t, dt);
-    struct drift_loop L = {.s = s, .dt = dt, .half_kick = half_kick, .ox_old = ox_old, .oz_old = oz_old,
+    struct drift_loop L = {.s = s, .dt = dt, .half_kick = half_kick, .o_old = (const double (*)[DIM])o_old,
                            .n_active = s->work.C.start[s->work.C.ncell]};
     team_for(SIM_THREADS(s), P->n, drift_range, &L);
     s->phys.n_clipped += L.clips;

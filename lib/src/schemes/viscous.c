@@ -155,7 +155,7 @@ static void fill_wall_rows(const struct solve_ctx *c, int with_constant, int vec
 {
     double **v = c->V->v;
     if (c->M) {
-        walls_mirror_apply(c->M, c->S->G, with_constant, v[vec], v[vec + DIM_UP], c->S->n_threads);
+        walls_mirror_fill(c->M, c->S->G, with_constant, &v[vec], c->S->n_threads);
         return;
     }
     struct wall_rows_loop L = {.c = c, .vec = vec, .with_constant = with_constant};

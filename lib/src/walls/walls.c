@@ -624,34 +624,3 @@ static void mirror_apply_range(void *arg, size_t b, size_t e)
     }
 }
 
-#if DIM == 2
-void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end)
-{
-    const double pos[DIM] = {x, z};
-    *d = walls_distance(W, w, pos, at_end);
-}
-
-void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
-                double *x1, double *z1, double *vx, double *vz, long *clips)
-{
-    double o_old[WALLS_MAX][DIM];
-    for (size_t w = 0; w < W->n; w++) {
-        o_old[w][0] = ox_old[w];
-        o_old[w][1] = oz_old[w];
-    }
-    const double p0[DIM] = {x0, z0};
-    double p1[DIM] = {*x1, *z1}, v[DIM] = {*vx, *vz};
-    walls_keep_fluid_side(W, (const double (*)[DIM])o_old, gap, p0, p1, v, clips);
-    *x1 = p1[0];
-    *z1 = p1[1];
-    *vx = v[0];
-    *vz = v[1];
-}
-
-void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
-                        double *vz, int n_threads)
-{
-    double *const v[DIM] = {vx, vz};
-    walls_mirror_fill(M, G, with_constant, v, n_threads);
-}
-#endif

@@ -20,11 +20,7 @@
 
 /* The moving state of one wall. */
 struct wall_state {
-#if DIM == 2 /* transitional: schemes/ still reads the displacement as (ox, oz) */
-    union { double o[DIM]; struct { double ox, oz; }; };
-#else
     double o[DIM];   /* displacement of the wall since t = 0 [m] */
-#endif
     double v[DIM];   /* current velocity [m/s] */
     double a[DIM];   /* current acceleration [m/s2] */
     int ext;         /* driven by an external velocity (ext_v) instead of its motion law */
@@ -130,13 +126,5 @@ void walls_mirror_at(struct wall_mirror *M, const struct walls *W,
 void walls_mirror_fill(const struct wall_mirror *M, const struct gather *G, int with_constant, double *const v[DIM],
                        int n_threads);
 
-#if DIM == 2
-/* Transitional: the (x, z) forms schemes/ still calls, on top of the functions above. */
-void walls_signed_distance(const struct walls *W, size_t w, double x, double z, double *d, int *at_end);
-void walls_clip(const struct walls *W, const double *ox_old, const double *oz_old, double gap, double x0, double z0,
-                double *x1, double *z1, double *vx, double *vz, long *clips);
-void walls_mirror_apply(const struct wall_mirror *M, const struct gather *G, int with_constant, double *vx,
-                        double *vz, int n_threads);
-#endif
 
 #endif
