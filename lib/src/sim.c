@@ -147,7 +147,9 @@ static mixsph_status fill_bodies(mixsph_sim *s)
         double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
         const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
         const double pos[DIM] = {(sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx};
-        particles_push(&s->phys.P, pos, rho, rho * dx * dx, (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
+        double mass = rho; /* rho dx^DIM, multiplied in that order */
+        for (int d = 0; d < DIM; d++) mass *= dx;
+        particles_push(&s->phys.P, pos, rho, mass, (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
         s->phys.P.mu[s->phys.P.n - 1] = m->mu;
     }
     s->phys.n_fluid = n;

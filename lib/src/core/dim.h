@@ -65,4 +65,12 @@ static inline double dim_norm(const double v[DIM])
 #endif
 }
 
+/* The volume of a lattice cell of side dx, dx^DIM (dx dx in 2D: per unit depth) [m^DIM]. */
+static inline double dim_cell_volume(double dx)
+{
+    double v = dx;
+    for (int d = 1; d < DIM; d++) v *= dx;
+    return v;
+}
+
 #endif

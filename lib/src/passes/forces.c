@@ -5,7 +5,7 @@
  *                - sum_j m_j Pi_ij grad_i W_ij                         (Monaghan: see below)
  *                + 1/rho_i sum_j V_j 2 mu_ij F r^2/(r^2 + eta^2) (u_i - u_j)   (Morris et al. 1997)
  *                + g
- * with V_j = m_j / rho_j, grad_i W_ij = F(r) (x_i - x_j) (kernel.h), eta^2 = 0.01 h^2,
+ * with V_j = m_j / rho_j, grad_i W_ij = F(r) (x_i - x_j) (kernel.h), eta^2 = numerics.eta2_over_h2 h^2 (0.01 h^2),
  * mu_ij = 2 mu_i mu_j / (mu_i + mu_j) the harmonic mean (it is bounded by 2 min(mu_i, mu_j), so
  * the explicit viscous step of a mobile grain next to a fixed one at mu_thr stays governed by
  * the grain's own viscosity, and water slides past grains with the water's viscosity), and

@@ -626,7 +626,7 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
     struct density_update_loop L = {.s = s, .dt = dt};
     team_for(SIM_THREADS(s), P->n, density_update_range, &L);
     bad_rho |= L.bad_rho;
-    if (pressures_and_regimes(s, &S, s->cfg.pressure_smoothing > 0.0, dt) != 0)
+    if (pressures_and_regimes(s, &S, s->scheme.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->work.forces, &S);
     if (bad_a < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");

@@ -260,7 +260,7 @@ static long walls_generate_lattice(const struct walls *W, double dx, const mixsp
                 const double d = geom_signed_distance(&wl->line, wl->side, x, z, &at_end);
                 if (at_end || d >= 0.0 || d < -depth) continue;
                 if (behind_earlier_fixed_wall(W, w, x, z, depth)) continue;
-                if (push_wall_particle(ws, w, x, z, dx * dx, P) < 0) return -1;
+                if (push_wall_particle(ws, w, x, z, dim_cell_volume(dx), P) < 0) return -1;
                 added++;
             }
         }
@@ -416,31 +416,48 @@ static inline void mirror_normal_velocity(const double n[DIM], const double v_wa
 }
 
 /* The arguments of a parallel loop of this file (core/team.h). */
-struct wall_loop {
+/* The parallel loops of this file (core/team.h), each with its own arguments. */
+struct extrapolate_loop { /* the fluid's state onto the wall particles */
     const struct walls *W;
     const struct kernel *K;
     const struct gather *G;
-    double dx;
+    double dx;            /* the particle spacing [m] */
     struct particles *P;
-    const struct particles *cP;
+};
+
+struct mirror_weights_loop { /* the mirror's weights and signs */
+    const struct walls *W;
+    const struct kernel *K;
+    const struct gather *G;
+    const struct particles *P;
     struct wall_mirror *M;
-    const struct wall_mirror *cM;
-    const double (*v_wall)[DIM];
-    double c;
-    double *const *v;
+};
+
+struct mirror_at_loop { /* the mirror's constants from the walls' velocities */
+    const struct walls *W;
+    const struct particles *P;
+    struct wall_mirror *M;
+    const double (*v_wall)[DIM]; /* per wall [m/s] */
+};
+
+struct mirror_fill_loop { /* the mirror applied to a velocity field */
+    const struct wall_mirror *M;
+    const struct gather *G;
+    double constant;      /* 1: the whole map c + s a u, 0: its linear part s a u */
+    double *const *v;     /* the field's DIM components */
 };
 static void mirror_weights_range(void *arg, size_t b, size_t e);
 static void mirror_apply_range(void *arg, size_t b, size_t e);
 
 static void extrapolate_range(void *arg, size_t b, size_t e)
 {
-    const struct wall_loop *L = arg;
+    const struct extrapolate_loop *L = arg;
     const struct walls *W = L->W;
     const struct wall_state *wstate = W->state;
     const struct kernel *K = L->K;
     const struct gather *G = L->G;
     struct particles *P = L->P;
-    const double g = W->g, vol = L->dx * L->dx, rho_alone = W->rho_alone;
+    const double g = W->g, vol = dim_cell_volume(L->dx), rho_alone = W->rho_alone;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL) continue;
@@ -487,7 +504,7 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
 void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K, const struct gather *G, double dx,
                              struct particles *P, size_t n, int n_threads)
 {
-    struct wall_loop L = {.W = W, .K = K, .G = G, .dx = dx, .P = P};
+    struct extrapolate_loop L = {.W = W, .K = K, .G = G, .dx = dx, .P = P};
     team_for(n_threads, n, extrapolate_range, &L);
 }
 
@@ -537,18 +554,18 @@ int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struc
     M->n_rows = 0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) M->rows[M->n_rows++] = i;
-    struct wall_loop L = {.W = W, .K = K, .G = G, .cP = P, .M = M};
+    struct mirror_weights_loop L = {.W = W, .K = K, .G = G, .P = P, .M = M};
     team_for(n_threads, M->n_rows, mirror_weights_range, &L);
     return 0;
 }
 
 static void mirror_weights_range(void *arg, size_t b, size_t e)
 {
-    const struct wall_loop *L = arg;
+    const struct mirror_weights_loop *L = arg;
     const struct walls *W = L->W;
     const struct kernel *K = L->K;
     const struct gather *G = L->G;
-    const struct particles *P = L->cP;
+    const struct particles *P = L->P;
     struct wall_mirror *M = L->M;
     const int wendland = K->type == KERNEL_WENDLAND_C2;
     for (size_t r = b; r < e; r++) {
@@ -572,9 +589,9 @@ static void mirror_weights_range(void *arg, size_t b, size_t e)
 
 static void mirror_at_range(void *arg, size_t b, size_t e)
 {
-    const struct wall_loop *L = arg;
+    const struct mirror_at_loop *L = arg;
     const struct walls *W = L->W;
-    const struct particles *P = L->cP;
+    const struct particles *P = L->P;
     struct wall_mirror *M = L->M;
     const double (*v)[DIM] = L->v_wall;
     for (size_t r = b; r < e; r++) {
@@ -595,23 +612,23 @@ void walls_mirror_at(struct wall_mirror *M, const struct walls *W, const struct 
         for (int d = 0; d < DIM; d++) v[w][d] = wstate[w].v[d];
         if (mo >= 0 && dt > 0.0) step_end_velocity(&W->motions[mo], &wstate[w], t_from, dt, v[w]);
     }
-    struct wall_loop L = {.W = W, .cP = P, .M = M, .v_wall = (const double (*)[DIM])v};
+    struct mirror_at_loop L = {.W = W, .P = P, .M = M, .v_wall = (const double (*)[DIM])v};
     team_for(n_threads, M->n_rows, mirror_at_range, &L);
 }
 
 void walls_mirror_fill(const struct wall_mirror *M, const struct gather *G, int with_constant, double *const v[DIM],
                        int n_threads)
 {
-    struct wall_loop L = {.cM = M, .G = G, .c = with_constant ? 1.0 : 0.0, .v = v};
+    struct mirror_fill_loop L = {.M = M, .G = G, .constant = with_constant ? 1.0 : 0.0, .v = v};
     team_for(n_threads, M->n_rows, mirror_apply_range, &L);
 }
 
 static void mirror_apply_range(void *arg, size_t b, size_t e)
 {
-    const struct wall_loop *L = arg;
-    const struct wall_mirror *M = L->cM;
+    const struct mirror_fill_loop *L = arg;
+    const struct wall_mirror *M = L->M;
     const struct gather *G = L->G;
-    const double c = L->c;
+    const double c = L->constant;
     double *const *v = L->v;
     for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
