@@ -349,7 +349,7 @@ mixsph_status mesh_check_closed(const struct mesh *m, const char *name, char *er
     for (size_t i = 0; i < n && st == MIXSPH_OK;) {
         size_t j = i;
         int forward = 0, backward = 0;
-        for (; j < n && e[j].lo == e[i].lo && e[j].hi == e[i].hi; j++) (e[j].forward ? forward : backward)++;
+        for (; j < n && e[j].lo == e[i].lo && e[j].hi == e[i].hi; j++) *(e[j].forward ? &forward : &backward) += 1;
         if (forward != 1 || backward != 1)
             st = status_set(err, err_len, MIXSPH_ERR_ARG,
                             "%s: not closed: the edge between vertices %zu and %zu (of triangle %zu) is used %d times "
