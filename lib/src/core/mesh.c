@@ -263,6 +263,18 @@ mixsph_status mesh_add_extruded_polygon(struct mesh *m, const struct polyline *p
 {
     mixsph_status st = check_extrusion(poly, 1, y0, y1, "extruded polygon", err, err_len);
     if (st != MIXSPH_OK) return st;
+    /* simple: no two segments that do not share a vertex meet (touching counts; overlapping
+     * collinear segments are not caught), O(n^2) for the few vertices of a case's body */
+    const size_t n = poly->n;
+    for (size_t a = 0; a < n; a++)
+        for (size_t b = a + 2; b < n; b++) {
+            if (a == 0 && b == n - 1) continue; /* neighbours through the closing segment */
+            double at;
+            if (geom_path_crosses(poly->x[a], poly->z[a], poly->x[(a + 1) % n], poly->z[(a + 1) % n], poly->x[b],
+                                  poly->z[b], poly->x[(b + 1) % n], poly->z[(b + 1) % n], &at))
+                return status_set(err, err_len, MIXSPH_ERR_ARG,
+                                  "extruded polygon: segments %zu and %zu cross (the polygon must be simple)", a, b);
+        }
     double twice_area = 0.0; /* shoelace, positive counter-clockwise in (x, z) */
     for (size_t i = 0, j = poly->n - 1; i < poly->n; j = i++) twice_area += poly->x[j] * poly->z[i] - poly->x[i] * poly->z[j];
     if (twice_area == 0.0)
@@ -352,8 +364,8 @@ mixsph_status mesh_check_closed(const struct mesh *m, const char *name, char *er
         for (; j < n && e[j].lo == e[i].lo && e[j].hi == e[i].hi; j++) *(e[j].forward ? &forward : &backward) += 1;
         if (forward != 1 || backward != 1)
             st = status_set(err, err_len, MIXSPH_ERR_ARG,
-                            "%s: not closed: the edge between vertices %zu and %zu (of triangle %zu) is used %d times "
-                            "from %zu to %zu and %d times back (a closed, consistently oriented mesh: once each way)",
+                            "%s: not closed: the edge between vertices %zu and %zu (of triangle %zu) is used by %d "
+                            "triangle(s) from %zu to %zu and %d back (a closed, consistently oriented mesh: one each way)",
                             name, e[i].lo, e[i].hi, e[i].triangle, forward, e[i].lo, e[i].hi, backward);
         i = j;
     }

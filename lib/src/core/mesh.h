@@ -64,8 +64,8 @@ mixsph_status mesh_add_extruded_polyline(struct mesh *m, const struct polyline *
 
 /** Append the closed prism of the simple polygon `poly` (x-z plane, closed implicitly, either
  *  orientation) extruded across y in [y0, y1]: the side quads and the two caps (ear clipping),
- *  normals outward. A self-intersecting polygon is refused (no ear left). Collinear vertices
- *  are dropped from the caps, leaving a T-junction on the cap's edge (closed in space, not by
+ *  normals outward. A self-intersecting polygon is refused, naming two segments that cross.
+ *  Collinear vertices are dropped from the caps, leaving a T-junction on the cap's edge (closed in space, not by
  *  indices). */
 mixsph_status mesh_add_extruded_polygon(struct mesh *m, const struct polyline *poly, double y0, double y1, char *err,
                                         size_t err_len);

@@ -228,7 +228,9 @@ static mixsph_status sweep_columns(const struct lattice *L, const struct mesh *m
                     edge_side(A, B, q, &wc) != orientation)
                     continue;
                 const double w = wa + wb + wc;
-                const double z = w != 0.0 ? (wa * A[2] + wb * B[2] + wc * C[2]) / w : A[2];
+                /* relative to A: exact on a level face, so a site on it is kept by the rule
+                 * lo <= z exactly (on a sloping face round-off decides) */
+                const double z = A[2] + (w != 0.0 ? (wb * (B[2] - A[2]) + wc * (C[2] - A[2])) / w : 0.0);
                 const size_t column = (size_t)(i - c->first[0]) + c->nx * (size_t)(j - c->first[1]);
                 /* the normal's z has the sign of the projected area: looking down (-) enters */
                 mixsph_status st = push_crossing(c, column, z, -orientation, err, err_len);

@@ -133,14 +133,16 @@ mixsph_status terrain_read_esri_ascii(const char *path, struct terrain *t, char 
         st = terrain_alloc(t, ncols, nrows, x0, y0, cell, path, err, err_len);
     }
     const size_t n = ncols * nrows;
+    size_t last_line = c.line; /* of the last value read: where a truncated file ends */
     for (size_t k = 0; k < n && st == MIXSPH_OK; k++) {
         size_t wlen;
         const char *w = text_next_word(&c, &wlen);
         double z;
+        if (w) last_line = c.line;
         if (!w)
             st = status_set(err, err_len, MIXSPH_ERR_CASE,
-                            "%s:%zu: truncated: %zu values of the %zu x %zu the header declares", path, c.line, k, nrows,
-                            ncols);
+                            "%s:%zu: truncated: %zu values of the %zu x %zu the header declares", path, last_line, k,
+                            nrows, ncols);
         else if (!text_word_number(w, wlen, &z))
             st = status_set(err, err_len, MIXSPH_ERR_CASE, "%s:%zu: value %zu (row %zu, column %zu): '%.*s' is no number",
                             path, c.line, k + 1, k / ncols + 1, k % ncols + 1, TEXT_QUOTED(w, wlen));
