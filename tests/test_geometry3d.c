@@ -19,6 +19,7 @@
 
 #include <cmocka.h>
 
+#include "file_read.h"
 #include "geometry.h"
 #include "mesh.h"
 #include "placement.h"
@@ -824,6 +825,13 @@ static void test_arguments(void **state)
     assert_non_null(strstr(err, "layers = 0"));
     assert_int_equal(ps.n, 0);
     mesh_free(&m);
+    /* a file beyond the readers' size limit is refused after limit + 1 bytes, naming the limit */
+    char *data;
+    size_t len;
+    assert_int_equal(file_read_all(MIXSPH_SOURCE_DIR "/tests/data/tetra.stl", 100, &data, &len, err, sizeof err),
+                     MIXSPH_ERR_IO);
+    assert_non_null(strstr(err, "larger than the limit of 100 bytes"));
+    assert_null(data);
 }
 
 int main(void)

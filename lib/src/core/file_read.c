@@ -2,6 +2,7 @@
 #include "file_read.h"
 
 #include <errno.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,7 +16,9 @@ mixsph_status file_read_all(const char *path, size_t max_bytes, char **data, siz
     *len = 0;
     FILE *f = fopen(path, "rb");
     if (!f) return status_set(err, err_len, MIXSPH_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    size_t cap = 1 << 16, n = 0;
+    /* never more than max_bytes + 1 bytes: the one beyond the limit tells a file that passes it */
+    const size_t limit = max_bytes < SIZE_MAX - 1 ? max_bytes + 1 : max_bytes;
+    size_t cap = limit < ((size_t)1 << 16) ? limit : (size_t)1 << 16, n = 0;
     char *buf = malloc(cap + 1);
     if (!buf) {
         fclose(f);
@@ -23,13 +26,8 @@ mixsph_status file_read_all(const char *path, size_t max_bytes, char **data, siz
     }
     for (;;) {
         n += fread(buf + n, 1, cap - n, f);
-        if (n < cap) break; /* end of file or an error, told apart below */
-        if (cap > max_bytes) {
-            free(buf);
-            fclose(f);
-            return status_set(err, err_len, MIXSPH_ERR_IO, "%s: larger than the limit of %zu bytes", path, max_bytes);
-        }
-        const size_t grown = cap * 2;
+        if (n < cap || cap == limit) break; /* the end of the file, an error, or the limit reached */
+        const size_t grown = cap > limit / 2 ? limit : 2 * cap;
         char *more = realloc(buf, grown + 1);
         if (!more) {
             free(buf);

@@ -464,6 +464,9 @@ static mixsph_status sample_triangle(const struct surface_sampling *S, const str
         edge_n[k][1] = ex / len;
         edge_c[k] = edge_n[k][0] * a[0] + edge_n[k][1] * a[1];
     }
+    if ((hi[0] - lo[0]) / S->dx > 1e7 || (hi[1] - lo[1]) / S->dx > 1e7)
+        return status_set(err, err_len, MIXSPH_ERR_ARG, "surface points: triangle %zu spans more than 1e7 points of %g",
+                          t, S->dx);
     const double slack = 1e-9 * S->dx, depth = S->first_depth + layer * S->dx;
     const long long i0 = (long long)ceil(lo[0] / S->dx - 1e-9), i1 = (long long)floor(hi[0] / S->dx + 1e-9);
     const long long j0 = (long long)ceil(lo[1] / S->dx - 1e-9), j1 = (long long)floor(hi[1] / S->dx + 1e-9);
