@@ -129,6 +129,29 @@ mixsph_status lattice_fill_terrain(const struct lattice *L, const struct terrain
     return st;
 }
 
+/* The extent [*lo, *hi] along the first coordinate of the triangle c (2D points) on the line
+ * where the second coordinate is r; 0 when the line misses it. Its rows are what the two
+ * rasterisations below walk, so that a long thin triangle costs its rows and points, not its
+ * bounding box. */
+static int triangle_row_span(const double c[3][2], double r, double *lo, double *hi)
+{
+    *lo = INFINITY;
+    *hi = -INFINITY;
+    for (int k = 0; k < 3; k++) {
+        const double *p = c[k], *q = c[(k + 1) % 3];
+        if (r < fmin(p[1], q[1]) || r > fmax(p[1], q[1])) continue;
+        if (p[1] == q[1]) {
+            *lo = fmin(*lo, fmin(p[0], q[0]));
+            *hi = fmax(*hi, fmax(p[0], q[0]));
+        } else {
+            const double x = p[0] + (r - p[1]) * (q[0] - p[0]) / (q[1] - p[1]);
+            *lo = fmin(*lo, x);
+            *hi = fmax(*hi, x);
+        }
+    }
+    return *lo <= *hi;
+}
+
 /* ---- the column sweep --------------------------------------------------------------------- */
 
 /* A mesh's crossings of the lattice's vertical columns, sorted by column then height. */
@@ -209,19 +232,20 @@ static mixsph_status sweep_columns(const struct lattice *L, const struct mesh *m
         const double area2 = (B[0] - A[0]) * (C[1] - A[1]) - (B[1] - A[1]) * (C[0] - A[0]);
         if (area2 == 0.0) continue; /* vertical: no column crosses it */
         const int orientation = area2 > 0.0 ? 1 : -1;
-        long long range[2][2];
-        int empty = 0;
-        for (int d = 0; d < 2; d++) {
-            const double a = fmin(A[d], fmin(B[d], C[d])), b = fmax(A[d], fmax(B[d], C[d]));
-            range[d][0] = (long long)floor((a - L->origin[d]) / L->dx - 0.5);
-            range[d][1] = (long long)ceil((b - L->origin[d]) / L->dx - 0.5);
-            if (range[d][0] < c->first[d]) range[d][0] = c->first[d];
-            if (range[d][1] > c->last[d]) range[d][1] = c->last[d];
-            empty |= range[d][0] > range[d][1];
-        }
-        if (empty) continue;
-        for (long long j = range[1][0]; j <= range[1][1]; j++)
-            for (long long i = range[0][0]; i <= range[0][1]; i++) {
+        const double projected[3][2] = {{A[0], A[1]}, {B[0], B[1]}, {C[0], C[1]}};
+        const double y_lo = fmin(A[1], fmin(B[1], C[1])), y_hi = fmax(A[1], fmax(B[1], C[1]));
+        long long j0 = (long long)floor((y_lo - L->origin[1]) / L->dx - 0.5);
+        long long j1 = (long long)ceil((y_hi - L->origin[1]) / L->dx - 0.5);
+        if (j0 < c->first[1]) j0 = c->first[1];
+        if (j1 > c->last[1]) j1 = c->last[1];
+        for (long long j = j0; j <= j1; j++) {
+            double x_lo, x_hi; /* the row's span, widened by a site: the exact test below decides */
+            if (!triangle_row_span(projected, site(L->origin[1], L->dx, j), &x_lo, &x_hi)) continue;
+            long long i0 = (long long)floor((x_lo - L->origin[0]) / L->dx - 0.5) - 1;
+            long long i1 = (long long)ceil((x_hi - L->origin[0]) / L->dx - 0.5) + 1;
+            if (i0 < c->first[0]) i0 = c->first[0];
+            if (i1 > c->last[0]) i1 = c->last[0];
+            for (long long i = i0; i <= i1; i++) {
                 const double q[2] = {site(L->origin[0], L->dx, i), site(L->origin[1], L->dx, j)};
                 double wa, wb, wc; /* each vertex's weight: the opposite edge's determinant */
                 if (edge_side(B, C, q, &wa) != orientation || edge_side(C, A, q, &wb) != orientation ||
@@ -236,6 +260,7 @@ static mixsph_status sweep_columns(const struct lattice *L, const struct mesh *m
                 mixsph_status st = push_crossing(c, column, z, -orientation, err, err_len);
                 if (st != MIXSPH_OK) return st;
             }
+        }
     }
     qsort(c->crossing, c->n, sizeof *c->crossing, compare_crossings);
     return MIXSPH_OK;
@@ -278,14 +303,13 @@ static mixsph_status fill_columns(const struct lattice *L, const struct mesh *m,
 {
     struct columns c;
     mixsph_status st = sweep_columns(L, m, lo, hi, &c, err, err_len);
-    size_t at = 0;
-    for (size_t column = 0; column < c.nx * c.ny && st == MIXSPH_OK; column++) {
-        size_t end = at;
-        while (end < c.n && c.crossing[end].column == column) end++;
-        if (end > at) /* a column without crossings is outside any body and misses any surface */
-            st = fill_column(L, m, rule, c.first[0] + (long long)(column % c.nx), c.first[1] + (long long)(column / c.nx),
-                             c.crossing + at, end - at, lo[2], hi[2], z_max, out, err, err_len);
-        at = end;
+    /* a column without crossings is outside any body and misses any surface: only the columns
+     * with crossings are walked */
+    for (size_t at = 0, end; at < c.n && st == MIXSPH_OK; at = end) {
+        const size_t column = c.crossing[at].column;
+        for (end = at; end < c.n && c.crossing[end].column == column;) end++;
+        st = fill_column(L, m, rule, c.first[0] + (long long)(column % c.nx), c.first[1] + (long long)(column / c.nx),
+                         c.crossing + at, end - at, lo[2], hi[2], z_max, out, err, err_len);
     }
     free(c.crossing);
     return st;
@@ -468,9 +492,12 @@ static mixsph_status sample_triangle(const struct surface_sampling *S, const str
         return status_set(err, err_len, MIXSPH_ERR_ARG, "surface points: triangle %zu spans more than 1e7 points of %g",
                           t, S->dx);
     const double slack = 1e-9 * S->dx, depth = S->first_depth + layer * S->dx;
-    const long long i0 = (long long)ceil(lo[0] / S->dx - 1e-9), i1 = (long long)floor(hi[0] / S->dx + 1e-9);
     const long long j0 = (long long)ceil(lo[1] / S->dx - 1e-9), j1 = (long long)floor(hi[1] / S->dx + 1e-9);
-    for (long long j = j0; j <= j1; j++)
+    for (long long j = j0; j <= j1; j++) {
+        double s_lo, s_hi; /* the row's span, widened by a point: the test below decides */
+        if (!triangle_row_span((const double(*)[2])c2, fmin(fmax((double)j * S->dx, lo[1]), hi[1]), &s_lo, &s_hi))
+            continue;
+        const long long i0 = (long long)ceil(s_lo / S->dx) - 1, i1 = (long long)floor(s_hi / S->dx) + 1;
         for (long long i = i0; i <= i1; i++) {
             const double s = (double)i * S->dx, r = (double)j * S->dx;
             int on = 1;
@@ -485,6 +512,7 @@ static mixsph_status sample_triangle(const struct surface_sampling *S, const str
             if (st == MIXSPH_OK) st = merge_insert(g, out, out->n - 1, err, err_len);
             if (st != MIXSPH_OK) return st;
         }
+    }
     return MIXSPH_OK;
 }
 
