@@ -655,6 +655,27 @@ static void test_lattice_fill(void **state)
     point_set_free(&ps);
     mesh_free(&slope);
 
+    /* an open tank (inward, no lid): a column crosses only the floor, its crossings do not sum to 0,
+     * and the sweep falls back to the winding number site by site: the same set as mesh_contains */
+    const double tank_lo[3] = {0.0, 0.0, 0.0}, tank_hi[3] = {1.0, 0.8, 0.5};
+    struct mesh tank = {0};
+    box(&tank, tank_lo, tank_hi, MESH_BOX_OPEN_TOP, 1);
+    L = (struct lattice){.dx = 0.1};
+    assert_int_equal(lattice_fill_mesh(&L, &tank, &ps, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(lattice_fill_box(&L, tank_lo, tank_hi, &all, err, sizeof err), MIXSPH_OK);
+    point_set_keep(&all, 0, &tank, 1);
+    print_message("    open tank: %zu of its 400 sites count as inside (winding number above 1/2)\n", ps.n);
+    assert_int_equal(ps.n, all.n); /* reference: mesh_contains, site by site */
+    for (size_t k = 0; k < ps.n; k++) {
+        int found = 0;
+        for (size_t q = 0; q < all.n; q++) found |= dist3(ps.pos[k], all.pos[q]) == 0.0;
+        assert_true(found);
+    }
+    assert_true(ps.n > 200);
+    point_set_free(&all);
+    point_set_free(&ps);
+    mesh_free(&tank);
+
     /* a limit on the points is refused, naming it */
     L = (struct lattice){.dx = 0.1, .max_points = 10};
     assert_int_equal(lattice_fill_box(&L, lo1, hi1, &ps, err, sizeof err), MIXSPH_ERR_ARG);

@@ -67,7 +67,8 @@ mixsph_status point_set_push(struct point_set *ps, const double pos[3], const do
 mixsph_status lattice_fill_box(const struct lattice *L, const double lo[3], const double hi[3], struct point_set *out,
                                char *err, size_t err_len);
 
-/** Append the lattice sites inside a closed mesh (the column sweep above; either orientation). */
+/** Append the lattice sites inside a closed mesh (the column sweep above; either orientation),
+ *  column by column (z fastest, then x, then y; lattice_fill_box's order is x, y, z). */
 mixsph_status lattice_fill_mesh(const struct lattice *L, const struct mesh *body, struct point_set *out, char *err,
                                 size_t err_len);
 
