@@ -131,7 +131,7 @@ static mixsph_status add_polyline_vertices(struct mesh *m, const struct polyline
 {
     for (size_t k = 0; k < line->n; k++) {
         const double p[3] = {line->x[k], y, line->z[k]};
-        size_t index;
+        size_t index = 0;
         mixsph_status st = mesh_add_vertex(m, p, &index, err, err_len);
         if (st != MIXSPH_OK) return st;
         if (k == 0) *first = index;
