@@ -78,7 +78,7 @@ static mixsph_sim *create(const char *text, const char *origin, double dx)
     const mixsph_status st = mixsph_sim_create_from_text(text, origin, ov, 1, &s, err, sizeof err);
     if (st != MIXSPH_OK) print_error("%s\n", err);
     assert_int_equal(st, MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* ctest -j runs tests side by side */
     return s;
 }
 
@@ -131,7 +131,7 @@ static mixsph_sim *create_heap(double mu_thr, double mu0, const mixsph_override 
     const mixsph_status st = mixsph_sim_create(MIXSPH_SOURCE_DIR "/cases/granular_heap.json", ov, n, &s, err, sizeof err);
     if (st != MIXSPH_OK) print_error("%s\n", err);
     assert_int_equal(st, MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* ctest -j runs tests side by side */
     return s;
 }
 
@@ -413,7 +413,7 @@ static size_t rigid_column(double mu0, double *advance_m)
     const mixsph_status st = mixsph_sim_create(MIXSPH_SOURCE_DIR "/cases/column_collapse.json", ov, 5, &s, err, sizeof err);
     if (st != MIXSPH_OK) print_error("%s\n", err);
     assert_int_equal(st, MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* ctest -j runs tests side by side */
     const size_t out_front = output(s, "front"), out_fixed = output(s, "fixed_particles");
     const double front0 = mixsph_sim_output_value(s, out_front);
     size_t held_least = SIZE_MAX;
