@@ -593,7 +593,7 @@ static double column_collapse(double dx)
 #define FRONT_TOL (2.0 * 1.3 * COL_DX / COL_W) /* 2h / r0: the front is resolved to the kernel support */
 
 /* (b) what holds at this resolution: it spreads, but no farther than the most mobile experiment.
- * In the validation suite (`test_granular validation`; 44 s on 2 threads). */
+ * In the validation suite (`test_granular validation`). */
 static void test_column_collapse(void **state)
 {
     (void)state;
@@ -608,7 +608,10 @@ static void test_column_collapse(void **state)
  * mu0, proportional to dx^2, so the run costs 1/16 of the one at dx = 0.0125), with the same
  * criteria re-derived for that resolution: it stops, its surface is no steeper than phi over
  * 4 bins of 2 dx, and its run-out lies between half the column width and the glass-bead edge of
- * the experiments' band plus the kernel support 2h / r0 = 0.325 at this dx. Measured: SHORT_MEASURED. */
+ * the experiments' band plus the kernel support 2h / r0 = 0.325 at this dx. Measured (12-07, one
+ * thread, 0.6 s): KE < 2 % at t = 0.37 s (10,065 steps), run-out 0.71 r0 (the trend in dx: 0.71,
+ * 0.99, 1.16 r0 at dx = 0.025, 0.0125, 0.01), steepest slope 21.3 deg. A column without friction
+ * runs to the end of the floor (3 r0) and one held by the rheology does not spread: both fail. */
 static void test_column_collapse_short(void **state)
 {
     (void)state;
@@ -641,6 +644,29 @@ static void test_column_runout(void **state)
                         COLUMN_RUNOUT_MEASURED - COLUMN_RUNOUT_MARGIN, COLUMN_RUNOUT_MEASURED + COLUMN_RUNOUT_MARGIN);
 }
 
+/* Today's band of test_column_runout_short: the run-out at dx = 0.025, 0.707774 r0, measured on
+ * 2026-12-07 (GCC 12, -O3, one thread; results do not depend on it). The same margin as the long
+ * run's in particle spacings, 0.64 dx (0.08 r0 at this dx; band 0.628-0.788 r0), which ends below
+ * the criterion's lower edge at this dx, 1.2 - 0.325 = 0.875 r0. It is what makes the short run
+ * fail when the friction changes: the friction angle 25 deg instead of 35 runs out 1.29 r0,
+ * 15 deg 1.85 r0, both within test_column_collapse_short's bounds. */
+#define COLUMN_RUNOUT_SHORT_MEASURED 0.708
+#define COLUMN_RUNOUT_SHORT_MARGIN (0.64 * COL_DX_SHORT / COL_W)
+/* (b), short: the criterion at dx = 0.025, to 2h = 0.325 r0. A known failure (comment above). */
+static void test_column_runout_short(void **state)
+{
+    (void)state;
+    const double runout = column_collapse(COL_DX_SHORT), front_tol = 2.0 * 1.3 * COL_DX_SHORT / COL_W;
+    print_message("run-out %.4f r0 against the experiments' %.1f to %.1f r0, tolerance 2h = %.3f r0\n", runout, RUNOUT_LO,
+                  RUNOUT_HI, front_tol);
+    /* reference: lambda a with lambda = 1.2 (Lube et al. 2005) to 1.8 (Lajeunesse et al. 2005),
+     * a = 1; tolerance 2h / r0 = 0.325 at this dx. Not met: today's band is the measured run-out,
+     * COLUMN_RUNOUT_SHORT_MEASURED, +- COLUMN_RUNOUT_SHORT_MARGIN */
+    known_failure_check("column_runout_short", runout >= RUNOUT_LO - front_tol && runout <= RUNOUT_HI + front_tol, runout,
+                        COLUMN_RUNOUT_SHORT_MEASURED - COLUMN_RUNOUT_SHORT_MARGIN,
+                        COLUMN_RUNOUT_SHORT_MEASURED + COLUMN_RUNOUT_SHORT_MARGIN);
+}
+
 /* `test_granular` runs the tests the model meets; `test_granular known_failure NAME` one of the
  * criteria it does not meet yet (header): heap_mobile, heap_implicit_vajont or column_runout.
  * CTest runs each of these on its own; each passes while its criterion is not met and its value
@@ -661,7 +687,13 @@ int main(int argc, char **argv)
             const struct CMUnitTest known[] = {cmocka_unit_test(test_column_runout)};
             return cmocka_run_group_tests(known, NULL, NULL);
         }
-        fprintf(stderr, "test_granular: unknown known_failure '%s' (heap_mobile, heap_implicit_vajont, column_runout)\n",
+        if (strcmp(argv[2], "column_runout_short") == 0) {
+            const struct CMUnitTest known[] = {cmocka_unit_test(test_column_runout_short)};
+            return cmocka_run_group_tests(known, NULL, NULL);
+        }
+        fprintf(stderr,
+                "test_granular: unknown known_failure '%s' (heap_mobile, heap_implicit_vajont, column_runout, "
+                "column_runout_short)\n",
                 argv[2]);
         return 2;
     }
