@@ -10,7 +10,9 @@
  * 2. The static state (the case's alpha_m = 0.2 damps the waves; t = 1.5 s, about 150 times
  *    2H / c_p): the oedometric state of plane strain, the vertical stress
  *    sigma_zz = -p + s_zz = -rho g (H_s - z) and sigma_xx / sigma_zz = nu / (1 - nu) = 0.4286,
- *    over the particles at least 3h from the walls, the floor and the top. */
+ *    over the particles at least 3h from the walls, the floor and the top. The run to 1.5 s is in
+ *    the validation suite (`test_elastic_column validation`); ./tools/do test reaches the same
+ *    state with 5 times the damping in a fifth of the time (test_oedometric_state_short). */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -18,6 +20,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <cmocka.h>
 
@@ -39,7 +42,7 @@ static mixsph_sim *create(const mixsph_override *ov, size_t n_ov)
     const mixsph_status st = mixsph_sim_create(CASE, ov, n_ov, &s, err, sizeof err);
     if (st != MIXSPH_OK) print_error("%s\n", err);
     assert_int_equal(st, MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(s, 2), MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK); /* ctest -j runs tests side by side */
     return s;
 }
 
@@ -73,11 +76,12 @@ static void test_elastic_wave_speed(void **state)
     mixsph_sim_destroy(s);
 }
 
-static void test_oedometric_state(void **state)
+/* The static state after t_end with the artificial viscosity alpha_m (the case's: 0.2). */
+static void oedometric_state(double alpha_m, double t_end)
 {
-    (void)state;
-    mixsph_sim *s = create(NULL, 0);
-    assert_int_equal(mixsph_sim_advance_to(s, 1.5), MIXSPH_OK);
+    const mixsph_override ov[] = {{"media.solid.alpha_m", alpha_m}};
+    mixsph_sim *s = create(ov, 1);
+    assert_int_equal(mixsph_sim_advance_to(s, t_end), MIXSPH_OK);
     const struct particles *P = &s->phys.P;
     const double margin = 3.0 * s->phys.h;
     double ztop = -INFINITY;
@@ -104,9 +108,9 @@ static void test_oedometric_state(void **state)
     const double slope = (n * szs - sz * ss) / (n * szz - sz * sz);
     ratio /= n;
     const double k0 = NU / (1.0 - NU);
-    print_message("t = 1.5 s, %g interior particles: d sigma_zz / dz = %.1f Pa/m (rho g = %.1f), sigma_xx / sigma_zz "
+    print_message("alpha_m = %g, t = %g s (%llu steps), %g interior particles: d sigma_zz / dz = %.1f Pa/m (rho g = %.1f), sigma_xx / sigma_zz "
                   "= %.4f (nu / (1 - nu) = %.4f), largest |sigma_zz + rho g (H_s - z)| = %.2f%% of rho g H\n",
-                  n, slope, RHO * G, ratio, k0, 100.0 * worst);
+                  alpha_m, t_end, (unsigned long long)mixsph_sim_steps(s), n, slope, RHO * G, ratio, k0, 100.0 * worst);
     /* reference d sigma_zz / dz = rho g (the weight above; the compression changes rho by
      * rho g H / K, 0.1 %); tolerance 2 %: the lattice bias of the SPH gradient with the cubic
      * spline at h = 1.3 dx is 1 % (test_hydrostatic), and the column's slowest mode still moves
@@ -122,11 +126,38 @@ static void test_oedometric_state(void **state)
     mixsph_sim_destroy(s);
 }
 
-int main(void)
+/* 2. as the case has it (alpha_m = 0.2) at t = 1.5 s (validation suite: `test_elastic_column
+ * validation`, 47k steps). */
+static void test_oedometric_state(void **state)
 {
+    (void)state;
+    oedometric_state(0.2, 1.5);
+}
+
+/* 2, short (./tools/do test): the static state does not depend on the damping that brings the
+ * column to it, so the short version damps the waves 5 times more strongly (alpha_m = 1.0) and
+ * takes the state at a fifth of the time, t = 0.3 s (9.5k steps), with the same references and
+ * tolerances. Measured (12-07): d sigma_zz / dz +0.29 %, sigma_xx / sigma_zz 0.4297 (+0.26 %),
+ * pointwise 1.16 % of rho g H (the long run: +0.2 %, -0.3 %, 1.2 %). Not yet static with less:
+ * alpha_m = 0.2 at 0.3 s gives -11 % and 12.5 %, alpha_m = 1.0 at 0.15 s +3.2 %. */
+#define OEDO_ALPHA_SHORT 1.0
+#define OEDO_T_SHORT 0.3
+static void test_oedometric_state_short(void **state)
+{
+    (void)state;
+    oedometric_state(OEDO_ALPHA_SHORT, OEDO_T_SHORT);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc > 1 && strcmp(argv[1], "validation") == 0) {
+        /* the long version (CTest test_elastic_column_validation, label validation) */
+        const struct CMUnitTest long_tests[] = {cmocka_unit_test(test_oedometric_state)};
+        return cmocka_run_group_tests(long_tests, NULL, NULL);
+    }
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_elastic_wave_speed),
-        cmocka_unit_test(test_oedometric_state),
+        cmocka_unit_test(test_oedometric_state_short),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
