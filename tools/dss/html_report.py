@@ -41,6 +41,8 @@ import subprocess
 
 import numpy as np
 
+from .emulator import _jsonable
+
 from .scenarios import ID
 
 PAGE = "report.html"
@@ -77,21 +79,8 @@ def _round(v, digits=6):
 
 
 def _plain(obj):
-    """JSON-ready: numpy scalars and arrays to Python, NaN to None."""
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
-    if isinstance(obj, (np.floating, float)):
-        x = float(obj)
-        return x if math.isfinite(x) else None
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    return obj
+    """JSON-ready: numpy scalars and arrays to Python, NaN to None (the emulator file's rule)."""
+    return _jsonable(obj)
 
 
 # ---- the emulator for the browser --------------------------------------------------------------
