@@ -2,6 +2,7 @@
  * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
 #include "sim.h"
 
+#include "body_sites.h"
 #include "budget.h"
 #include "law_registry.h"
 #include "state.h"
@@ -34,19 +35,30 @@ static int make_dir(const char *path)
 #endif
 }
 
-#if DIM == 2 /* bodies are polygons of the x-z plane (case input), placed on a 2D lattice */
 /* A lattice site of a body, for the hydrostatic initialisation. */
 struct site {
-    long i, k;       /* lattice indices: x = (i + 1/2) dx, z = z_offset + (k + 1/2) dx */
+    long i, j, k;    /* lattice indices: x = (i + 1/2) dx, y = (j + 1/2) dx (3D; 0 in 2D), z = z_offset + (k + 1/2) dx */
     int medium;
+    size_t body;     /* the body it belongs to */
 };
 
 static int site_cmp(const void *a, const void *b)
 {
     const struct site *p = a, *q = b;
     if (p->i != q->i) return p->i < q->i ? -1 : 1;
+    if (p->j != q->j) return p->j < q->j ? -1 : 1;
     if (p->k != q->k) return p->k > q->k ? -1 : 1; /* top first */
     return 0;
+}
+
+/* The position of a lattice site. */
+static void site_position(const struct site *st, double dx, double z_off, double pos[DIM])
+{
+    pos[0] = (st->i + 0.5) * dx;
+#if DIM == 3
+    pos[1] = (st->j + 0.5) * dx;
+#endif
+    pos[DIM_UP] = z_off + (st->k + 0.5) * dx;
 }
 
 /* Is pos too close to a wall, or behind one, to hold a particle? */
@@ -60,15 +72,24 @@ static int site_blocked(const mixsph_sim *s, const double pos[DIM])
     return 0;
 }
 
-/* Fill every body on the global lattice (a site belongs to the first body listing it), then
- * give each particle the hydrostatic pressure of the lattice column above it:
- * p = sum over the sites above of rho0 g dx, plus half its own; rho from the EOS; m = rho dx^2. */
-static mixsph_status fill_bodies(mixsph_sim *s)
+/* Append a site to the growing array. */
+static int push_site(struct site **sites, size_t *n, size_t *cap, struct site st)
 {
-    const double dx = s->phys.dx, z_off = geom_lattice_z_offset(s->cfg.lattice_z0, dx);
-    size_t n = 0, cap = 1024;
-    struct site *sites = malloc(cap * sizeof *sites);
-    if (!sites) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    if (*n == *cap) {
+        struct site *q = realloc(*sites, 2 * *cap * sizeof *q);
+        if (!q) return -1;
+        *sites = q;
+        *cap *= 2;
+    }
+    (*sites)[(*n)++] = st;
+    return 0;
+}
+
+#if DIM == 2 /* bodies are polygons of the x-z plane, placed on the 2D lattice */
+/* Every body's free sites on the global lattice (a site belongs to the first body listing it). */
+static mixsph_status collect_sites(mixsph_sim *s, double z_off, struct site **sites, size_t *n, size_t *cap)
+{
+    const double dx = s->phys.dx;
     double bx0 = INFINITY, bx1 = -INFINITY, bz0 = INFINITY, bz1 = -INFINITY;
     for (size_t b = 0; b < s->cfg.n_bodies; b++) {
         const struct polyline *pg = &s->cfg.bodies[b].polygon;
@@ -81,12 +102,9 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     }
     const long i0 = (long)floor(bx0 / dx) - 1, i1 = (long)ceil(bx1 / dx) + 1;
     const long k0 = (long)floor((bz0 - z_off) / dx) - 1, k1 = (long)ceil((bz1 - z_off) / dx) + 1;
-    size_t per_body[CASE_MAX_BODIES] = {0}; /* particles each body got */
     for (long k = k0; k <= k1; k++) {
-        if (sim_interrupted(s)) {
-            free(sites);
+        if (sim_interrupted(s))
             return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while filling the bodies", s->cfg.origin);
-        }
         for (long i = i0; i <= i1; i++) {
             const double pos[DIM] = {(i + 0.5) * dx, z_off + (k + 0.5) * dx};
             const double x = pos[0], z = pos[DIM_UP];
@@ -100,23 +118,83 @@ static mixsph_status fill_bodies(mixsph_sim *s)
                 }
             }
             if (medium < 0 || site_blocked(s, pos)) continue;
-            per_body[body]++;
-            if (n == cap) {
-                struct site *q = realloc(sites, 2 * cap * sizeof *sites);
-                if (!q) {
-                    free(sites);
-                    return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
-                }
-                sites = q;
-                cap *= 2;
-            }
-            sites[n++] = (struct site){i, k, medium};
+            if (push_site(sites, n, cap, (struct site){i, 0, k, medium, body}) != 0)
+                return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
         }
+    }
+    return MIXSPH_OK;
+}
+#else
+/* by the body, then the lattice place: equal places together, the first body's first */
+static int site_body_cmp(const void *a, const void *b)
+{
+    const int c = site_cmp(a, b);
+    if (c != 0) return c;
+    const struct site *p = a, *q = b;
+    return p->body < q->body ? -1 : p->body > q->body;
+}
+
+/* Every body's free sites on the global lattice (io/body_sites.h; a site belongs to the first
+ * body listing it). */
+static mixsph_status collect_sites(mixsph_sim *s, double z_off, struct site **sites, size_t *n, size_t *cap)
+{
+    const double dx = s->phys.dx;
+    const struct lattice L = {.dx = dx, .origin = {0.0, 0.0, z_off},
+                              .max_points = (size_t)fmin(4.0 * s->cfg.max_particles + 1024.0, 1e15)};
+    for (size_t b = 0; b < s->cfg.n_bodies; b++) {
+        if (sim_interrupted(s))
+            return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while filling the bodies", s->cfg.origin);
+        struct point_set ps;
+        memset(&ps, 0, sizeof ps);
+        const mixsph_status st = body_sites(&s->cfg, b, &L, &ps, s->err, sizeof s->err);
+        if (st != MIXSPH_OK) {
+            point_set_free(&ps);
+            return st;
+        }
+        for (size_t q = 0; q < ps.n; q++) {
+            const struct site site = {lround(ps.pos[q][0] / dx - 0.5), lround(ps.pos[q][1] / dx - 0.5),
+                                      lround((ps.pos[q][2] - z_off) / dx - 0.5), s->cfg.bodies[b].medium, b};
+            if (push_site(sites, n, cap, site) != 0) {
+                point_set_free(&ps);
+                return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+            }
+        }
+        point_set_free(&ps);
+    }
+    qsort(*sites, *n, sizeof **sites, site_body_cmp);
+    size_t kept = 0;
+    for (size_t q = 0; q < *n; q++) {
+        if (kept > 0 && site_cmp(&(*sites)[kept - 1], &(*sites)[q]) == 0) continue; /* a later body's copy */
+        double pos[DIM];
+        site_position(&(*sites)[q], dx, z_off, pos);
+        if (site_blocked(s, pos)) continue;
+        (*sites)[kept++] = (*sites)[q];
+    }
+    *n = kept;
+    return MIXSPH_OK;
+}
+#endif
+
+/* Fill every body on the global lattice, then give each particle the hydrostatic pressure of the
+ * lattice column above it: p = sum over the sites above of rho0 g dx, plus half its own; rho from
+ * the EOS; m = rho dx^DIM. */
+static mixsph_status fill_bodies(mixsph_sim *s)
+{
+    const double dx = s->phys.dx, z_off = geom_lattice_z_offset(s->cfg.lattice_z0, dx);
+    size_t n = 0, cap = 1024;
+    struct site *sites = malloc(cap * sizeof *sites);
+    if (!sites) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
+    const mixsph_status st = collect_sites(s, z_off, &sites, &n, &cap);
+    if (st != MIXSPH_OK) {
+        free(sites);
+        return st;
     }
     if (n == 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: bodies: no particle fits in the bodies at dx = %g", s->cfg.origin, dx);
     }
+    size_t per_body[CASE_MAX_BODIES] = {0}; /* particles each body got */
+    for (size_t q = 0; q < n; q++) per_body[sites[q].body]++;
     /* a body that got no particle lies behind the walls, or within the bodies listed before it */
     for (size_t b = 0; b < s->cfg.n_bodies; b++) {
         if (per_body[b] > 0) continue;
@@ -140,13 +218,14 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     }
     double above = 0.0; /* pressure of the column above the current site [Pa] */
     for (size_t q = 0; q < n; q++) {
-        if (q == 0 || sites[q].i != sites[q - 1].i) above = 0.0;
+        if (q == 0 || sites[q].i != sites[q - 1].i || sites[q].j != sites[q - 1].j) above = 0.0;
         const struct medium *m = &s->cfg.media[sites[q].medium];
         const double p = above + 0.5 * m->rho0 * s->cfg.g * dx;
         above += m->rho0 * s->cfg.g * dx;
         double (*const initial_pressure)(const struct medium *, double) = law_get(m->law)->initial_pressure;
         const double rho = eos_density(initial_pressure ? initial_pressure(m, p) : p, m->rho0, m->c);
-        const double pos[DIM] = {(sites[q].i + 0.5) * dx, z_off + (sites[q].k + 0.5) * dx};
+        double pos[DIM];
+        site_position(&sites[q], dx, z_off, pos);
         double mass = rho; /* rho dx^DIM, multiplied in that order */
         for (int d = 0; d < DIM; d++) mass *= dx;
         particles_push(&s->phys.P, pos, rho, mass, (uint8_t)sites[q].medium, MIXSPH_STATE_MOBILE);
@@ -156,13 +235,6 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     free(sites);
     return MIXSPH_OK;
 }
-#else
-static mixsph_status fill_bodies(mixsph_sim *s)
-{
-    return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: bodies: polygon bodies are 2D geometry; a 3D build cannot place them yet",
-                    s->cfg.origin);
-}
-#endif
 
 /* The domain: given in the case, or the bounding box of all geometry (moving walls swept over
  * the run) with room for the wall layers, and half the height again above for splashes. Its

@@ -14,12 +14,16 @@
 #include "case_schema.h"
 #include "geometry.h"
 #include "law_registry.h"
+#include "mesh.h"
+#include "stl.h"
 #include "time_step.h"
 #include "status.h"
 
 /* Bytes one particle adds to one snapshot: a row of snap_NNNN.csv (ten fields of 1-13 characters,
  * about 90 bytes) and its values in run.h5 (seven doubles and three small integers, about 70). */
 #define BUDGET_SNAPSHOT_BYTES_PER_PARTICLE 160.0
+/* ... and in 3D the y columns more: y and v_y (about 26 bytes of CSV, 16 of run.h5) */
+#define BUDGET_SNAPSHOT_BYTES_3D 40.0
 
 /* Lattice sites of the box [x0, x1] x [z0, z1] at spacing dx, as the fills scan it (one site of
  * margin on each side). */
@@ -28,11 +32,53 @@ static double box_sites(double x0, double x1, double z0, double z1, double dx)
     return (floor((x1 - x0) / dx) + 3.0) * (floor((z1 - z0) / dx) + 3.0);
 }
 
-/* Particles of body k. */
+/* Particles of body k of a 2D case. */
 static double body_particles(const struct case_def *c, size_t k)
 {
     const struct body *bd = &c->bodies[k];
     return geom_polygon_area_in_band(&bd->polygon, bd->z_min, bd->z_max) / (c->dx * c->dx);
+}
+
+/* The box [lo, hi] a 3D body lies in (an STL body: its mesh's bounds, from the file; an unreadable
+ * file gives an empty box, and the fill then says why) and its volume [m3]. */
+static double body_box3(const struct case_def *c, size_t k, double lo[3], double hi[3])
+{
+    const struct body *bd = &c->bodies[k];
+    double volume = NAN;
+    switch (bd->shape) {
+    case BODY_POLYGON:
+        lo[1] = bd->y_min, hi[1] = bd->y_max;
+        lo[0] = lo[2] = INFINITY, hi[0] = hi[2] = -INFINITY;
+        geom_grow_box(&bd->polygon, &lo[0], &hi[0], &lo[2], &hi[2]);
+        volume = geom_polygon_area_in_band(&bd->polygon, bd->z_min, bd->z_max) * (bd->y_max - bd->y_min);
+        break;
+    case BODY_BOX:
+        memcpy(lo, bd->box_min, 3 * sizeof *lo);
+        memcpy(hi, bd->box_max, 3 * sizeof *hi);
+        break;
+    case BODY_STL: {
+        struct mesh m;
+        memset(&m, 0, sizeof m);
+        char msg[256];
+        if (stl_read(bd->stl, &m, NULL, msg, sizeof msg) == MIXSPH_OK && m.n_triangles > 0) {
+            mesh_bounds(&m, lo, hi);
+            volume = fabs(mesh_volume(&m));
+        } else {
+            lo[0] = lo[1] = lo[2] = hi[0] = hi[1] = hi[2] = 0.0;
+        }
+        mesh_free(&m);
+        break;
+    }
+    default: /* BODY_BELOW_LEVEL: the domain below the level */
+        lo[0] = c->domain[0], hi[0] = c->domain[1];
+        lo[1] = c->domain_y[0], hi[1] = c->domain_y[1];
+        lo[2] = c->domain[2 * DIM_UP], hi[2] = c->domain[2 * DIM_UP + 1];
+        break;
+    }
+    lo[2] = fmax(lo[2], bd->z_min);
+    hi[2] = fmin(hi[2], bd->z_max);
+    if (isnan(volume)) volume = fmax(0.0, hi[0] - lo[0]) * fmax(0.0, hi[1] - lo[1]) * fmax(0.0, hi[2] - lo[2]);
+    return volume;
 }
 
 /* Wall particles of wall k: a strip of wall_layers rows behind its length. */
@@ -71,11 +117,22 @@ void budget_estimate(const struct case_def *c, struct budget *b)
 {
     memset(b, 0, sizeof *b);
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
-    for (size_t k = 0; k < c->n_bodies; k++) {
-        b->particles += body_particles(c, k);
-        geom_grow_box(&c->bodies[k].polygon, &x0, &x1, &z0, &z1);
+    if (c->dimensions == 3) {
+        /* a 3D body: its volume over dx^3; the fill scans each body's box (placement.h) */
+        for (size_t k = 0; k < c->n_bodies; k++) {
+            double lo[3], hi[3];
+            b->particles += body_box3(c, k, lo, hi) / (c->dx * c->dx * c->dx);
+            double sites = 1.0;
+            for (int d = 0; d < 3; d++) sites *= fmax(0.0, floor((hi[d] - lo[d]) / c->dx)) + 3.0;
+            b->lattice_sites += sites;
+        }
+    } else {
+        for (size_t k = 0; k < c->n_bodies; k++) {
+            b->particles += body_particles(c, k);
+            geom_grow_box(&c->bodies[k].polygon, &x0, &x1, &z0, &z1);
+        }
+        if (c->n_bodies > 0) b->lattice_sites = box_sites(x0, x1, z0, z1, c->dx);
     }
-    if (c->n_bodies > 0) b->lattice_sites = box_sites(x0, x1, z0, z1, c->dx);
     for (size_t k = 0; k < c->n_walls; k++) {
         b->wall_particles += wall_particles(c, k);
         b->lattice_sites += wall_sites(c, k);
@@ -84,7 +141,7 @@ void budget_estimate(const struct case_def *c, struct budget *b)
     b->monitor_rows = floor(c->t_end / c->monitor_interval) + 1.0;
     if (c->snapshot_interval > 0.0)
         b->snapshot_bytes = (floor(c->t_end / c->snapshot_interval) + 1.0) * (b->particles + b->wall_particles) *
-                            BUDGET_SNAPSHOT_BYTES_PER_PARTICLE;
+                            (BUDGET_SNAPSHOT_BYTES_PER_PARTICLE + (c->dimensions - 2) * BUDGET_SNAPSHOT_BYTES_3D);
 }
 
 /* "over the limit of 1e7 (numerics.max_particles)" */

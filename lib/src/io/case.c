@@ -14,6 +14,7 @@
 #include "case_schema.h"
 #include "law_registry.h"
 #include "status.h"
+#include "viscous.h"
 
 #define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
 
@@ -229,6 +230,13 @@ static mixsph_status read_numerics(const struct case_reader *r, const cJSON *roo
     if (c->wall_layers < (int)ceil(2.0 * c->h_over_dx))
         return FAIL(r, "%s: numerics.wall_layers: %d layers do not cover the kernel support 2h = %.2f dx (expected >= %d)",
                     r->origin, c->wall_layers, 2.0 * c->h_over_dx, (int)ceil(2.0 * c->h_over_dx));
+    /* the coarse level of two_level is written for the groups of a 2D cell grid (viscous_coarse.h) */
+    if (c->dimensions == 3 && c->viscous_preconditioner == VISCOUS_TWO_LEVEL) {
+        if (item(item(root, "numerics"), "viscous_preconditioner"))
+            return FAIL(r, "%s: numerics.viscous_preconditioner: \"two_level\" is 2D only (its coarse level groups the "
+                           "cell rows of a 2D grid); a 3D case takes \"jacobi\", its default there", r->origin);
+        c->viscous_preconditioner = VISCOUS_JACOBI;
+    }
     if (c->viscosity_arithmetic && !c->viscosity_implicit)
         return FAIL(r, "%s: numerics.viscosity_mean: \"arithmetic\" needs numerics.viscosity \"implicit\" (the "
                        "explicit time step (4) is sized for the harmonic mean: a mobile grain beside a fixed one "
@@ -333,6 +341,77 @@ static mixsph_status read_media(const struct case_reader *r, const cJSON *root, 
     return MIXSPH_OK;
 }
 
+/* A 3D body's corner key box_min or box_max: exactly three numbers [x, y, z]. */
+static mixsph_status read_corner(const struct case_reader *r, const cJSON *it, const char *path, const char *key,
+                                 double corner[3])
+{
+    double *v = NULL;
+    size_t n = 0;
+    TRY(case_schema_numbers(r, it, path, key, 3, &v, &n));
+    for (size_t d = 0; d < 3 && n == 3; d++) corner[d] = v[d];
+    free(v);
+    if (n != 3) return FAIL(r, "%s: %s.%s: expected 3 numbers [x, y, z], got %zu", r->origin, path, key, n);
+    return MIXSPH_OK;
+}
+
+/* The shape of a body (enum body_shape): a 2D case's is its polygon; a 3D case's body takes one
+ * of polygon (with y_min and y_max), box_min with box_max, or stl, and with none of them is the
+ * domain below its z_max. An STL path is resolved against the case file's folder. */
+static mixsph_status read_body_shape(const struct case_reader *r, const cJSON *it, const char *path,
+                                     const struct case_def *c, struct body *bd)
+{
+    const int polygon = item(it, "polygon") != NULL, box = item(it, "box_min") || item(it, "box_max"),
+              stl = item(it, "stl") != NULL, across = item(it, "y_min") || item(it, "y_max");
+    bd->shape = BODY_POLYGON;
+    if (c->dimensions == 2) {
+        if (box || stl || across)
+            return FAIL(r, "%s: %s: box_min, box_max, stl, y_min and y_max are keys of a 3D case (this case has "
+                           "dimensions 2)", r->origin, path);
+        if (!polygon) return FAIL(r, "%s: %s.polygon: missing (expected an array of [x, z] points)", r->origin, path);
+        return MIXSPH_OK;
+    }
+    if (polygon + box + stl > 1)
+        return FAIL(r, "%s: %s: expected one shape: polygon (with y_min, y_max), box_min with box_max, or stl",
+                    r->origin, path);
+    if (across && !polygon)
+        return FAIL(r, "%s: %s: y_min and y_max extrude a polygon (this body has none)", r->origin, path);
+    if (polygon) {
+        if (!item(it, "y_min") || !item(it, "y_max") || !(bd->y_max > bd->y_min))
+            return FAIL(r, "%s: %s: a 3D polygon body needs y_min < y_max (its extrusion across y)", r->origin, path);
+        return MIXSPH_OK;
+    }
+    if (box) {
+        if (!item(it, "box_min") || !item(it, "box_max"))
+            return FAIL(r, "%s: %s: a box needs both box_min and box_max", r->origin, path);
+        TRY(read_corner(r, it, path, "box_min", bd->box_min));
+        TRY(read_corner(r, it, path, "box_max", bd->box_max));
+        for (int d = 0; d < 3; d++)
+            if (!(bd->box_max[d] > bd->box_min[d]))
+                return FAIL(r, "%s: %s: expected box_min < box_max on every axis (axis %c: %g, %g)", r->origin, path,
+                            "xyz"[d], bd->box_min[d], bd->box_max[d]);
+        bd->shape = BODY_BOX;
+        return MIXSPH_OK;
+    }
+    if (stl) {
+        char given[CASE_PATH_LEN];
+        snprintf(given, sizeof given, "%s", bd->stl);
+        const char *slash = strrchr(r->origin, '/');
+        if (given[0] != '/' && slash) {
+            const int dir_len = (int)(slash - r->origin);
+            if (snprintf(bd->stl, sizeof bd->stl, "%.*s/%s", dir_len, r->origin, given) >= (int)sizeof bd->stl)
+                return FAIL(r, "%s: %s.stl: the path with the case's folder is over %d characters", r->origin, path,
+                            CASE_PATH_LEN - 1);
+        }
+        bd->shape = BODY_STL;
+        return MIXSPH_OK;
+    }
+    if (!isfinite(bd->z_max) || !c->has_domain)
+        return FAIL(r, "%s: %s: a 3D body without a shape (polygon, box_min/box_max or stl) fills the domain below "
+                       "its z_max: it needs z_max and the case's domain", r->origin, path);
+    bd->shape = BODY_BELOW_LEVEL;
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_bodies(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     for (const cJSON *it = item(root, "bodies")->child; it; it = it->next) {
@@ -344,6 +423,7 @@ static mixsph_status read_bodies(const struct case_reader *r, const cJSON *root,
         const char *medium = item(it, "medium")->valuestring;
         bd->medium = find_medium(c, medium);
         if (bd->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
+        TRY(read_body_shape(r, it, path, c, bd));
     }
     if (c->n_bodies == 0) return FAIL(r, "%s: bodies: expected at least one body", r->origin);
     return MIXSPH_OK;
@@ -395,7 +475,8 @@ static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, 
                 return FAIL(r, "%s: %s.motion: '%s' is not one of the motions", r->origin, path, motion->valuestring);
         }
     }
-    if (c->n_walls == 0) return FAIL(r, "%s: walls: expected at least one wall", r->origin);
+    /* a 3D case may have none (particles in the domain alone; 3D walls come with their own keys) */
+    if (c->n_walls == 0 && c->dimensions == 2) return FAIL(r, "%s: walls: expected at least one wall", r->origin);
     return MIXSPH_OK;
 }
 
@@ -419,6 +500,32 @@ static mixsph_status read_profile_times(const struct case_reader *r, const cJSON
     return MIXSPH_OK;
 }
 
+/* What a monitor takes in the case's dimension: the y keys in 3D only; in 3D, a pressure probe at a
+ * point (x, y, z) in the flow, and no profile or wall_pressure (2D measures: x bins of a section,
+ * the pressure along a wall's polyline). */
+static mixsph_status read_monitor_dimension(const struct case_reader *r, const cJSON *it, const char *path,
+                                            const struct case_def *c, const struct monitor_def *md)
+{
+    const int across = item(it, "y") || item(it, "y_min") || item(it, "y_max");
+    if (c->dimensions == 2) {
+        if (across) return FAIL(r, "%s: %s: y, y_min and y_max are keys of a 3D case (this case has dimensions 2)",
+                                r->origin, path);
+        return MIXSPH_OK;
+    }
+    if (md->kind == MONITOR_PROFILE || md->kind == MONITOR_WALL_PRESSURE)
+        return FAIL(r, "%s: %s: a %s monitor is 2D only (in 3D: max_elevation over a region with x and y ranges, "
+                       "pressure_probe at a point, kinetic_energy, front, wall_work)", r->origin, path,
+                    md->kind == MONITOR_PROFILE ? "profile" : "wall_pressure");
+    if (md->kind == MONITOR_PRESSURE_PROBE) {
+        if (item(it, "wall"))
+            return FAIL(r, "%s: %s.wall: a probe on a wall's sensor is 2D only; in 3D give a point in the flow "
+                           "(x, y, z)", r->origin, path);
+        if (!item(it, "y")) return FAIL(r, "%s: %s.y: missing (a 3D probe's point is x, y, z)", r->origin, path);
+    }
+    if (!(md->y_max > md->y_min)) return FAIL(r, "%s: %s: expected y_min < y_max", r->origin, path);
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_monitors(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     const struct case_section *sec = section("monitors");
@@ -431,14 +538,16 @@ static mixsph_status read_monitors(const struct case_reader *r, const cJSON *roo
         c->n_monitors++;
         md->medium = md->wall = -1;
         md->at_max_of = -1;
-        md->x_min = md->z_min = -INFINITY; /* everywhere: the region of a monitor that takes none (wall_work) */
-        md->x_max = md->z_max = INFINITY;
+        md->x_min = md->y_min = md->z_min = -INFINITY; /* everywhere: the region of a monitor that takes none */
+        md->x_max = md->y_max = md->z_max = INFINITY;
+        md->point_y = 0.0;
         /* the type first: it says which keys the monitor takes */
         TRY(case_schema_read_key(r, it, path, case_schema_key(sec, "type"), md));
         if (md->kind == MONITOR_PROFILE) md->bin = c->dx;
         TRY(case_schema_read(r, it, path, sec, 1u << md->kind, md));
         if (!(md->x_max > md->x_min) || !(md->z_max > md->z_min))
             return FAIL(r, "%s: %s: expected x_min < x_max and z_min < z_max", r->origin, path);
+        TRY(read_monitor_dimension(r, it, path, c, md));
         if (md->kind == MONITOR_WALL_PRESSURE || md->kind == MONITOR_WALL_WORK || md->kind == MONITOR_PRESSURE_PROBE) {
             const cJSON *w = item(it, "wall");
             if (!w && md->kind == MONITOR_PRESSURE_PROBE) continue; /* a point in the flow */
@@ -600,6 +709,7 @@ static mixsph_status read_domain_rules(const struct case_reader *r, const struct
 {
     for (size_t k = 0; k < c->n_bodies && c->has_domain; k++) {
         const struct body *bd = &c->bodies[k];
+        if (bd->shape != BODY_POLYGON) continue; /* a 3D box, STL or level: the fill says when none of it fits */
         double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
         geom_grow_box(&bd->polygon, &x0, &x1, &z0, &z1);
         z0 = fmax(z0, bd->z_min);
@@ -659,12 +769,24 @@ static mixsph_status read_root(const struct case_reader *r, const cJSON *root, s
         return FAIL(r, "%s: name: %s is not a plain identifier (expected " NAME_RULE "; it names the output folder)",
                     r->origin, q);
     }
+    if (c->dimensions != DIM)
+        return FAIL(r, "%s: dimensions: the case is %dD, this build of the library is %dD (the mixsph executable and "
+                       "the FMU hold both builds)", r->origin, c->dimensions, DIM);
     TRY(read_numerics(r, root, c));
     const cJSON *d = item(root, "domain");
     if (d) {
         TRY(case_schema_read(r, d, "domain", section("domain"), 0, c));
         if (!(c->domain[1] > c->domain[0]) || !(c->domain[2 * DIM_UP + 1] > c->domain[2 * DIM_UP]))
             return FAIL(r, "%s: domain: expected x_min < x_max and z_min < z_max", r->origin);
+        const int across = item(d, "y_min") || item(d, "y_max");
+        if (c->dimensions == 2 && across)
+            return FAIL(r, "%s: domain: y_min and y_max are keys of a 3D case (this case has dimensions 2)", r->origin);
+        if (c->dimensions == 3 && (!item(d, "y_min") || !item(d, "y_max") || !(c->domain_y[1] > c->domain_y[0])))
+            return FAIL(r, "%s: domain: a 3D case's domain needs y_min < y_max", r->origin);
+#if DIM == 3
+        c->domain[2] = c->domain_y[0];
+        c->domain[3] = c->domain_y[1];
+#endif
         c->has_domain = 1;
     }
     TRY(read_media(r, root, c));

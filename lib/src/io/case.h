@@ -17,11 +17,23 @@
 #define CASE_MAX_MOTIONS 8
 #define CASE_MAX_MONITORS 16
 
+#define CASE_PATH_LEN 512
+/* The shape of a body: a 2D case's bodies are polygons; a 3D case's one of these. */
+enum body_shape {
+    BODY_POLYGON = 0,     /* 2D: the polygon; 3D: the polygon extruded across y_min <= y <= y_max */
+    BODY_BOX = 1,         /* 3D: the box box_min <= p <= box_max */
+    BODY_STL = 2,         /* 3D: the inside of a closed STL surface */
+    BODY_BELOW_LEVEL = 3  /* 3D: the domain between z_min and z_max, minus what the walls block */
+};
 struct body {
     char name[CASE_NAME_LEN];
     int medium;               /* index into media */
+    int shape;                /* enum body_shape */
     struct polyline polygon;  /* closed implicitly [m] */
     double z_min, z_max;      /* the body is clipped to z_min <= z <= z_max [m] */
+    double y_min, y_max;      /* 3D polygon: its extrusion across y [m] */
+    double box_min[3], box_max[3]; /* 3D box: opposite corners (x, y, z) [m] */
+    char stl[CASE_PATH_LEN];  /* 3D STL: the file as the case gives it, then resolved against the case's folder */
 };
 
 #define CASE_MAX_PROFILE_TIMES 16
@@ -43,9 +55,11 @@ struct monitor_def {
     int wall;                 /* wall_pressure, wall_work: index into walls; pressure_probe: the wall the
                                  sensor (point_x, point_z) sits on, -1 for a point in the flow */
     double point_x, point_z;  /* pressure_probe: the point [m] (on a wall: the sensor, at t = 0) */
+    double point_y;           /* pressure_probe in 3D: the point's y [m] */
     int direction;            /* front: +1 largest x, -1 smallest x */
     double x_min, x_max;      /* region [m] (infinite when not given) */
     double z_min, z_max;
+    double y_min, y_max;      /* 3D: the region across y [m] (infinite when not given) */
     int min_neighbours;       /* particles with fewer same-medium neighbours are spray, ignored */
     double bin;               /* profile: bin width [m] */
     size_t n_times;           /* profile: times at which it is written [s] */
@@ -78,6 +92,7 @@ struct full_scale {
 struct case_def {
     char origin[256];         /* file name, for messages */
     char name[CASE_NAME_LEN];
+    int dimensions;           /* 2 or 3: the case's space (the build's DIM must equal it) */
     double g;                 /* gravity magnitude [m/s2], acting along -z */
     /* every key of `numerics`, as the member its row names (core/numerics_keys.def: what each
      * holds, its unit and who reads it) */
@@ -87,6 +102,7 @@ struct case_def {
     int has_domain;
     double domain[2 * DIM];   /* bounds along axis d: domain[2 d] .. domain[2 d + 1] [m] (the case gives x and
                                  z: x_min, x_max, z_min, z_max in 2D); particles leaving it are lost */
+    double domain_y[2];       /* the domain's y_min, y_max as read (3D; copied into domain) [m] */
     double monitor_interval;  /* [s] */
     double snapshot_interval; /* [s], 0 = none */
     /* the resource budget (budget.h) beyond numerics.max_*: limits on what the case asks for,

@@ -59,6 +59,9 @@ static const struct case_key top_keys[] = {
     {.key = "description", .type = CASE_STRING, .meaning = "free text (not read by the model)"},
     {.key = "parameters", .type = CASE_OBJECT,
      .meaning = "named numbers that values elsewhere in the case use as `\"$name\"` (see Parameters)"},
+    {.key = "dimensions", .type = CASE_INTEGER, RANGE(2, 0, 3, 0), DEF(2), .unit = "-",
+     .field = CASE_FIELD(case_def, dimensions),
+     .meaning = "2: a vertical section in x and z; 3: x, y and z, z up (bodies, domain and monitors then take y)"},
     {.key = "gravity", .type = CASE_NUMBER, RANGE(0, 0, 100, 0), DEF(9.81), .unit = "m/s²",
      .field = CASE_FIELD(case_def, g), .meaning = "gravity magnitude, acting along −z"},
     {.key = "numerics", .type = CASE_OBJECT, .need = CASE_REQUIRED, .meaning = "resolution, time step, end time"},
@@ -85,11 +88,17 @@ static const struct case_key numerics_keys[] = {
 
 /* bound k (0: min, 1: max) along axis d of case_def.domain */
 #define DOMAIN_FIELD(d, k) (offsetof(struct case_def, domain) + (2 * (d) + (k)) * sizeof(double) + 1)
+/* y_min (k = 0), y_max (1) of a 3D case's domain, read apart (case.c copies them into domain) */
+#define DOMAIN_Y_FIELD(k) (offsetof(struct case_def, domain_y) + (k) * sizeof(double) + 1)
 static const struct case_key domain_keys[] = {
     {.key = "x_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0, 0),
      .meaning = "left end"},
     {.key = "x_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(0, 1),
      .meaning = "right end, > x_min"},
+    {.key = "y_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D", ANYWHERE, .unit = "m",
+     .field = DOMAIN_Y_FIELD(0), .meaning = "3D: the side at the smallest y"},
+    {.key = "y_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D", ANYWHERE, .unit = "m",
+     .field = DOMAIN_Y_FIELD(1), .meaning = "3D: the side at the largest y, > y_min"},
     {.key = "z_min", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(DIM_UP, 0),
      .meaning = "bottom"},
     {.key = "z_max", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m", .field = DOMAIN_FIELD(DIM_UP, 1),
@@ -98,8 +107,21 @@ static const struct case_key domain_keys[] = {
 
 static const struct case_key body_keys[] = {
     {.key = "medium", .type = CASE_NAME, .need = CASE_REQUIRED, .meaning = "name of one of the media"},
-    {.key = "polygon", .type = CASE_POINTS, .need = CASE_REQUIRED, .lo = 3, .unit = "m",
-     .field = CASE_FIELD(body, polygon), .meaning = "the outline, closed implicitly"},
+    {.key = "polygon", .type = CASE_POINTS, .need = CASE_SOMETIMES, .need_text = "2D", .lo = 3, .unit = "m",
+     .field = CASE_FIELD(body, polygon),
+     .meaning = "the outline in x and z, closed implicitly; in 3D extruded across y_min ≤ y ≤ y_max. A 3D body "
+                "takes one of polygon, box_min with box_max, or stl; with none of them it is the domain below z_max "
+                "(inside the walls)"},
+    {.key = "y_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D polygon", ANYWHERE, .unit = "m",
+     .field = CASE_FIELD(body, y_min), .meaning = "3D: the polygon's extrusion starts at this y"},
+    {.key = "y_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D polygon", ANYWHERE, .unit = "m",
+     .field = CASE_FIELD(body, y_max), .meaning = "3D: ... and ends at this y, > y_min"},
+    {.key = "box_min", .type = CASE_NUMBERS, .lo = 3, .unit = "m",
+     .meaning = "3D: a box, its corner [x, y, z] of smallest coordinates (with box_max)"},
+    {.key = "box_max", .type = CASE_NUMBERS, .lo = 3, .unit = "m", .meaning = "3D: the box's opposite corner [x, y, z]"},
+    {.key = "stl", .type = CASE_STRING, .lo = 1, .hi = CASE_PATH_LEN - 1, .field = CASE_FIELD(body, stl),
+     .meaning = "3D: a closed triangulated surface (STL, ASCII or binary), the body its inside; a path relative to "
+                "the case file's folder"},
     {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(body, z_min),
      .meaning = "the body is clipped to z ≥ z_min"},
     {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(body, z_max),
@@ -152,6 +174,9 @@ static const struct case_key monitor_keys[] = {
     {.key = "x", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
      .field = CASE_FIELD(monitor_def, point_x),
      .meaning = "the probe's point: with `wall`, the sensor's place on that wall (at t = 0), within dx/2 of it"},
+    {.key = "y", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D", ANYWHERE,
+     .only = V(MONITOR_PRESSURE_PROBE), .unit = "m", .field = CASE_FIELD(monitor_def, point_y),
+     .meaning = "3D: the probe's point across"},
     {.key = "z", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
      .field = CASE_FIELD(monitor_def, point_z), .meaning = "height of the probe's point"},
     {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions, .only = V(MONITOR_FRONT),
@@ -163,6 +188,10 @@ static const struct case_key monitor_keys[] = {
      .unit = "m", .field = CASE_FIELD(monitor_def, x_min), .meaning = "region the monitor looks at: left end"},
     {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY),
      .unit = "m", .field = CASE_FIELD(monitor_def, x_max), .meaning = "right end, > x_min"},
+    {.key = "y_min", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY), .unit = "m",
+     .field = CASE_FIELD(monitor_def, y_min), .meaning = "3D: the region's side at the smallest y"},
+    {.key = "y_max", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY), .unit = "m",
+     .field = CASE_FIELD(monitor_def, y_max), .meaning = "3D: its side at the largest y, > y_min"},
     {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_min),
      .meaning = "bottom"},
     {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_max),

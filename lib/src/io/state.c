@@ -123,6 +123,14 @@ static const char *get_str(struct reader *r, size_t *n)
     return t;
 }
 
+int state_dimension(const void *buf, size_t len)
+{
+    uint32_t head[3];
+    if (!buf || len < 8 + sizeof head || memcmp(buf, STATE_MAGIC, 8) != 0) return 0;
+    memcpy(head, (const unsigned char *)buf + 8, sizeof head);
+    return head[1] == STATE_ORDER && (head[2] == 2 || head[2] == 3) ? (int)head[2] : 0;
+}
+
 /* ---- what is saved ------------------------------------------------------------------------ */
 
 static void put_source(struct writer *w, const mixsph_sim *s)

@@ -20,4 +20,9 @@ struct state_source {
 mixsph_status state_read_source(const void *buf, size_t len, struct state_source *src, char *err, size_t err_len);
 void state_source_free(struct state_source *src);
 
+/** The dimension (2 or 3) of the build that saved a state, read from its header; 0 for a buffer
+ *  that is no state of this machine's byte order. Any build reads it (the dispatcher of the
+ *  library for both dimensions, sim_dimension.c, picks the build that loads the state). */
+int state_dimension(const void *buf, size_t len);
+
 #endif

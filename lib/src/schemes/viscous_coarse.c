@@ -50,6 +50,8 @@ void viscous_coarse_free(struct viscous_coarse *K)
     free(K);
 }
 
+#if DIM == 2 /* the coarse level is written for a 2D grid (viscous_coarse_build) */
+
 /* Resize *p to n elements of `size` bytes. */
 static int grow(void **p, size_t n, size_t size)
 {
@@ -89,6 +91,8 @@ static int reserve(struct viscous_coarse *K, size_t n, size_t size)
     }
     return 0;
 }
+
+#endif
 
 int viscous_coarse_build(struct viscous_coarse *K, const struct forces *F, const struct pair_system *S,
                          const unsigned char *unknown, size_t n)
