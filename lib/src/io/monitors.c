@@ -29,9 +29,11 @@
  * Samples are taken every output.monitor_interval of simulated time; the extremes over the
  * samples and their times are kept, and each sample is a row of monitors.csv when an output
  * folder is set.
- * A monitor's region, point and bins are case input in the vertical x-z plane (2D): they are
- * compared with components 0 (x) and DIM_UP (z) of the particles' positions; in 3D a region
- * spans every y and a point lies at y = 0. */
+ * A monitor's region, point and bins are case input in x and z (and y in 3D): compared with
+ * components 0 (x), DIM_UP (z) and, in 3D, 1 (y) of the particles' positions. In 3D a region is a
+ * box (y_min..y_max, every y by default) and a probe's point is (x, y, z) in the flow; profile and
+ * wall_pressure (x bins of a section, the pressure along a wall's polyline) are 2D only, which the
+ * case reader says (io/case.c). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -81,12 +83,15 @@ static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffi
     memcpy(s->out.name[s->out.n++], name, CASE_NAME_LEN);
 }
 
-/* A point of the x-z plane (case input) as a position. */
-static void plane_point(double x, double z, double pos[DIM])
+/* A probe's point (case input: x, z, and y in 3D) as a position. */
+static void case_point(const struct monitor_def *md, double pos[DIM])
 {
     for (int d = 0; d < DIM; d++) pos[d] = 0.0;
-    pos[0] = x;
-    pos[DIM_UP] = z;
+    pos[0] = md->point_x;
+#if DIM == 3
+    pos[1] = md->point_y;
+#endif
+    pos[DIM_UP] = md->point_z;
 }
 
 /* The position pos of particle i. */
@@ -100,7 +105,7 @@ static void position_of(const struct particles *P, size_t i, double pos[DIM])
  * normal by the standoff. */
 static void probe_point(const mixsph_sim *s, const struct monitor_def *md, double pos[DIM])
 {
-    plane_point(md->point_x, md->point_z, pos);
+    case_point(md, pos);
     if (md->wall < 0) return;
     const struct walls *W = &s->phys.walls;
     for (int d = 0; d < DIM; d++) pos[d] += W->state[md->wall].o[d];
@@ -152,7 +157,7 @@ static mixsph_status probe_check(mixsph_sim *s, const struct monitor_def *md)
         int at_end;
         const struct wall_state *ws = &s->phys.walls.state[md->wall]; /* the point is given at t = 0 */
         double sensor[DIM];
-        plane_point(md->point_x, md->point_z, sensor);
+        case_point(md, sensor);
         for (int k = 0; k < DIM; k++) sensor[k] += ws->o[k];
         const double d = walls_distance(&s->phys.walls, (size_t)md->wall, sensor, &at_end);
         if (at_end || !(fabs(d) <= 0.5 * s->phys.dx))
@@ -207,10 +212,13 @@ mixsph_status monitors_init(mixsph_sim *s)
     return MIXSPH_OK;
 }
 
-/* Whether particle i lies in the region of a monitor (bounds of x and z). */
+/* Whether particle i lies in the region of a monitor (bounds of x and z; and y in 3D). */
 static int in_region(const struct monitor_def *md, const struct particles *P, size_t i)
 {
     const double x = P->pos[0][i], z = P->pos[DIM_UP][i];
+#if DIM == 3
+    if (!(P->pos[1][i] >= md->y_min && P->pos[1][i] <= md->y_max)) return 0;
+#endif
     return x >= md->x_min && x <= md->x_max && z >= md->z_min && z <= md->z_max;
 }
 
