@@ -6,6 +6,12 @@ the walls in grey; or an animation of all snapshots.
 
     .venv/bin/python tools/plot_snapshot.py RUN [--time T | --index K] [--color medium|speed]
         [--animate] [--fps F] [--vmax V] [--xlim X0 X1] [--zlim Z0 Z1] [--no-walls] [-o FILE]
+        [--view side|plan] [--y-band Y0 Y1]
+
+A 3D run ("dimensions": 3) is drawn as a vertical slice, the side view x-z of the particles whose
+y lies in a band (--y-band; by default 2 dx wide about the middle of the particles' y range at
+t = 0), or with --view plan as a plan view x-y from above (every particle, the highest drawn
+last, so the colours are those of the top; --zlim then bounds y).
 
 RUN is an output folder (holding run.h5) or the run.h5 file itself. Without --time/--index the
 last snapshot is drawn. -o defaults to RUN/snapshot_<index>_<color>.png, or for --animate to
@@ -68,14 +74,40 @@ class Run:
         kinds = {name: m.get("type", "fluid") for name, m in case.get("media", {}).items()}
         self.granular = [kinds.get(m, "fluid") == "granular" for m in self.media]
 
+        self.dim = self.groups[0]["position"].shape[1]
+        self.view, self.y_band = "side", None
+
+    def set_view(self, view, y_band):
+        """What snapshot() returns of a 3D run: the side view of the particles in the y band (the
+        default band: 2 dx about the middle of the y range at t = 0), or the plan view."""
+        if self.dim == 2 and (view != "side" or y_band):
+            raise SystemExit("plot_snapshot: --view plan and --y-band are for a 3D run; this run is 2D")
+        self.view = view
+        if self.dim == 3 and view == "side":
+            y = self.groups[0]["position"][()][:, 1]
+            mid = 0.5 * (y.min() + y.max())
+            self.y_band = tuple(y_band) if y_band else (mid - self.dx, mid + self.dx)
+
     def snapshot(self, k):
-        """Snapshot k: positions in the plotted x-z plane (the first and the vertical, last,
-        component: a 3D run is seen from the side), speeds |u|, media, states, time."""
+        """Snapshot k: positions in the plotted plane (x and the vertical, last, component; of a
+        3D run the particles in the y band, or x and y in the plan view, the highest last),
+        speeds |u|, media, states, time."""
         g = self.groups[k]
         pos = g["position"][()]
-        return {name: g[name][()] for name in ("medium", "state")} | {
-            "position": pos[:, [0, pos.shape[1] - 1]], "speed": np.linalg.norm(g["velocity"][()], axis=1),
-            "time": float(g.attrs["time"]), "index": k}
+        out = {name: g[name][()] for name in ("medium", "state")} | {
+            "speed": np.linalg.norm(g["velocity"][()], axis=1), "time": float(g.attrs["time"]), "index": k}
+        if self.dim == 3 and self.view == "plan":
+            keep = np.argsort(pos[:, 2], kind="stable")
+            axes = [0, 1]
+        elif self.dim == 3:
+            keep = np.nonzero((pos[:, 1] >= self.y_band[0]) & (pos[:, 1] < self.y_band[1]))[0]
+            axes = [0, 2]
+        else:
+            keep = slice(None)
+            axes = [0, pos.shape[1] - 1]
+        out = {name: v[keep] if isinstance(v, np.ndarray) else v for name, v in out.items()}
+        out["position"] = pos[keep][:, axes]
+        return out
 
     def max_speed(self):
         v = 0.0
@@ -119,7 +151,7 @@ class Drawer:
         self.ax.set_ylim(z0, z1)
         self.ax.set_aspect("equal")
         self.ax.set_xlabel("x [m]")
-        self.ax.set_ylabel("z [m]")
+        self.ax.set_ylabel("y [m]" if run.view == "plan" else "z [m]")
         self.cols, self.fixed_cols = medium_colours(run)
         self.walls = self.ax.scatter([], [], c=WALL_COLOUR, marker="s", linewidths=0)
         if args.color == "speed":
@@ -160,7 +192,11 @@ class Drawer:
             colours = np.where((st[part] == FIXED)[:, None], self.fixed_cols[med], self.cols[med])
             self.pts.set_facecolors(colours)
         what = "|u|" if self.args.color == "speed" else "medium"
-        self.title.set_text(f"{self.run.case}: t = {s['time']:.3f} s ({what}, snapshot {k})")
+        where = ""
+        if self.run.dim == 3:
+            where = ", plan view" if self.run.view == "plan" else \
+                f", {self.run.y_band[0]:.3g} <= y < {self.run.y_band[1]:.3g} m"
+        self.title.set_text(f"{self.run.case}: t = {s['time']:.3f} s ({what}, snapshot {k}{where})")
         return self.walls, self.pts, self.title
 
 
@@ -189,6 +225,10 @@ def main(argv=None):
     ap.add_argument("--xlim", type=float, nargs=2, metavar=("X0", "X1"))
     ap.add_argument("--zlim", type=float, nargs=2, metavar=("Z0", "Z1"))
     ap.add_argument("--no-walls", action="store_true", help="do not draw the wall particles")
+    ap.add_argument("--view", choices=["side", "plan"], default="side",
+                    help="3D run: a vertical slice x-z (side, default) or the plan view x-y")
+    ap.add_argument("--y-band", type=float, nargs=2, metavar=("Y0", "Y1"),
+                    help="3D run, side view: the slice Y0 <= y < Y1 [m] (default: 2 dx about the middle)")
     ap.add_argument("--width", type=float, default=9.0, help="figure width [in] (9)")
     ap.add_argument("--dpi", type=float, default=110.0)
     ap.add_argument("-o", "--output", help="output file (.png, .pdf, .svg; .gif or .mp4 with --animate)")
@@ -196,10 +236,12 @@ def main(argv=None):
     if args.animate and (args.time is not None or args.index is not None):
         ap.error("--animate draws every snapshot: no --time or --index")
     run = Run(args.run)
+    run.set_view(args.view, args.y_band)
     drawer = Drawer(run, args)
     if not args.animate:
         k = pick(run, args)
-        out = args.output or os.path.join(run.folder, f"snapshot_{k:04d}_{args.color}.png")
+        view = f"_{args.view}" if run.dim == 3 else ""
+        out = args.output or os.path.join(run.folder, f"snapshot_{k:04d}_{args.color}{view}.png")
         drawer.draw(k)
         drawer.fig.savefig(out)
         print(f"plot_snapshot: {out} (snapshot {k}, t = {run.times[k]:.4f} s)")
