@@ -393,8 +393,8 @@ static mixsph_status read_body_shape(const struct case_reader *r, const cJSON *i
         return MIXSPH_OK;
     }
     if (stl) {
-        char given[CASE_PATH_LEN];
-        snprintf(given, sizeof given, "%s", bd->stl);
+        const char *given = item(it, "stl")->valuestring; /* its length checked by its row */
+        snprintf(bd->stl, sizeof bd->stl, "%s", given);
         const char *slash = strrchr(r->origin, '/');
         if (given[0] != '/' && slash) {
             const int dir_len = (int)(slash - r->origin);

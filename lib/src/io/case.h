@@ -33,7 +33,7 @@ struct body {
     double z_min, z_max;      /* the body is clipped to z_min <= z <= z_max [m] */
     double y_min, y_max;      /* 3D polygon: its extrusion across y [m] */
     double box_min[3], box_max[3]; /* 3D box: opposite corners (x, y, z) [m] */
-    char stl[CASE_PATH_LEN];  /* 3D STL: the file as the case gives it, then resolved against the case's folder */
+    char stl[CASE_PATH_LEN];  /* 3D STL: the file, a relative path resolved against the case file's folder */
 };
 
 #define CASE_MAX_PROFILE_TIMES 16

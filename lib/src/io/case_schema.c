@@ -119,7 +119,7 @@ static const struct case_key body_keys[] = {
     {.key = "box_min", .type = CASE_NUMBERS, .lo = 3, .unit = "m",
      .meaning = "3D: a box, its corner [x, y, z] of smallest coordinates (with box_max)"},
     {.key = "box_max", .type = CASE_NUMBERS, .lo = 3, .unit = "m", .meaning = "3D: the box's opposite corner [x, y, z]"},
-    {.key = "stl", .type = CASE_STRING, .lo = 1, .hi = CASE_PATH_LEN - 1, .field = CASE_FIELD(body, stl),
+    {.key = "stl", .type = CASE_STRING, .lo = 1, .hi = CASE_PATH_LEN - 1,
      .meaning = "3D: a closed triangulated surface (STL, ASCII or binary), the body its inside; a path relative to "
                 "the case file's folder"},
     {.key = "z_min", .type = CASE_NUMBER, ANYWHERE, DEF(-INFINITY), .unit = "m", .field = CASE_FIELD(body, z_min),
