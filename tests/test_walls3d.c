@@ -17,9 +17,12 @@
 #include <cmocka.h>
 
 #include "dim.h"
+#include "cells.h"
 #include "geometry.h"
+#include "kernel.h"
 #include "mesh.h"
 #include "motion.h"
+#include "neighbours.h"
 #include "particles.h"
 #include "stl.h"
 #include "surface.h"
@@ -419,6 +422,70 @@ static void test_moving_box_wall(void **state)
     surface_free(&wl.surface);
 }
 
+/* The fluid's state extrapolated onto the wall particles of a tank (Adami et al. 2012, eq. 27):
+ * with the fluid at rest in the hydrostatic state p = rho g (H - z), the formula gives every wall
+ * particle with fluid around it rho g (H - z_w) exactly (the pressure is linear in z and the
+ * correction term carries its gradient), to round-off; a no-slip wall mirrors a uniform fluid
+ * velocity u to -u, a free-slip one keeps u. */
+static void test_extrapolation_in_a_tank(void **state)
+{
+    (void)state;
+    const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.4, 0.3, 0.3}, dx = 0.05, H = 0.25, rho = 1000.0, g = 9.81;
+    const double u[3] = {0.1, 0.2, -0.05};
+    for (int slip = WALL_NO_SLIP; slip <= WALL_FREE_SLIP; slip++) {
+        struct wall wl = box_wall(lo, hi, MESH_BOX_OPEN_TOP, 0);
+        wl.slip = slip;
+        assert_int_equal(wall_surface_build(&wl, NULL, err, sizeof err), MIXSPH_OK);
+        struct walls W;
+        walls_init(&W, &wl, 1, NULL, 3, WALL_PLACEMENT_LATTICE, 0.0, g, rho);
+        struct particles P = {0};
+        assert_int_equal(particles_alloc(&P, 1024), 0);
+        for (long k = 0; (k + 0.5) * dx < H; k++)
+            for (long j = 0; (j + 0.5) * dx < hi[1]; j++)
+                for (long i = 0; (i + 0.5) * dx < hi[0]; i++) {
+                    const double pos[3] = {(i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx};
+                    const size_t f = particles_push(&P, pos, rho, rho * dx * dx * dx, 0, MIXSPH_STATE_MOBILE);
+                    assert_true(f != (size_t)-1);
+                    P.p[f] = rho * g * (H - pos[2]);
+                    for (int d = 0; d < 3; d++) P.vel[d][f] = u[d];
+                }
+        assert_true(walls_generate(&W, dx, NULL, &P) > 0);
+        const struct kernel K = kernel_make_type(1.3 * dx, KERNEL_WENDLAND_C2);
+        const double rc = 2.0 * K.h, glo[3] = {-0.2, -0.2, -0.2}, ghi[3] = {0.6, 0.5, 0.6};
+        struct cells C;
+        struct neighbours NB = {0};
+        struct gather G = {0};
+        assert_int_equal(cells_init(&C, glo, ghi, rc), 0);
+        assert_true(cells_build(&C, &P) >= 0);
+        const size_t n = C.start[C.ncell];
+        assert_int_equal(n, P.n);
+        assert_int_equal(neighbours_build(&NB, &C, &P, n, rc, 1), 0);
+        assert_int_equal(neighbours_gather_reserve(&G, P.cap), 0);
+        for (size_t i = 0; i < n; i++)
+            G.mode[i] = P.state[i] == MIXSPH_STATE_WALL ? NEIGHBOURS_GATHER_ALL : NEIGHBOURS_GATHER_NONE;
+        assert_int_equal(neighbours_gather_build(&G, &NB, &C, P.state, n, rc, 1), 0);
+        walls_extrapolate_fluid(&W, &K, &G, dx, &P, n, 1);
+        size_t seen = 0;
+        double worst = 0.0;
+        for (size_t i = 0; i < n; i++) {
+            if (P.state[i] != MIXSPH_STATE_WALL || G.start[i + 1] == G.start[i]) continue;
+            seen++;
+            const double want = fmax(0.0, rho * g * (H - P.pos[2][i]));
+            worst = fmax(worst, fabs(P.p[i] - want));
+            for (int d = 0; d < 3; d++) assert_float_equal(P.uv[d][i], slip == WALL_NO_SLIP ? -u[d] : u[d], 1e-12);
+        }
+        print_message("%s tank: %zu wall particles by the fluid, largest |p_w - rho g (H - z)| = %.3g Pa\n",
+                      slip == WALL_NO_SLIP ? "no-slip" : "free-slip", seen, worst);
+        assert_true(seen > 500);
+        assert_true(worst < 1e-9 * rho * g * H);
+        neighbours_gather_free(&G);
+        neighbours_free(&NB);
+        cells_free(&C);
+        particles_free(&P);
+        surface_free(&wl.surface);
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -429,6 +496,7 @@ int main(void)
         cmocka_unit_test(test_sloping_wall_distance),
         cmocka_unit_test(test_crossing_guard_slope),
         cmocka_unit_test(test_moving_box_wall),
+        cmocka_unit_test(test_extrapolation_in_a_tank),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
