@@ -422,7 +422,7 @@ static mixsph_status read_wall_form(const struct case_reader *r, const cJSON *it
         if (key && wl->form != forms[k].form)
             return FAIL(r, "%s: %s: give one geometry (polyline, box_min and box_max, stl or terrain), not %s and %s",
                         r->origin, path, key, forms[k].key);
-        key = forms[k].key;
+        if (!key) key = forms[k].key; /* the first, named in messages */
         wl->form = forms[k].form;
     }
     if (!key) return FAIL(r, "%s: %s: missing its geometry (expected polyline, box_min and box_max, stl or terrain)",
