@@ -486,6 +486,50 @@ static void test_extrapolation_in_a_tank(void **state)
     }
 }
 
+/* The bucket index finds the nearest triangle: on a wavy terrain of 40 x 30 nodes the distance of
+ * points near it, far above and below it and outside its box equals the brute-force minimum over
+ * every triangle (mesh_distance), exactly (the same closest-point arithmetic); the bounded query
+ * agrees within its bound and reports nothing beyond it. */
+static void test_index_against_brute_force(void **state)
+{
+    (void)state;
+    const size_t nx = 40, ny = 30;
+    double z[40 * 30];
+    for (size_t j = 0; j < ny; j++)
+        for (size_t i = 0; i < nx; i++) z[j * nx + i] = 0.2 * sin(0.5 * (double)i) * cos(0.4 * (double)j) + 0.01 * (double)i;
+    struct terrain t = {0};
+    struct mesh m = {0}, copy = {0};
+    struct surface s;
+    assert_int_equal(terrain_from_heights(&t, nx, ny, 0.0, 0.0, 0.1, z, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(terrain_to_mesh(&t, &m, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(terrain_to_mesh(&t, &copy, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(surface_build(&s, &m, err, sizeof err), MIXSPH_OK);
+    unsigned seed = 99;
+    long within = 0;
+    for (int k = 0; k < 3000; k++) {
+        double p[3];
+        for (int d = 0; d < 3; d++) {
+            seed = seed * 1103515245u + 12345u;
+            const double u = (double)(seed >> 8) / (double)(1u << 24);
+            p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : -3.0 + 6.0 * u * u * u; /* many near z = 0 */
+        }
+        const double exact = mesh_distance(&copy, p, NULL, NULL), d = surface_signed_distance(&s, p, NULL);
+        assert_true(fabs(d) == exact);
+        const double bounded = surface_signed_distance_within(&s, p, 0.3, NULL);
+        if (exact <= 0.3) {
+            assert_true(bounded == d);
+            within++;
+        } else {
+            assert_true(bounded == INFINITY);
+        }
+    }
+    print_message("index against brute force: 3000 points, %ld within 0.3 m\n", within);
+    assert_true(within > 300);
+    surface_free(&s);
+    mesh_free(&copy);
+    terrain_free(&t);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -497,6 +541,7 @@ int main(void)
         cmocka_unit_test(test_crossing_guard_slope),
         cmocka_unit_test(test_moving_box_wall),
         cmocka_unit_test(test_extrapolation_in_a_tank),
+        cmocka_unit_test(test_index_against_brute_force),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,6 +1,7 @@
 /* surface.c - the pseudo-normals and the bucket index of an oriented surface, and its queries
  * (surface.h). */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -18,6 +19,7 @@ void surface_free(struct surface *s)
     free(s->vertex_boundary);
     free(s->cell_start);
     free(s->cell_triangle);
+    free(s->empty_rings);
     memset(s, 0, sizeof *s);
 }
 
@@ -179,6 +181,42 @@ static int build_index(struct surface *s)
     return 0;
 }
 
+/* For every bucket, the Chebyshev distance (in buckets) to the nearest one holding a triangle:
+ * a breadth-first search from all of those over the 26 neighbours, capped at 65535. */
+static int build_empty_rings(struct surface *s)
+{
+    const size_t ncell = s->n[0] * s->n[1] * s->n[2];
+    size_t *queue = malloc(ncell * sizeof *queue);
+    s->empty_rings = malloc(ncell * sizeof *s->empty_rings);
+    if (!queue || !s->empty_rings) {
+        free(queue);
+        return -1;
+    }
+    size_t head = 0, tail = 0;
+    for (size_t c = 0; c < ncell; c++) {
+        const int full = s->cell_start[c + 1] > s->cell_start[c];
+        s->empty_rings[c] = full ? 0 : UINT16_MAX;
+        if (full) queue[tail++] = c;
+    }
+    while (head < tail) {
+        const size_t c = queue[head++], i = c % s->n[0], j = c / s->n[0] % s->n[1], k = c / (s->n[0] * s->n[1]);
+        const uint16_t next = s->empty_rings[c] == UINT16_MAX - 1 ? s->empty_rings[c] : (uint16_t)(s->empty_rings[c] + 1);
+        for (int dk = -1; dk <= 1; dk++)
+            for (int dj = -1; dj <= 1; dj++)
+                for (int di = -1; di <= 1; di++) {
+                    if ((di < 0 && i == 0) || (dj < 0 && j == 0) || (dk < 0 && k == 0) || (di > 0 && i + 1 == s->n[0]) ||
+                        (dj > 0 && j + 1 == s->n[1]) || (dk > 0 && k + 1 == s->n[2]))
+                        continue;
+                    const size_t q = cell_index(s, (size_t)((long)i + di), (size_t)((long)j + dj), (size_t)((long)k + dk));
+                    if (s->empty_rings[q] != UINT16_MAX) continue;
+                    s->empty_rings[q] = next;
+                    queue[tail++] = q;
+                }
+    }
+    free(queue);
+    return 0;
+}
+
 mixsph_status surface_build(struct surface *s, struct mesh *m, char *err, size_t err_len)
 {
     memset(s, 0, sizeof *s);
@@ -191,7 +229,7 @@ mixsph_status surface_build(struct surface *s, struct mesh *m, char *err, size_t
     s->edge_boundary = calloc(3 * nt, 1);
     s->vertex_boundary = calloc(nv, 1);
     if (!s->vertex_normal || !s->edge_normal || !s->edge_boundary || !s->vertex_boundary || build_edges(s) != 0 ||
-        build_index(s) != 0) {
+        build_index(s) != 0 || build_empty_rings(s) != 0) {
         surface_free(s);
         return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory (a surface of %zu triangles)", nt);
     }
@@ -215,70 +253,108 @@ static const double *feature_normal(const struct surface *s, size_t t, int f, in
     }
 }
 
-/* The distance from p to the grid's box (0 inside) [m]. */
-static double distance_to_grid(const struct surface *s, const double p[3])
+/* How far p lies outside the grid along each axis (0 within its slab) [m]. */
+static void outside_grid(const struct surface *s, const double p[3], double out[3])
 {
-    double d2 = 0.0;
     for (int d = 0; d < 3; d++) {
         const double hi = s->lo[d] + (double)s->n[d] * s->cell;
-        const double out = p[d] < s->lo[d] ? s->lo[d] - p[d] : p[d] > hi ? p[d] - hi : 0.0;
-        d2 += out * out;
+        out[d] = p[d] < s->lo[d] ? s->lo[d] - p[d] : p[d] > hi ? p[d] - hi : 0.0;
     }
-    return sqrt(d2);
 }
 
-double surface_signed_distance(const struct surface *s, const double p[3], struct surface_point *at)
+/* A lower bound of the distance from p to every bucket outside the box of buckets c -+ r (those
+ * not searched yet): beyond a face of the box (one not on the grid's edge) a bucket is at least
+ * that face's gap from p along its axis, and along the others at least p's distance outside the
+ * grid. INFINITY when the box covers the grid. */
+static double unsearched_bound(const struct surface *s, const double p[3], const size_t c[3], size_t r,
+                               const double out[3])
+{
+    double best = INFINITY;
+    for (int d = 0; d < 3; d++) {
+        double across = 0.0;
+        for (int e = 0; e < 3; e++)
+            if (e != d) across += out[e] * out[e];
+        if (c[d] > r) { /* buckets below the box along d */
+            const double gap = p[d] - (s->lo[d] + (double)(c[d] - r) * s->cell);
+            best = fmin(best, sqrt(fmax(gap, 0.0) * fmax(gap, 0.0) + across));
+        }
+        if (c[d] + r + 1 < s->n[d]) { /* buckets above it */
+            const double gap = s->lo[d] + (double)(c[d] + r + 1) * s->cell - p[d];
+            best = fmin(best, sqrt(fmax(gap, 0.0) * fmax(gap, 0.0) + across));
+        }
+    }
+    return best;
+}
+
+/* The nearest of the triangles of bucket (i, j, k) to p, if nearer than *best2. */
+static void search_bucket(const struct surface *s, const double p[3], size_t i, size_t j, size_t k, double *best2,
+                          size_t *best_t, int *best_f, double best_point[3])
 {
     const struct mesh *m = &s->mesh;
-    if (m->n_triangles == 0) return INFINITY;
+    const size_t cell = cell_index(s, i, j, k);
+    for (size_t q = s->cell_start[cell]; q < s->cell_start[cell + 1]; q++) {
+        const size_t t = s->cell_triangle[q];
+        double x[3], px[3];
+        const int f = mesh_closest_feature(p, m->vertex[m->triangle[t][0]], m->vertex[m->triangle[t][1]],
+                                           m->vertex[m->triangle[t][2]], x);
+        vec3_sub(x, p, px);
+        const double d2 = vec3_dot(px, px);
+        if (d2 < *best2) {
+            *best2 = d2;
+            *best_t = t;
+            *best_f = f;
+            memcpy(best_point, x, sizeof x);
+        }
+    }
+}
+
+double surface_signed_distance_within(const struct surface *s, const double p[3], double max_distance,
+                                      struct surface_point *at)
+{
+    if (s->mesh.n_triangles == 0) return INFINITY;
     size_t c[3], reach = 0;
+    double out[3];
+    outside_grid(s, p, out);
     for (int d = 0; d < 3; d++) {
         c[d] = surface_cell_of(s, d, p[d]);
         const size_t far = c[d] > s->n[d] - 1 - c[d] ? c[d] : s->n[d] - 1 - c[d];
         if (far > reach) reach = far;
     }
-    const double outside = distance_to_grid(s, p);
     double best2 = INFINITY, best_point[3] = {0.0, 0.0, 0.0};
     size_t best_t = 0;
     int best_f = MESH_AT_FACE;
-    for (size_t r = 0; r <= reach; r++) {
-        /* the shell of buckets at Chebyshev distance r from c, clipped to the grid */
+    /* the shells of buckets at Chebyshev distance r from c, clipped to the grid; those nearer than
+     * the first bucket with a triangle are empty */
+    const size_t first = s->empty_rings[cell_index(s, c[0], c[1], c[2])];
+    if (first > 0 && unsearched_bound(s, p, c, first - 1, out) > max_distance) return INFINITY;
+    for (size_t r = first; r <= reach; r++) {
         size_t a[3], b[3];
         for (int d = 0; d < 3; d++) {
             a[d] = c[d] >= r ? c[d] - r : 0;
             b[d] = c[d] + r < s->n[d] ? c[d] + r : s->n[d] - 1;
         }
         for (size_t k = a[2]; k <= b[2]; k++)
-            for (size_t j = a[1]; j <= b[1]; j++)
-                for (size_t i = a[0]; i <= b[0]; i++) {
-                    const int on_shell = i + r == c[0] || i == c[0] + r || j + r == c[1] || j == c[1] + r ||
-                                         k + r == c[2] || k == c[2] + r;
-                    if (!on_shell) continue;
-                    const size_t cell = cell_index(s, i, j, k);
-                    for (size_t q = s->cell_start[cell]; q < s->cell_start[cell + 1]; q++) {
-                        const size_t t = s->cell_triangle[q];
-                        double x[3], px[3];
-                        const int f = mesh_closest_feature(p, m->vertex[m->triangle[t][0]], m->vertex[m->triangle[t][1]],
-                                                           m->vertex[m->triangle[t][2]], x);
-                        vec3_sub(x, p, px);
-                        const double d2 = vec3_dot(px, px);
-                        if (d2 < best2) {
-                            best2 = d2;
-                            best_t = t;
-                            best_f = f;
-                            memcpy(best_point, x, sizeof x);
-                        }
-                    }
+            for (size_t j = a[1]; j <= b[1]; j++) {
+                const int jk_on_shell = k + r == c[2] || k == c[2] + r || j + r == c[1] || j == c[1] + r;
+                if (jk_on_shell) {
+                    for (size_t i = a[0]; i <= b[0]; i++) search_bucket(s, p, i, j, k, &best2, &best_t, &best_f, best_point);
+                    continue;
                 }
-        /* every bucket not searched yet is at least r cells from p's clamped bucket */
-        const double unsearched = (double)r * s->cell - outside;
-        if (best2 < INFINITY && sqrt(best2) <= unsearched) break;
+                if (c[0] >= r) search_bucket(s, p, c[0] - r, j, k, &best2, &best_t, &best_f, best_point);
+                if (r > 0 && c[0] + r < s->n[0]) search_bucket(s, p, c[0] + r, j, k, &best2, &best_t, &best_f, best_point);
+            }
+        const double bound = unsearched_bound(s, p, c, r, out);
+        if (best2 < INFINITY && sqrt(best2) <= bound) break;
+        if (best2 == INFINITY && bound > max_distance) return INFINITY;
+        if (best2 < INFINITY && bound > max_distance && sqrt(best2) > max_distance) return INFINITY;
     }
+    const double dist = sqrt(best2);
+    if (dist > max_distance) return INFINITY;
     int boundary;
     const double *n = feature_normal(s, best_t, best_f, &boundary);
     double pq[3];
     vec3_sub(p, best_point, pq);
-    const double dist = sqrt(best2), side = vec3_dot(pq, n);
+    const double side = vec3_dot(pq, n);
     if (at) {
         memcpy(at->closest, best_point, sizeof best_point);
         memcpy(at->normal, n, 3 * sizeof *n);
@@ -286,6 +362,11 @@ double surface_signed_distance(const struct surface *s, const double p[3], struc
         at->at_boundary = boundary;
     }
     return side < 0.0 ? -dist : dist;
+}
+
+double surface_signed_distance(const struct surface *s, const double p[3], struct surface_point *at)
+{
+    return surface_signed_distance_within(s, p, INFINITY, at);
 }
 
 int surface_first_crossing(const struct surface *s, const double a[3], const double b[3], double *t_hit, double n[3])

@@ -14,14 +14,18 @@
  *
  * Index: a uniform grid of cubic buckets over the mesh's box, each listing the triangles whose
  * boxes overlap it. The nearest triangle is searched in shells of buckets around the point's,
- * until the nearest found is closer than any bucket not searched yet: a point near the surface
- * (a wall particle, a fluid particle beside a wall) looks at the triangles of a few buckets
- * whatever the mesh's size. The bucket side starts at the mean of the triangles' largest extents
+ * until the nearest found is closer than any bucket not searched yet (a bound from the point's
+ * place in its bucket), starting at the first shell with a triangle (a distance transform of the
+ * empty buckets): a point near the surface (a wall particle, a fluid particle beside a wall) looks
+ * at the triangles of a few buckets whatever the mesh's size. A point far from the surface needs
+ * many shells (measured: tests/bench/bench_walls3d.c, docs/performance.md); a caller that only
+ * asks whether the surface is within some distance uses surface_signed_distance_within. The bucket side starts at the mean of the triangles' largest extents
  * and grows until the grid has at most 8 buckets per triangle (plus 64): few empty buckets on a
  * surface of even triangles; a mesh of very uneven triangles lists many small ones per bucket. */
 #ifndef MIXSPH_SURFACE_H
 #define MIXSPH_SURFACE_H
 #include <stddef.h>
+#include <stdint.h>
 
 #include "mesh.h"
 #include "mixsph.h"
@@ -37,6 +41,7 @@ struct surface {
     size_t n[3];                    /* buckets along x, y, z */
     size_t *cell_start;             /* bucket c lists cell_triangle[cell_start[c] .. cell_start[c + 1]) */
     size_t *cell_triangle;
+    uint16_t *empty_rings;          /* per bucket: the shells of buckets around it holding no triangle */
 };
 
 /* The point of a surface nearest to a query point, and what the surface is there. */
@@ -56,6 +61,11 @@ void surface_free(struct surface *s);
 
 /** The signed distance from p to the surface [m] (< 0 behind it), and where (may be NULL). */
 double surface_signed_distance(const struct surface *s, const double p[3], struct surface_point *at);
+
+/** The same within max_distance: +INFINITY (and `at` untouched) when no point of the surface is
+ *  that close. Cheap for a far point, whose exact distance can take many shells of buckets. */
+double surface_signed_distance_within(const struct surface *s, const double p[3], double max_distance,
+                                      struct surface_point *at);
 
 /** Does the segment a -> b cross the surface from its front to its back (within [a, b], a
  *  crossing through an edge counted)? Then *t receives the fraction of a -> b at the first such

@@ -53,6 +53,12 @@ void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double
     geom_side_normal(&wl->line, wl->side, pos[0] - o[0], pos[DIM_UP] - o[DIM_UP], &nx, &nz);
     from_plane(nx, nz, n);
 }
+
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach)
+{
+    int at_end;
+    return !(fabs(walls_distance(W, w, pos, &at_end)) > reach); /* NaN counts as near */
+}
 #else
 /* The signed distance of pos to wall w where it is now, and its nearest point in its own frame. */
 static double surface_query(const struct walls *W, size_t w, const double pos[DIM], struct surface_point *at)
@@ -75,6 +81,13 @@ void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double
     struct surface_point at;
     surface_query(W, w, pos, &at);
     for (int d = 0; d < DIM; d++) n[d] = at.normal[d];
+}
+
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach)
+{
+    const double *o = W->state[w].o;
+    const double p[3] = {pos[0] - o[0], pos[1] - o[1], pos[2] - o[2]};
+    return !(fabs(surface_signed_distance_within(&W->def[w].surface, p, reach, NULL)) > reach);
 }
 #endif
 

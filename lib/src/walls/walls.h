@@ -77,6 +77,10 @@ long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *in
  *  closest point is an end of the polyline (3D: on an open edge of the surface). */
 double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end);
 
+/** Is pos within `reach` of wall w where it is now (either side)? The crossing guard's filter:
+ *  in 3D it stops searching beyond reach, where the exact distance can take long. */
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach);
+
 /** The unit normal n of wall w toward its fluid at the point of the wall nearest to pos. */
 void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double n[DIM]);
 
