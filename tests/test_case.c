@@ -937,6 +937,31 @@ static void test_numerics_reach_the_step(void **state)
     mixsph_sim_destroy(s);
 }
 
+/* The 3D wall forms and the y components are refused by a 2D case, naming the key and why; a
+ * wall takes one geometry, and only its own form's keys. */
+static void test_wall_forms_in_2d(void **state)
+{
+    (void)state;
+    const char *tank = "\"polyline\": [[0.0, 0.3], [0.0, 0.0], [0.2, 0.0], [0.2, 0.3]], \"fluid_side\": \"left\"";
+    EXPECT_EDIT_ERROR(tank, "\"box_min\": [0, 0, 0], \"box_max\": [1, 1, 1]",
+                      ORIGIN ": walls.tank.box_min: a 3D geometry, and this case is 2D");
+    EXPECT_EDIT_ERROR(tank, "\"stl\": \"tank.stl\"", ORIGIN ": walls.tank.stl: a 3D geometry, and this case is 2D");
+    EXPECT_EDIT_ERROR(tank, "\"terrain\": \"dem.asc\"", ORIGIN ": walls.tank.terrain: a 3D geometry, and this case is 2D");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\" }", "\"fluid_side\": \"left\", \"y_min\": 0, \"y_max\": 1 }",
+                      ORIGIN ": walls.tank.y_min: only a 3D case extrudes a polyline across y");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\" }", "\"fluid_side\": \"left\", \"side_walls\": \"free-slip\" }",
+                      ORIGIN ": walls.tank.side_walls: only a 3D case extrudes a polyline across y");
+    EXPECT_EDIT_ERROR("\"vz\": [0.0, 0.0, 0.0]", "\"vy\": [0.0, 0.0, 0.0], \"vz\": [0.0, 0.0, 0.0]",
+                      ORIGIN ": motions.plate.vy: a 2D case has no velocity across y");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\" }", "\"fluid_side\": \"left\", \"stl\": \"a.stl\" }",
+                      ORIGIN ": walls.tank: give one geometry (polyline, box_min and box_max, stl or terrain), not "
+                             "polyline and stl");
+    EXPECT_EDIT_ERROR(tank, "\"slip\": \"no-slip\"",
+                      ORIGIN ": walls.tank: missing its geometry (expected polyline, box_min and box_max, stl or terrain)");
+    EXPECT_EDIT_ERROR("\"fluid_side\": \"left\" }", "\"fluid_side\": \"left\", \"open_faces\": \"none\" }",
+                      ORIGIN ": walls.tank.open_faces: a polyline wall does not take this key (only box)");
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -950,6 +975,7 @@ int main(void)
         cmocka_unit_test(test_unknown_key),
         cmocka_unit_test(test_bad_reference_or_choice),
         cmocka_unit_test(test_motion_arrays),
+        cmocka_unit_test(test_wall_forms_in_2d),
         cmocka_unit_test(test_overrides),
         cmocka_unit_test(test_override_parse),
         cmocka_unit_test(test_create),

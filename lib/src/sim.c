@@ -376,8 +376,8 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (n_wall == WALLS_INTERRUPTED)
         return SIM_FAIL(s, MIXSPH_ERR_INTERRUPTED, "%s: interrupted while placing the wall particles", s->cfg.origin);
     if (n_wall == WALLS_NOT_IN_3D)
-        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: walls: polyline walls are 2D geometry; a 3D build cannot place them yet",
-                        s->cfg.origin);
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: numerics.wall_placement: 'aligned' is 2D only (a 3D case's wall "
+                        "particles are lattice sites)", s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->phys.n_wall = (size_t)n_wall;
     set_domain(s);

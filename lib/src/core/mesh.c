@@ -399,8 +399,8 @@ int mesh_contains(const struct mesh *m, const double p[3])
     return fabs(mesh_winding_number(m, p)) > 0.5;
 }
 
-void mesh_closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3],
-                              double closest[3])
+int mesh_closest_feature(const double p[3], const double a[3], const double b[3], const double c[3],
+                         double closest[3])
 {
     double ab[3], ac[3], ap[3], bp[3], cp[3];
     vec3_sub(b, a, ab);
@@ -409,41 +409,48 @@ void mesh_closest_on_triangle(const double p[3], const double a[3], const double
     const double d1 = vec3_dot(ab, ap), d2 = vec3_dot(ac, ap);
     if (d1 <= 0.0 && d2 <= 0.0) { /* vertex a */
         memcpy(closest, a, 3 * sizeof *a);
-        return;
+        return MESH_AT_VERTEX_A;
     }
     vec3_sub(p, b, bp);
     const double d3 = vec3_dot(ab, bp), d4 = vec3_dot(ac, bp);
     if (d3 >= 0.0 && d4 <= d3) { /* vertex b */
         memcpy(closest, b, 3 * sizeof *b);
-        return;
+        return MESH_AT_VERTEX_B;
     }
     const double vc = d1 * d4 - d3 * d2;
     if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) { /* edge ab */
         vec3_axpy(a, d1 / (d1 - d3), ab, closest);
-        return;
+        return MESH_AT_EDGE_AB;
     }
     vec3_sub(p, c, cp);
     const double d5 = vec3_dot(ab, cp), d6 = vec3_dot(ac, cp);
     if (d6 >= 0.0 && d5 <= d6) { /* vertex c */
         memcpy(closest, c, 3 * sizeof *c);
-        return;
+        return MESH_AT_VERTEX_C;
     }
     const double vb = d5 * d2 - d1 * d6;
     if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) { /* edge ac */
         vec3_axpy(a, d2 / (d2 - d6), ac, closest);
-        return;
+        return MESH_AT_EDGE_CA;
     }
     const double va = d3 * d6 - d5 * d4;
     if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0) { /* edge bc */
         double bc[3];
         vec3_sub(c, b, bc);
         vec3_axpy(b, (d4 - d3) / ((d4 - d3) + (d5 - d6)), bc, closest);
-        return;
+        return MESH_AT_EDGE_BC;
     }
     const double denom = 1.0 / (va + vb + vc); /* the face, by its barycentric coordinates */
     double q[3];
     vec3_axpy(a, vb * denom, ab, q);
     vec3_axpy(q, vc * denom, ac, closest);
+    return MESH_AT_FACE;
+}
+
+void mesh_closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3],
+                              double closest[3])
+{
+    (void)mesh_closest_feature(p, a, b, c, closest);
 }
 
 double mesh_distance(const struct mesh *m, const double p[3], size_t *triangle, double closest[3])

@@ -97,6 +97,18 @@ int mesh_contains(const struct mesh *m, const double p[3]);
  *  triangle and closest (if non-NULL) the nearest point. INFINITY for an empty mesh. */
 double mesh_distance(const struct mesh *m, const double p[3], size_t *triangle, double closest[3]);
 
+/* Which part of a triangle (a, b, c) holds the point nearest to a given one (mesh_closest_feature). */
+enum mesh_feature {
+    MESH_AT_FACE = 0,
+    MESH_AT_VERTEX_A, MESH_AT_VERTEX_B, MESH_AT_VERTEX_C,
+    MESH_AT_EDGE_AB, MESH_AT_EDGE_BC, MESH_AT_EDGE_CA
+};
+
+/** The point of triangle (a, b, c) nearest to p, and the part of the triangle it lies on (enum
+ *  mesh_feature): its interior, a vertex or an edge (the Voronoi region of Ericson's test). */
+int mesh_closest_feature(const double p[3], const double a[3], const double b[3], const double c[3],
+                         double closest[3]);
+
 /** The point of triangle (a, b, c) nearest to p (Ericson, Real-Time Collision Detection 5.1.5). */
 void mesh_closest_on_triangle(const double p[3], const double a[3], const double b[3], const double c[3],
                               double closest[3]);

@@ -15,6 +15,7 @@
 #include "law_registry.h"
 #include "status.h"
 #include "viscous.h"
+#include "wall_surface.h"
 
 #define FAIL(r, ...) status_set((r)->err, (r)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
 
@@ -429,6 +430,9 @@ static mixsph_status read_bodies(const struct case_reader *r, const cJSON *root,
     return MIXSPH_OK;
 }
 
+/* Whether the case is three-dimensional: a build runs the cases of its own dimension. */
+static int case_is_3d(const struct case_def *c) { return c->dimensions == 3; }
+
 static mixsph_status read_motions(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     const cJSON *m = item(root, "motions");
@@ -438,12 +442,17 @@ static mixsph_status read_motions(const struct case_reader *r, const cJSON *root
         TRY(entry(r, it, "motions", c->n_motions, CASE_MAX_MOTIONS, path, sizeof path, mo->name));
         c->n_motions++;
         TRY(case_schema_read(r, it, path, section("motions"), 0, mo));
-        size_t nt = 0, nx = 0, nz = 0;
+        size_t nt = 0, nx = 0, nz = 0, ny = 0;
         TRY(case_schema_numbers(r, it, path, "t", 1, &mo->t, &nt));
         TRY(case_schema_numbers(r, it, path, "vx", 1, &mo->vx, &nx));
         TRY(case_schema_numbers(r, it, path, "vz", 1, &mo->vz, &nz));
         if (nx != nt || nz != nt)
             return FAIL(r, "%s: %s: t, vx and vz must have the same length (%zu, %zu, %zu)", r->origin, path, nt, nx, nz);
+        if (item(it, "vy")) {
+            if (!case_is_3d(c)) return FAIL(r, "%s: %s.vy: a 2D case has no velocity across y", r->origin, path);
+            TRY(case_schema_numbers(r, it, path, "vy", 1, &mo->vy, &ny));
+            if (ny != nt) return FAIL(r, "%s: %s.vy: as many values as t (%zu, expected %zu)", r->origin, path, ny, nt);
+        }
         for (size_t k = 1; k < nt; k++)
             if (!(mo->t[k] > mo->t[k - 1])) return FAIL(r, "%s: %s.t[%zu]: times must increase", r->origin, path, k);
         mo->n = nt;
@@ -458,6 +467,106 @@ static mixsph_status read_motions(const struct case_reader *r, const cJSON *root
     return MIXSPH_OK;
 }
 
+/* The faces of a box wall: all but those its open_faces names (default: the top). */
+static mixsph_status read_box_faces(const struct case_reader *r, const cJSON *it, const char *path, struct wall *wl)
+{
+    static const char *const names[] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+    const cJSON *open = item(it, "open_faces");
+    const char *text = open ? open->valuestring : "z_max";
+    wl->box_faces = MESH_BOX_ALL;
+    if (strcmp(text, "none") == 0) return MIXSPH_OK;
+    for (const char *at = text; *at;) {
+        const size_t len = strcspn(at, ", ");
+        int found = -1;
+        for (int f = 0; f < 6; f++)
+            if (len == strlen(names[f]) && strncmp(at, names[f], len) == 0) found = f;
+        if (found < 0 && len > 0)
+            return FAIL(r, "%s: %s.open_faces: '%.*s' is not a face (expected x_min, x_max, y_min, y_max, z_min, z_max "
+                           "or none)", r->origin, path, (int)len, at);
+        if (found >= 0) wl->box_faces &= ~(1u << found); /* MESH_BOX_XMIN = 1, ... in this order */
+        at += len;
+        at += strspn(at, ", ");
+    }
+    return MIXSPH_OK;
+}
+
+/* The form of a wall: the one geometry key its entry holds. */
+static mixsph_status read_wall_form(const struct case_reader *r, const cJSON *it, const char *path, const struct case_def *c,
+                                    struct wall *wl)
+{
+    static const struct { const char *key; int form; } forms[] = {{"polyline", WALL_FORM_POLYLINE}, {"box_min", WALL_FORM_BOX},
+        {"box_max", WALL_FORM_BOX}, {"stl", WALL_FORM_STL}, {"terrain", WALL_FORM_TERRAIN}};
+    const char *key = NULL;
+    for (size_t k = 0; k < SCHEMA_COUNT(forms); k++) {
+        if (!item(it, forms[k].key)) continue;
+        if (key && wl->form != forms[k].form)
+            return FAIL(r, "%s: %s: give one geometry (polyline, box_min and box_max, stl or terrain), not %s and %s",
+                        r->origin, path, key, forms[k].key);
+        if (!key) key = forms[k].key; /* the first, named in messages */
+        wl->form = forms[k].form;
+    }
+    if (!key) return FAIL(r, "%s: %s: missing its geometry (expected polyline, box_min and box_max, stl or terrain)",
+                          r->origin, path);
+    if (wl->form != WALL_FORM_POLYLINE && !case_is_3d(c))
+        return FAIL(r, "%s: %s.%s: a 3D geometry, and this case is 2D (its walls are polylines)", r->origin, path, key);
+    static const char *const across_y[] = {"y_min", "y_max", "side_walls", "side_walls_z_max"};
+    for (size_t k = 0; k < SCHEMA_COUNT(across_y) && wl->form == WALL_FORM_POLYLINE; k++) {
+        const int given = item(it, across_y[k]) != NULL;
+        if (given && !case_is_3d(c))
+            return FAIL(r, "%s: %s.%s: only a 3D case extrudes a polyline across y (this case is 2D)", r->origin, path,
+                        across_y[k]);
+        if (!given && k < 2 && case_is_3d(c))
+            return FAIL(r, "%s: %s.%s: missing (a polyline wall of a 3D case is extruded from y_min to y_max)",
+                        r->origin, path, across_y[k]);
+    }
+    return MIXSPH_OK;
+}
+
+/* The folder of the case file named by origin, "" when it has none. */
+static void case_folder(const char *origin, char *dir, size_t len)
+{
+    const char *slash = strrchr(origin, '/');
+    const size_t n = slash ? (size_t)(slash - origin) : 0;
+    snprintf(dir, len, "%.*s", (int)(n < len ? n : len - 1), origin);
+    if (slash && n == 0) snprintf(dir, len, "/");
+}
+
+/* A 3D wall's surface, and a flume's side walls as the next wall. */
+static mixsph_status build_wall_surface(const struct case_reader *r, const cJSON *it, const char *path,
+                                        struct case_def *c, struct wall *wl)
+{
+    char dir[sizeof c->origin], why[384];
+    case_folder(r->origin, dir, sizeof dir);
+    if (wl->form == WALL_FORM_BOX) {
+        double *lo = NULL, *hi = NULL;
+        size_t n_lo = 0, n_hi = 0;
+        mixsph_status st = case_schema_numbers(r, it, path, "box_min", 3, &lo, &n_lo);
+        if (st == MIXSPH_OK) st = case_schema_numbers(r, it, path, "box_max", 3, &hi, &n_hi);
+        if (st == MIXSPH_OK && (n_lo != 3 || n_hi != 3))
+            st = FAIL(r, "%s: %s: box_min and box_max are points [x, y, z] (found %zu and %zu numbers)", r->origin, path,
+                      n_lo, n_hi);
+        for (int d = 0; d < 3 && st == MIXSPH_OK; d++) {
+            wl->box_min[d] = lo[d];
+            wl->box_max[d] = hi[d];
+        }
+        free(lo);
+        free(hi);
+        TRY(st);
+        TRY(read_box_faces(r, it, path, wl));
+    }
+    if (wall_surface_build(wl, dir, why, sizeof why) != MIXSPH_OK)
+        return FAIL(r, "%s: %s: %s", r->origin, path, why);
+    if (wl->form != WALL_FORM_POLYLINE || wl->side_walls == WALL_SIDES_NONE) return MIXSPH_OK;
+    if (c->n_walls == CASE_MAX_WALLS)
+        return FAIL(r, "%s: %s.side_walls: at most %d walls, with the side walls", r->origin, path, CASE_MAX_WALLS);
+    struct wall *sides = &c->walls[c->n_walls];
+    if (wall_side_walls(wl, sides, why, sizeof why) != MIXSPH_OK) return FAIL(r, "%s: %s.side_walls: %s", r->origin, path, why);
+    if (find_wall(c, sides->name) >= 0)
+        return FAIL(r, "%s: %s.side_walls: a wall is already named %s", r->origin, path, sides->name);
+    c->n_walls++;
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     for (const cJSON *it = item(root, "walls")->child; it; it = it->next) {
@@ -466,7 +575,15 @@ static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, 
         TRY(entry(r, it, "walls", c->n_walls, CASE_MAX_WALLS, path, sizeof path, wl->name));
         c->n_walls++;
         wl->friction_deg = NAN; /* not given: the grains' own phi */
-        TRY(case_schema_read(r, it, path, section("walls"), 0, wl));
+        wl->y_min = wl->y_max = wl->side_walls_z_max = NAN;
+        wl->side_walls = WALL_SIDES_NONE;
+        TRY(read_wall_form(r, it, path, c, wl));
+        TRY(case_schema_read(r, it, path, section("walls"), 1u << wl->form, wl));
+        if (wl->form == WALL_FORM_POLYLINE && !item(it, "fluid_side"))
+            return FAIL(r, "%s: %s.fluid_side: missing (expected a string)", r->origin, path);
+        const cJSON *file = item(it, wl->form == WALL_FORM_STL ? "stl" : "terrain"); /* its length checked */
+        if (file && (wl->form == WALL_FORM_STL || wl->form == WALL_FORM_TERRAIN))
+            snprintf(wl->file, sizeof wl->file, "%s", file->valuestring);
         wl->motion = -1;
         const cJSON *motion = item(it, "motion");
         if (motion) {
@@ -474,6 +591,7 @@ static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, 
             if (wl->motion < 0)
                 return FAIL(r, "%s: %s.motion: '%s' is not one of the motions", r->origin, path, motion->valuestring);
         }
+        if (case_is_3d(c)) TRY(build_wall_surface(r, it, path, c, wl));
     }
     /* a 3D case may have none (particles in the domain alone; 3D walls come with their own keys) */
     if (c->n_walls == 0 && c->dimensions == 2) return FAIL(r, "%s: walls: expected at least one wall", r->origin);
@@ -833,11 +951,15 @@ mixsph_status case_parse(const char *json_text, const char *origin, const mixsph
 void case_free(struct case_def *c)
 {
     for (size_t i = 0; i < CASE_MAX_BODIES; i++) geom_free(&c->bodies[i].polygon);
-    for (size_t i = 0; i < CASE_MAX_WALLS; i++) geom_free(&c->walls[i].line);
+    for (size_t i = 0; i < CASE_MAX_WALLS; i++) {
+        geom_free(&c->walls[i].line);
+        surface_free(&c->walls[i].surface);
+    }
     for (size_t i = 0; i < CASE_MAX_MOTIONS; i++) {
         free(c->motions[i].t);
         free(c->motions[i].vx);
+        free(c->motions[i].vy);
         free(c->motions[i].vz);
-        c->motions[i].t = c->motions[i].vx = c->motions[i].vz = NULL;
+        c->motions[i].t = c->motions[i].vx = c->motions[i].vy = c->motions[i].vz = NULL;
     }
 }

@@ -41,6 +41,12 @@ static const struct case_choice diffusion_forms[] = {{"hydrostatic", 0}, {"molte
 static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
+static const struct case_choice wall_forms[] = {{"polyline", WALL_FORM_POLYLINE},
+                                                {"box", WALL_FORM_BOX},
+                                                {"stl", WALL_FORM_STL},
+                                                {"terrain", WALL_FORM_TERRAIN},
+                                                {NULL, 0}};
+static const struct case_choice box_fluid[] = {{"inside", 0}, {"outside", 1}, {NULL, 0}};
 static const struct case_choice directions[] = {{"+x", 1}, {"-x", -1}, {NULL, 0}};
 static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
                                                    {"max_elevation", MONITOR_MAX_ELEVATION},
@@ -129,10 +135,44 @@ static const struct case_key body_keys[] = {
 };
 
 static const struct case_key wall_keys[] = {
-    {.key = "polyline", .type = CASE_POINTS, .need = CASE_REQUIRED, .lo = 2, .unit = "m",
-     .field = CASE_FIELD(wall, line), .meaning = "the wall, an open polyline; consecutive points differ"},
-    {.key = "fluid_side", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = sides,
-     .field = CASE_FIELD(wall, side), .meaning = "the side of the fluid, seen along the polyline's direction of travel"},
+    {.key = "polyline", .type = CASE_POINTS, .need = CASE_SOMETIMES, .need_text = "one of polyline, box_min, stl, terrain",
+     .lo = 2, .unit = "m", .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, line),
+     .meaning = "the wall, an open polyline of [x, z] points; consecutive points differ. In a 3D case it is "
+                "extruded across y from y_min to y_max"},
+    {.key = "fluid_side", .type = CASE_CHOICE, .need = CASE_SOMETIMES, .need_text = "polyline", .choices = sides,
+     .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, side),
+     .meaning = "the side of the fluid, seen along the polyline's direction of travel"},
+    {.key = "y_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "a polyline of a 3D case", ANYWHERE,
+     .unit = "m", .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, y_min),
+     .meaning = "3D: the extruded polyline spans y from y_min to y_max"},
+    {.key = "y_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "a polyline of a 3D case", ANYWHERE,
+     .unit = "m", .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, y_max), .meaning = "3D: see y_min"},
+    {.key = "side_walls", .type = CASE_CHOICE, .def_text = "none", .choices = slips, .only = V(WALL_FORM_POLYLINE),
+     .field = CASE_FIELD(wall, side_walls),
+     .meaning = "3D: add the planes y = y_min and y = y_max, fluid between them, as the wall <name>_sides with this "
+                "slip condition (fixed, the polyline's friction)"},
+    {.key = "side_walls_z_max", .type = CASE_NUMBER, ANYWHERE, .def_text = "the polyline's top", .unit = "m",
+     .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, side_walls_z_max),
+     .meaning = "3D: the side walls reach from the polyline's lowest point up to this height"},
+    {.key = "box_min", .type = CASE_NUMBERS, .need = CASE_SOMETIMES, .need_text = "box", .lo = 3, .unit = "m",
+     .only = V(WALL_FORM_BOX), .meaning = "3D: the box's lowest corner [x, y, z]"},
+    {.key = "box_max", .type = CASE_NUMBERS, .need = CASE_SOMETIMES, .need_text = "box", .lo = 3, .unit = "m",
+     .only = V(WALL_FORM_BOX), .meaning = "3D: the box's highest corner [x, y, z]"},
+    {.key = "open_faces", .type = CASE_STRING, .lo = 1, .hi = 64, .def_text = "z_max", .only = V(WALL_FORM_BOX),
+     .meaning = "3D: the faces the box leaves open, comma-separated among x_min, x_max, y_min, y_max, z_min, z_max, "
+                "or none (a closed box)"},
+    {.key = "fluid", .type = CASE_CHOICE, DEF(0), .choices = box_fluid, .only = V(WALL_FORM_BOX),
+     .field = CASE_FIELD(wall, fluid_outside), .meaning = "3D: the fluid is inside the box (a tank) or outside it (an obstacle)"},
+    {.key = "stl", .type = CASE_STRING, .need = CASE_SOMETIMES, .need_text = "stl", .lo = 1, .hi = WALL_PATH_LEN,
+     .only = V(WALL_FORM_STL),
+     .meaning = "3D: an STL file (ASCII or binary), relative to the case file's folder; the fluid is on the side its "
+                "facets' normals point to (the right-hand rule of their vertices)"},
+    {.key = "flip_normals", .type = CASE_BOOL, DEF(0), .only = V(WALL_FORM_STL), .field = CASE_FIELD(wall, flip),
+     .meaning = "3D: the fluid is on the other side of the STL's facets"},
+    {.key = "terrain", .type = CASE_STRING, .need = CASE_SOMETIMES, .need_text = "terrain", .lo = 1, .hi = WALL_PATH_LEN,
+     .only = V(WALL_FORM_TERRAIN),
+     .meaning = "3D: an ESRI ASCII height grid, relative to the case file's folder, turned into a surface; the fluid "
+                "is above it"},
     {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .numeric_choice = 1,
      .field = CASE_FIELD(wall, slip), .meaning = "the condition on the tangential velocity"},
     {.key = "friction", .type = CASE_NUMBER, RANGE(0, 0, 89, 0), .def_text = "φ of the grains", .unit = "deg",
@@ -147,6 +187,8 @@ static const struct case_key motion_keys[] = {
      .meaning = "times of the velocity law, strictly increasing"},
     {.key = "vx", .type = CASE_NUMBERS, .need = CASE_REQUIRED, .lo = 1, .unit = "m/s",
      .meaning = "horizontal velocity at those times (as many as t)"},
+    {.key = "vy", .type = CASE_NUMBERS, .lo = 1, .unit = "m/s", .def_text = "0",
+     .meaning = "3D: velocity across y at those times (as many as t)"},
     {.key = "vz", .type = CASE_NUMBERS, .need = CASE_REQUIRED, .lo = 1, .unit = "m/s",
      .meaning = "vertical velocity at those times (as many as t)"},
     {.key = "speed_scale", .type = CASE_NUMBER, RANGE(0, 0, 1e3, 0), DEF(1), .unit = "-",
@@ -248,7 +290,7 @@ static const struct case_section sections[] = {
     {SECTION("numerics", "numerics", numerics_keys)},
     {SECTION("domain", "domain", domain_keys)},
     {SECTION("bodies", "bodies.<name>", body_keys)},
-    {SECTION("walls", "walls.<name>", wall_keys)},
+    {SECTION("walls", "walls.<name>", wall_keys), .variant_noun = "wall", .variants = wall_forms},
     {SECTION("motions", "motions.<name>", motion_keys)},
     {SECTION("monitors", "monitors.<name>", monitor_keys), .variant_noun = "monitor", .variants = monitor_types},
     {SECTION("full_scale", "full_scale", full_scale_keys)},

@@ -152,10 +152,8 @@ static void near_wall_range(void *arg, size_t b, size_t e)
         if (P->state[i] != MIXSPH_STATE_WALL)
             for (size_t w = 0; w < s->phys.walls.n && !close; w++) {
                 double pos[DIM];
-                int at_end;
                 for (int k = 0; k < DIM; k++) pos[k] = P->pos[k][i];
-                const double d = walls_distance(&s->phys.walls, w, pos, &at_end);
-                close = !(fabs(d) > reach); /* NaN counts as close */
+                close = walls_near(&s->phys.walls, w, pos, reach);
             }
         s->work.near_wall[i] = (uint8_t)close;
     }

@@ -28,13 +28,21 @@ static void motion_locate(const struct motion *m, double tl, size_t *k, double *
     *f = (tl - m->t[lo]) / (m->t[lo + 1] - m->t[lo]);
 }
 
-/* The table's in-plane components (x, z) as a DIM vector (motion.h). */
-static void plane_vector(double x, double z, double v[DIM])
+/* The table's components (x, y, z) as a DIM vector (motion.h): y only in 3D. */
+static void table_vector(double x, double y, double z, double v[DIM])
 {
     for (int d = 0; d < DIM; d++) v[d] = 0.0;
     v[0] = x;
+#if DIM == 3
+    v[1] = y;
+#else
+    (void)y;
+#endif
     v[DIM_UP] = z;
 }
+
+/* Row k of the table's y column (0 without one). */
+static double vy_at(const struct motion *m, size_t k) { return m->vy ? m->vy[k] : 0.0; }
 
 void motion_velocity(const struct motion *m, double t, double v[DIM])
 {
@@ -43,10 +51,11 @@ void motion_velocity(const struct motion *m, double t, double v[DIM])
     int outside;
     motion_locate(m, t / m->time_scale, &k, &f, &outside);
     if (outside) {
-        plane_vector(m->speed_scale * m->vx[k], m->speed_scale * m->vz[k], v);
+        table_vector(m->speed_scale * m->vx[k], m->speed_scale * vy_at(m, k), m->speed_scale * m->vz[k], v);
         return;
     }
-    plane_vector(m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k])),
+    table_vector(m->speed_scale * (m->vx[k] + f * (m->vx[k + 1] - m->vx[k])),
+                 m->speed_scale * (vy_at(m, k) + f * (vy_at(m, k + 1) - vy_at(m, k))),
                  m->speed_scale * (m->vz[k] + f * (m->vz[k + 1] - m->vz[k])), v);
 }
 
@@ -57,9 +66,10 @@ void motion_acceleration(const struct motion *m, double t, double a[DIM])
     int outside;
     motion_locate(m, t / m->time_scale, &k, &f, &outside);
     if (outside) {
-        plane_vector(0.0, 0.0, a);
+        table_vector(0.0, 0.0, 0.0, a);
         return;
     }
     const double dt = (m->t[k + 1] - m->t[k]) * m->time_scale;
-    plane_vector(m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt, m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt, a);
+    table_vector(m->speed_scale * (m->vx[k + 1] - m->vx[k]) / dt, m->speed_scale * (vy_at(m, k + 1) - vy_at(m, k)) / dt,
+                 m->speed_scale * (m->vz[k + 1] - m->vz[k]) / dt, a);
 }

@@ -1,7 +1,6 @@
 /* motion.h - a prescribed motion law: a velocity table, linear between its rows, stretched in
- * time and scaled in speed (docs/cases.md, "motions"); the walls move by it. The table gives the
- * velocity in the vertical x-z plane of the walls' polylines (case input, 2D): as a DIM vector it
- * is (vx, vz) in 2D, (vx, 0, vz) in 3D. */
+ * time and scaled in speed (docs/cases.md, "motions"); the walls move by it. As a DIM vector the
+ * table's velocity is (vx, vz) in 2D, (vx, vy, vz) in 3D (vy NULL: 0; a 2D case has none). */
 #ifndef MIXSPH_MOTION_H
 #define MIXSPH_MOTION_H
 #include <stddef.h>
@@ -12,7 +11,7 @@
 struct motion {
     char name[SCHEMA_NAME_LEN];
     size_t n;
-    double *t, *vx, *vz;      /* velocity law, linear between rows [s], [m/s] */
+    double *t, *vx, *vy, *vz; /* velocity law, linear between rows [s], [m/s]; vy may be NULL (0) */
     double speed_scale;       /* velocities are multiplied by this [-] */
     double time_scale;        /* the law is stretched in time by this [-] */
 };

@@ -37,6 +37,7 @@ static inline void from_plane(double x, double z, double v[DIM])
     v[DIM_UP] = z;
 }
 
+#if DIM == 2
 double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end)
 {
     const struct wall *wl = &W->def[w];
@@ -52,6 +53,43 @@ void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double
     geom_side_normal(&wl->line, wl->side, pos[0] - o[0], pos[DIM_UP] - o[DIM_UP], &nx, &nz);
     from_plane(nx, nz, n);
 }
+
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach)
+{
+    int at_end;
+    return !(fabs(walls_distance(W, w, pos, &at_end)) > reach); /* NaN counts as near */
+}
+#else
+/* The signed distance of pos to wall w where it is now, and its nearest point in its own frame. */
+static double surface_query(const struct walls *W, size_t w, const double pos[DIM], struct surface_point *at)
+{
+    const double *o = W->state[w].o;
+    const double p[3] = {pos[0] - o[0], pos[1] - o[1], pos[2] - o[2]};
+    return surface_signed_distance(&W->def[w].surface, p, at);
+}
+
+double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end)
+{
+    struct surface_point at;
+    const double d = surface_query(W, w, pos, &at);
+    *at_end = at.at_boundary;
+    return d;
+}
+
+void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double n[DIM])
+{
+    struct surface_point at;
+    surface_query(W, w, pos, &at);
+    for (int d = 0; d < DIM; d++) n[d] = at.normal[d];
+}
+
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach)
+{
+    const double *o = W->state[w].o;
+    const double p[3] = {pos[0] - o[0], pos[1] - o[1], pos[2] - o[2]};
+    return !(fabs(surface_signed_distance_within(&W->def[w].surface, p, reach, NULL)) > reach);
+}
+#endif
 
 void walls_init(struct walls *W, const struct wall *def, size_t n, const struct motion *motions, int layers,
                 int placement, double lattice_z0, double g, double rho_alone)
@@ -267,17 +305,127 @@ static long walls_generate_lattice(const struct walls *W, double dx, const mixsp
     }
     return added;
 }
+#else /* DIM == 3: the lattice sites behind each wall's surface */
+
+/* Whether pos lies behind a fixed wall before w, within the layers' depth: among fixed walls a
+ * site is filled once. At t = 0 a wall's frame is the case's. */
+static int behind_earlier_fixed_wall(const struct walls *W, size_t w, const double pos[3], double depth)
+{
+    if (W->def[w].motion >= 0) return 0;
+    for (size_t v = 0; v < w; v++) {
+        if (W->def[v].motion >= 0) continue;
+        const double d = surface_signed_distance(&W->def[v].surface, pos, NULL);
+        if (d < 0.0 && d >= -depth) return 1;
+    }
+    return 0;
+}
+
+/* The buckets of surface s's grid grown by m buckets on every side (N[d] = n[d] + 2 m of them)
+ * that lie within m buckets of one holding a triangle: the only ones whose lattice sites can be
+ * within m bucket sides of the surface. A box dilation, axis by axis. NULL when out of memory. */
+static unsigned char *buckets_near_surface(const struct surface *s, size_t m, size_t N[3])
+{
+    for (int d = 0; d < 3; d++) N[d] = s->n[d] + 2 * m;
+    const size_t total = N[0] * N[1] * N[2], stride[3] = {1, N[0], N[0] * N[1]};
+    unsigned char *mask = calloc(total, 1), *grown = calloc(total, 1);
+    if (!mask || !grown) {
+        free(mask);
+        free(grown);
+        return NULL;
+    }
+    for (size_t k = 0; k < s->n[2]; k++)
+        for (size_t j = 0; j < s->n[1]; j++)
+            for (size_t i = 0; i < s->n[0]; i++) {
+                const size_t c = (k * s->n[1] + j) * s->n[0] + i;
+                if (s->cell_start[c + 1] > s->cell_start[c]) mask[(k + m) * stride[2] + (j + m) * stride[1] + i + m] = 1;
+            }
+    for (int a = 0; a < 3; a++) {
+        memset(grown, 0, total);
+        for (size_t c = 0; c < total; c++) {
+            if (!mask[c]) continue;
+            const size_t at = c / stride[a] % N[a];
+            const size_t lo = at >= m ? at - m : 0, hi = at + m < N[a] ? at + m : N[a] - 1;
+            for (size_t q = lo; q <= hi; q++) grown[c + (q - at) * stride[a]] = 1; /* unsigned wrap: exact */
+        }
+        unsigned char *t = mask;
+        mask = grown;
+        grown = t;
+    }
+    free(grown);
+    return mask;
+}
+
+/* The lattice indices whose sites (l + 1/2) dx + off lie in [b0, b1): first .. end - 1. */
+static void sites_in(double b0, double b1, double off, double dx, long *first, long *end)
+{
+    *first = (long)ceil((b0 - off) / dx - 0.5);
+    *end = (long)ceil((b1 - off) / dx - 0.5);
+}
+
+/* Every lattice site (i + 1/2) dx, (j + 1/2) dx, z_off + (k + 1/2) dx within the layers' depth
+ * behind a wall's surface (-depth <= d < 0, d the signed distance), bucket by bucket of its
+ * grid near the surface. Beyond an open edge the rule keeps the sites behind the edge's face
+ * within depth of the edge (a quarter cylinder), so two surfaces meeting at an edge (a flume's
+ * bed and its side walls) leave no gap between their layers. */
+static long walls_generate_lattice(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
+                                   struct particles *P)
+{
+    const double depth = W->layers * dx, z_off = geom_lattice_z_offset(W->lattice_z0, dx);
+    const double off[3] = {0.0, 0.0, z_off};
+    long added = 0;
+    for (size_t w = 0; w < W->n; w++) {
+        const struct surface *s = &W->def[w].surface;
+        const size_t m = (size_t)ceil(depth / s->cell);
+        size_t N[3];
+        unsigned char *near = buckets_near_surface(s, m, N);
+        if (!near) return -1;
+        for (size_t K = 0; K < N[2]; K++)
+            for (size_t J = 0; J < N[1]; J++) {
+                if (interrupt && interrupt->requested && interrupt->requested(interrupt->user)) {
+                    free(near);
+                    return WALLS_INTERRUPTED;
+                }
+                for (size_t I = 0; I < N[0]; I++) {
+                    if (!near[(K * N[1] + J) * N[0] + I]) continue;
+                    const size_t at[3] = {I, J, K};
+                    long first[3], end[3];
+                    for (int d = 0; d < 3; d++) {
+                        const double b0 = s->lo[d] + ((double)at[d] - (double)m) * s->cell;
+                        const double b1 = s->lo[d] + ((double)at[d] + 1.0 - (double)m) * s->cell;
+                        sites_in(b0, b1, off[d], dx, &first[d], &end[d]);
+                    }
+                    for (long k = first[2]; k < end[2]; k++)
+                        for (long j = first[1]; j < end[1]; j++)
+                            for (long i = first[0]; i < end[0]; i++) {
+                                const double pos[3] = {(i + 0.5) * dx, (j + 0.5) * dx, z_off + (k + 0.5) * dx};
+                                const double d = surface_signed_distance(s, pos, NULL);
+                                if (!(d < 0.0) || d < -depth || behind_earlier_fixed_wall(W, w, pos, depth)) continue;
+                                const size_t p = particles_push(P, pos, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
+                                if (p == (size_t)-1) {
+                                    free(near);
+                                    return -1;
+                                }
+                                P->vol[p] = dim_cell_volume(dx);
+                                P->m[p] = 0.0;
+                                for (int c = 0; c < DIM; c++) P->vel[c][p] = P->uv[c][p] = W->state[w].v[c];
+                                added++;
+                            }
+                }
+            }
+        free(near);
+    }
+    return added;
+}
 #endif
 
 long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt, struct particles *P)
 {
 #if DIM == 2
     if (W->placement == WALL_PLACEMENT_ALIGNED) return walls_generate_aligned(W, dx, interrupt, P);
-    return walls_generate_lattice(W, dx, interrupt, P);
 #else
-    (void)dx, (void)interrupt, (void)P;
-    return W->n > 0 ? WALLS_NOT_IN_3D : 0;
+    if (W->placement == WALL_PLACEMENT_ALIGNED) return WALLS_NOT_IN_3D;
 #endif
+    return walls_generate_lattice(W, dx, interrupt, P);
 }
 
 /* The velocity of a moving wall at the end of the step from t_from by dt: its motion law's, or
@@ -338,6 +486,7 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
     for (size_t w = 0; w < W->n; w++) wstate[w].work -= dot(force[w], shift[w]);
 }
 
+#if DIM == 2
 void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], double gap, const double p0[DIM],
                            double p1[DIM], double v[DIM], long *clips)
 {
@@ -380,6 +529,38 @@ void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], do
         if (!hit) return;
     }
 }
+#else
+/* In 3D the first crossing of the step's path from the front of a wall's surface to its back
+ * (surface_first_crossing, over the few triangles of the buckets the path passes). */
+void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], double gap, const double p0[DIM],
+                           double p1[DIM], double v[DIM], long *clips)
+{
+    for (int pass = 0; pass < 4; pass++) {
+        int hit = 0;
+        for (size_t w = 0; w < W->n && !hit; w++) {
+            const struct wall_state *ws = &W->state[w];
+            double a[3], b[3], step[3], n[3], t;
+            for (int d = 0; d < DIM; d++) {
+                a[d] = p0[d] - o_old[w][d];
+                b[d] = p1[d] - ws->o[d];
+                step[d] = b[d] - a[d];
+            }
+            if (!surface_first_crossing(&W->def[w].surface, a, b, &t, n)) continue;
+            double dv[DIM];
+            for (int d = 0; d < DIM; d++) {
+                p1[d] = a[d] + t * step[d] + gap * n[d] + ws->o[d];
+                dv[d] = v[d] - ws->v[d];
+            }
+            const double vn = dot(dv, n);
+            if (vn < 0.0)
+                for (int d = 0; d < DIM; d++) v[d] -= vn * n[d];
+            (*clips)++;
+            hit = 1;
+        }
+        if (!hit) return;
+    }
+}
+#endif
 
 /* The kernel weight of a non-wall neighbour j from wall particle i in the extrapolation onto i;
  * r = x_i - x_j. */

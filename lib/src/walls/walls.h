@@ -1,12 +1,14 @@
-/* walls.h - walls from polylines (docs/model.md section 8, docs/numerics.md): layers of wall
- * particles behind each polyline, their motion, the extrapolation of the fluid's state onto
- * them, and the geometric guard against crossings. A wall treatment plugs in here: it owns the
- * wall particles' p, rho, m and viscous velocity (uv), which the pair loops read.
+/* walls.h - walls from polylines (2D) or triangulated surfaces (3D) (docs/model.md section 8,
+ * docs/numerics.md): layers of wall particles behind each wall, their motion, the extrapolation
+ * of the fluid's state onto them, and the geometric guard against crossings. A wall treatment
+ * plugs in here: it owns the wall particles' p, rho, m and viscous velocity (uv), which the pair
+ * loops read.
  *
- * A wall is a polyline of the case (2D geometry input) in the vertical x-z plane: its distance,
- * normal and crossings are taken in that plane, over components 0 and DIM_UP of a position, and
- * its normal has no other component. In 3D (DIM = 3) the placement of wall particles along a
- * polyline is not available yet (walls_generate refuses walls), so no 3D run has a wall. */
+ * In 2D (DIM = 2) a wall is a polyline of the case in the vertical x-z plane: its distance,
+ * normal and crossings are taken in that plane. In 3D (DIM = 3) it is the oriented surface of its
+ * definition (wall_def.h, core/surface.h): distance and normal by the nearest triangle and its
+ * pseudo-normal, crossings by a segment-triangle test; wall particles on the lattice only. Both
+ * move by translation (their motion law's velocity; in 3D with its y component). */
 #ifndef MIXSPH_WALLS_H
 #define MIXSPH_WALLS_H
 #include <stddef.h>
@@ -60,19 +62,24 @@ void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const
                            struct particles *P);
 
 #define WALLS_INTERRUPTED (-2L)
-#define WALLS_NOT_IN_3D (-3L) /* walls_generate: polyline walls are placed in 2D only (for now) */
+#define WALLS_NOT_IN_3D (-3L) /* walls_generate: the aligned placement is 2D only */
 
 /** Append the wall particles of every wall of the case at spacing dx (W->layers layers
  *  deep, placed as W->placement says); their `medium` field holds their wall's index and
  *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row,
  *  or every segment when aligned. Returns the number added, -1 when out of memory,
- *  WALLS_INTERRUPTED when the host asked to stop, WALLS_NOT_IN_3D for any wall in 3D. */
+ *  WALLS_INTERRUPTED when the host asked to stop, WALLS_NOT_IN_3D for the aligned placement in 3D. In 3D a wall's particles are the
+ *  lattice sites within the layers' depth behind its surface (and behind its open edges). */
 long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
 
 /** Signed distance of pos to wall w at its current position (< 0 behind it) [m], and whether the
- *  closest point is an end of the polyline. */
+ *  closest point is an end of the polyline (3D: on an open edge of the surface). */
 double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end);
+
+/** Is pos within `reach` of wall w where it is now (either side)? The crossing guard's filter:
+ *  in 3D it stops searching beyond reach, where the exact distance can take long. */
+int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach);
 
 /** The unit normal n of wall w toward its fluid at the point of the wall nearest to pos. */
 void walls_normal(const struct walls *W, size_t w, const double pos[DIM], double n[DIM]);
