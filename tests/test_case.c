@@ -599,11 +599,12 @@ static void test_table_variants(void **state)
     (void)state;
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"max_elevation\", \"medium\": \"water\", \"direction\": \"+x\"",
-                      ORIGIN ": monitors.front.direction: a max_elevation monitor does not take this key (only front)");
+                      ORIGIN ": monitors.front.direction: a max_elevation monitor does not take this key (only front, runout "
+                      "or slide_impact)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"kinetic_energy\", \"medium\": \"water\", \"min_neighbours\": 3",
                       ORIGIN ": monitors.front.min_neighbours: a kinetic_energy monitor does not take this key "
-                      "(only front, max_elevation or profile)");
+                      "(only front, max_elevation, profile, runout, wave_gauge or slide_impact)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"medium\": \"water\"",
                       ORIGIN ": monitors.front.medium: a wall_pressure monitor does not take this key");
