@@ -617,7 +617,8 @@ static void test_table_variants(void **state)
                       "\"type\": \"pressure_probe\", \"x\": 0.1", ORIGIN ": monitors.front.z: missing (expected a number)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"x\": 0.1",
-                      ORIGIN ": monitors.front.x: a wall_pressure monitor does not take this key (only pressure_probe)");
+                      ORIGIN ": monitors.front.x: a wall_pressure monitor does not take this key (only pressure_probe or "
+                      "wave_gauge)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"front\", \"direction\": \"+x\"", ORIGIN ": monitors.front.medium: missing (expected a string)");
 }
