@@ -161,7 +161,7 @@ def main(argv=None, prog=PROG):
     spacings = [a.dx, a.dx / 2] if a.refine else [a.dx]
     rows = [run_one(a, kind, dx) for kind in ("stable", "steep") for dx in spacings]
     head = ("| heap | slope [deg] | dx [m] | status | wall [s] | t [s] | largest displacement to 2 s [dx] | "
-            "flank angle at t [deg] | vs 2 dx [deg] | grains > 1 mm/s at t | criterion | met |")
+            "flank angle at 0 [deg] | at t [deg] | vs 2 dx [deg] | grains > 1 mm/s at t | criterion | met |")
     lines = [head, "|" + " --- |" * (head.count("|") - 1)]
     ok_all = True
     for r in rows:
@@ -175,7 +175,8 @@ def main(argv=None, prog=PROG):
             met = abs(r.get("angle", math.nan) - a.phi) <= ANGLE_TOL
         ok_all &= met and r["status"] == "ok"
         lines.append(f"| {r['kind']} | {r['slope']:g} | {r['dx']:g} | {r['status']} | {f(r.get('wall'), '.0f')} | "
-                     f"{f(r.get('t_last'), '.1f')} | {f(r.get('moved_dx'), '.3g')} | {f(r.get('angle'), '.1f')} | "
+                     f"{f(r.get('t_last'), '.1f')} | {f(r.get('moved_dx'), '.3g')} | {f(r.get('angle0'), '.1f')} | "
+                     f"{f(r.get('angle'), '.1f')} | "
                      f"{f(d, '+.1f')} | {f(100 * r.get('moving', math.nan), '.1f')} % | {crit} | "
                      f"{'yes' if met else '**no**'} |")
     command = "PYTHONPATH=$PWD .venv/bin/python " + shlex.join([PROG] + (list(argv) if argv is not None else sys.argv[1:]))
