@@ -276,13 +276,6 @@ def run(argv=None, prog=PROG):
         raise mt.ToolError(f"--threshold {args.threshold:g}: expected a positive thickness [m]")
     spacings = [args.dx, args.dx / 2] if args.refine else [args.dx]
     s = campaign.settings(args, prog, OPTIONS, len(aspects) * len(spacings))
-    case_json = with_threshold_monitors(s.case_json, args.threshold)
-    case = os.path.join(s.out, "case_column.json")
-    os.makedirs(s.out, exist_ok=True)
-    with open(case, "w") as f:
-        json.dump(case_json, f, indent=2)
-        f.write("\n")
-    s = dataclasses.replace(s, case=case, case_json=case_json, case_sha=campaign.case_digest(case))
     params = s.case_json.get("parameters") or {}
     L0, g = params.get("L0"), s.case_json.get("gravity")
     if not isinstance(L0, (int, float)) or not isinstance(g, (int, float)):
@@ -294,6 +287,14 @@ def run(argv=None, prog=PROG):
     if too_short:
         raise mt.ToolError(f"t_end = {s.t_end:g} s is shorter than 5 sqrt(H0/g) of a = "
                            f"{','.join(f'{a:g}' for a in too_short)}: give --t-end")
+    # the case with the threshold monitors, written once the options are known to be good
+    case_json = with_threshold_monitors(s.case_json, args.threshold)
+    case = os.path.join(s.out, "case_column.json")
+    os.makedirs(s.out, exist_ok=True)
+    with open(case, "w") as f:
+        json.dump(case_json, f, indent=2)
+        f.write("\n")
+    s = dataclasses.replace(s, case=case, case_json=case_json, case_sha=campaign.case_digest(case))
     jobs, runs = [], []
     for a in aspects:
         for dx in spacings:
