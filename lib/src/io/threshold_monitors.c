@@ -103,8 +103,8 @@ double wave_gauge_elevation(const mixsph_sim *s, const struct monitor_def *md)
             top = fmin(top, P->pos[DIM_UP][i]);
     if (isinf(top)) return NAN;
     /* follow the column up: the highest particle within `gap` above the top so far, until none is
-     * (each round raises the top by more than 0, at most by the column's height / 1 ulp: in
-     * practice about its height / dx rounds) */
+     * (each round moves the top to a higher particle, so the rounds end; about the column's
+     * height / (2 dx) of them) */
     for (;;) {
         double next = top;
         for (size_t i = 0; i < P->n; i++) {
