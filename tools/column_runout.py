@@ -325,8 +325,7 @@ def run(argv=None, prog=PROG):
           f"{100 * CRITERION:g} % of the fits, 99 % of the grains below 1 mm/s at 5 T):")
     mt.print_table(t_columns, t_rows)
     md_thr = os.path.join(s.out, "column_threshold.md")
-    command = "PYTHONPATH=$PWD .venv/bin/python " + " ".join(
-        [prog if prog.endswith(".py") else PROG] + list(argv if argv is not None else sys.argv[1:]))
+    command = mt.reproduce_command(PROG, list(argv if argv is not None else sys.argv[1:]))
     text = (f"Columns of cases/column_collapse.json at dx = {spacing_text} m, L0 = {L0:g} m, threshold "
             f"{args.threshold:g} m" + (", " + " ".join(f"--set {k}={mt.num(v)}" for k, v in s.extra) if s.extra else "")
             + "\n\n" + "\n".join(mt.markdown_table([(g_, f"{g_} {h}".strip(), al) for g_, h, al in t_columns], t_rows))

@@ -34,6 +34,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixsph_tools.readers import list_snapshots, read_snapshot  # noqa: E402
+from mixsph_tools.report import reproduce_command  # noqa: E402
 from mixsph_tools.runs import with_law  # noqa: E402
 
 PROG = "tools/granular_heap.py"
@@ -179,7 +180,7 @@ def main(argv=None, prog=PROG):
                      f"{f(r.get('angle'), '.1f')} | "
                      f"{f(d, '+.1f')} | {f(100 * r.get('moving', math.nan), '.1f')} % | {crit} | "
                      f"{'yes' if met else '**no**'} |")
-    command = "PYTHONPATH=$PWD .venv/bin/python " + shlex.join([PROG] + (list(argv) if argv is not None else sys.argv[1:]))
+    command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
     text = "\n".join(lines) + "\n\n```sh\n" + command + "\n```\n"
     print(text)
     os.makedirs(a.out, exist_ok=True)

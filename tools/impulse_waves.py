@@ -40,6 +40,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixsph_tools.readers import read_monitors  # noqa: E402
+from mixsph_tools.report import reproduce_command  # noqa: E402
 from mixsph_tools.runs import with_law  # noqa: E402
 
 PROG = "tools/impulse_waves.py"
@@ -213,7 +214,7 @@ def main(argv=None, prog=PROG):
                      f"{EXPONENT[1]:g}: {'met' if ex_ok[dx] else '**not met**'}).")
     worst = max((r.get("excluded", 0.0) for r in rows), default=0.0)
     lines.append(f"Largest excluded mass: {100 * worst:.3f} % of the total.")
-    command = "PYTHONPATH=$PWD .venv/bin/python " + shlex.join([PROG] + (list(argv) if argv is not None else sys.argv[1:]))
+    command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
     text = "\n".join(lines) + "\n\n```sh\n" + command + "\n```\n"
     print(text)
     os.makedirs(a.out, exist_ok=True)
