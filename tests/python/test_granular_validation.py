@@ -71,3 +71,10 @@ def test_flank_angle_of_a_lattice_heap():
     pts = [(x, z) for x, z in pts if z <= (0.3 - abs(x)) * math.tan(math.radians(30))]
     x, z = np.array(pts).T
     assert gh.flank_angle(x, z, dx) == pytest.approx(30.0, abs=1.5)
+
+
+def test_reproduce_command_drops_where_things_go():
+    # --mixsph and --doc (with their values, in either form) do not change the numbers: left out
+    import mixsph_tools as mt
+    cmd = mt.reproduce_command("tools/x.py", ["--dx", "0.01", "--mixsph", "/a/b/mixsph", "--doc=d.md", "--check"])
+    assert cmd == "PYTHONPATH=$PWD .venv/bin/python tools/x.py --dx 0.01 --check"
