@@ -74,7 +74,7 @@ def test_flank_angle_of_a_lattice_heap():
 
 
 def test_reproduce_command_drops_where_things_go():
-    # --mixsph and --doc (with their values, in either form) do not change the numbers: left out
+    # --mixsph, --doc and --out (with their values, in either form) do not change the numbers: left out
     import mixsph_tools as mt
-    cmd = mt.reproduce_command("tools/x.py", ["--dx", "0.01", "--mixsph", "/a/b/mixsph", "--doc=d.md", "--check"])
+    cmd = mt.reproduce_command("tools/x.py", ["--dx", "0.01", "--mixsph", "/a/b/mixsph", "--doc=d.md", "--out", "o", "--check"])
     assert cmd == "PYTHONPATH=$PWD .venv/bin/python tools/x.py --dx 0.01 --check"

@@ -19,10 +19,10 @@ def num(v):
     return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
 
 
-def reproduce_command(script, args, drop=("--mixsph", "--doc")):
+def reproduce_command(script, args, drop=("--mixsph", "--doc", "--out")):
     """The command that reproduces a script's table from the source folder: ``script`` (its path
     from there) with ``args``, less the options in ``drop`` and their values (where the
-    executable is and where the table is copied do not change the numbers)."""
+    executable is, where the runs and the table go do not change the numbers)."""
     import shlex
     kept, skip = [], False
     for a in args:
