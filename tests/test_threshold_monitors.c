@@ -21,15 +21,16 @@
 #define DX 0.01     /* [m] */
 #define RHO0 1000.0 /* [kg/m3] */
 
-/* A case of one fluid `w` (the monitors do not look at the law) with the given bodies and
- * monitors, on a long floor. */
+/* A case of one fluid `w` and a heavier one `g` (the monitors do not look at the law) with the
+ * given bodies and monitors, on a long floor. */
 static mixsph_sim *make(const char *bodies, const char *monitors)
 {
     char json[8192], err[512] = "";
     snprintf(json, sizeof json,
              "{ \"name\": \"threshold_monitors\", \"gravity\": 9.81,\n"
              "  \"numerics\": { \"dx\": %g, \"t_end\": 0.1, \"density_diffusion\": 0, \"density_bound\": 0 },\n"
-             "  \"media\": { \"w\": { \"type\": \"fluid\", \"rho\": %g, \"K\": 6.25e5, \"mu\": 1e-3, \"alpha_m\": 0.1 } },\n"
+             "  \"media\": { \"w\": { \"type\": \"fluid\", \"rho\": %g, \"K\": 6.25e5, \"mu\": 1e-3, \"alpha_m\": 0.1 },\n"
+             "             \"g\": { \"type\": \"fluid\", \"rho\": 2000, \"K\": 6.25e5, \"mu\": 1e-3, \"alpha_m\": 0.1 } },\n"
              "  \"bodies\": { %s },\n"
              "  \"walls\": { \"floor\": { \"polyline\": [[-1.5, 0.0], [1.5, 0.0]], \"fluid_side\": \"left\" } },\n"
              "  \"domain\": { \"x_min\": -1.6, \"x_max\": 1.6, \"z_min\": -0.1, \"z_max\": 2.0 },\n"
@@ -127,6 +128,23 @@ static void test_wave_gauge_pool(void **state)
  * area), within the lattice's count error, taken as its perimeter times dx/2. With `still`
  * below the front the impact has not happened (NaN); above it, it has. Once taken (a sample),
  * the values stay when the slide changes. */
+/* A pool 0.3 m deep whose column at 0 <= x <= 0.4 holds a layer of the other medium `g` at
+ * 0.1 <= z <= 0.15 (grains lying in the water): the gauge at x = 0.2 follows the column through
+ * it and reads the water's surface, 0 (to round-off, as above); a gauge that stopped at the
+ * layer would read the lower water's top, -0.2 m. */
+static void test_wave_gauge_through_grains(void **state)
+{
+    (void)state;
+    mixsph_sim *s = make("\"low\": { \"medium\": \"w\", \"polygon\": [[0.0, 0.0], [0.4, 0.0], [0.4, 0.1], [0.0, 0.1]] },"
+                         "\"layer\": { \"medium\": \"g\", \"polygon\": [[0.0, 0.1], [0.4, 0.1], [0.4, 0.15], [0.0, 0.15]] },"
+                         "\"high\": { \"medium\": \"w\", \"polygon\": [[0.0, 0.15], [0.4, 0.15], [0.4, 0.3], [0.0, 0.3]] }",
+                         "\"gauge\": { \"type\": \"wave_gauge\", \"medium\": \"w\", \"x\": 0.2, \"still\": 0.3 }");
+    const double eta = output(s, "gauge");
+    print_message("eta through a layer of grains: %.6f m (0)\n", eta);
+    assert_true(fabs(eta) <= 1e-9);
+    mixsph_sim_destroy(s);
+}
+
 static void test_slide_impact_ramp(void **state)
 {
     (void)state;
@@ -210,6 +228,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_runout_triangle),  cmocka_unit_test(test_wave_gauge_pool),
+        cmocka_unit_test(test_wave_gauge_through_grains),
         cmocka_unit_test(test_slide_impact_ramp), cmocka_unit_test(test_speed_quantile),
         cmocka_unit_test(test_bad_definitions),
     };

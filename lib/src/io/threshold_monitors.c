@@ -12,12 +12,13 @@
  *                  highest particle. The deposit's height is the largest h_b (H_inf of a column
  *                  collapse on a flat bed).
  *   wave_gauge   - the free surface at a station x: the top (centre + dx/2, as the profile
- *                  monitor) of the highest particle of the water column in the window
+ *                  monitor) of the highest particle of the medium in its column in the window
  *                  |x_j - x| <= window, minus the still level. Splash is excluded by two rules:
  *                  a particle counts only with min_neighbours neighbours of its medium, and the
- *                  column is followed up from its lowest particle through gaps of at most
- *                  GAUGE_GAP_OVER_DX dx, so a drop or jet separated from the water below by a
- *                  larger gap is not the surface.
+ *                  column is followed up from the medium's lowest particle through gaps of at
+ *                  most GAUGE_GAP_OVER_DX dx, so a drop or jet separated from the water below by
+ *                  a larger gap is not the surface. The column passes through the particles of
+ *                  every medium (a slide's grains lying in the water do not cut it).
  *   slide_impact - the impact of a slide into still water, for the impulse product of Heller &
  *                  Hager (2010): the first sample at which the slide's front (the lowest lower
  *                  edge z_j - dx/2 of its counting particles) reaches the still level; then the
@@ -93,30 +94,42 @@ double runout_position(const mixsph_sim *s, const struct monitor_def *md, double
     return run;
 }
 
+/* A particle the gauge's column may pass through: a mobile or held particle of any medium in
+ * the window, not spray (the medium's own neighbours; grains under or in the water belong to
+ * the column as much as the water does). */
+static int in_gauge_column(const struct monitor_def *md, const struct particles *P, size_t i)
+{
+    return P->state[i] <= MIXSPH_STATE_FIXED && P->nneigh[i] >= md->min_neighbours &&
+           fabs(P->pos[0][i] - md->point_x) <= md->window;
+}
+
 double wave_gauge_elevation(const mixsph_sim *s, const struct monitor_def *md)
 {
     const struct particles *P = &s->phys.P;
     const double dx = s->phys.dx, gap = GAUGE_GAP_OVER_DX * dx;
     double top = INFINITY;
     for (size_t i = 0; i < P->n; i++)
-        if (of_medium(md, P, i) && P->nneigh[i] >= md->min_neighbours && fabs(P->pos[0][i] - md->point_x) <= md->window)
-            top = fmin(top, P->pos[DIM_UP][i]);
+        if (in_gauge_column(md, P, i) && P->medium[i] == md->medium) top = fmin(top, P->pos[DIM_UP][i]);
     if (isinf(top)) return NAN;
-    /* follow the column up: the highest particle within `gap` above the top so far, until none is
-     * (each round moves the top to a higher particle, so the rounds end; about the column's
-     * height / (2 dx) of them) */
+    /* follow the column up from its lowest particle of the medium: the highest particle (of any
+     * medium) within `gap` above the top so far, until none is (each round moves the top to a
+     * higher particle, so the rounds end; about the column's height / (2 dx) of them) */
     for (;;) {
         double next = top;
         for (size_t i = 0; i < P->n; i++) {
-            if (!of_medium(md, P, i) || P->nneigh[i] < md->min_neighbours || fabs(P->pos[0][i] - md->point_x) > md->window)
-                continue;
+            if (!in_gauge_column(md, P, i)) continue;
             const double z = P->pos[DIM_UP][i];
             if (z > next && z <= top + gap) next = z;
         }
         if (!(next > top)) break;
         top = next;
     }
-    return top + 0.5 * dx - md->still;
+    /* the surface: the highest particle of the medium in the column so followed */
+    double surface = -INFINITY;
+    for (size_t i = 0; i < P->n; i++)
+        if (in_gauge_column(md, P, i) && P->medium[i] == md->medium && P->pos[DIM_UP][i] <= top)
+            surface = fmax(surface, P->pos[DIM_UP][i]);
+    return surface + 0.5 * dx - md->still;
 }
 
 int slide_impact_now(const mixsph_sim *s, const struct monitor_def *md, double out[IMPACT_N])
