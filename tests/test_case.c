@@ -599,11 +599,12 @@ static void test_table_variants(void **state)
     (void)state;
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"max_elevation\", \"medium\": \"water\", \"direction\": \"+x\"",
-                      ORIGIN ": monitors.front.direction: a max_elevation monitor does not take this key (only front)");
+                      ORIGIN ": monitors.front.direction: a max_elevation monitor does not take this key (only front, runout "
+                      "or slide_impact)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"kinetic_energy\", \"medium\": \"water\", \"min_neighbours\": 3",
                       ORIGIN ": monitors.front.min_neighbours: a kinetic_energy monitor does not take this key "
-                      "(only front, max_elevation or profile)");
+                      "(only front, max_elevation, profile, runout, wave_gauge or slide_impact)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"medium\": \"water\"",
                       ORIGIN ": monitors.front.medium: a wall_pressure monitor does not take this key");
@@ -616,7 +617,8 @@ static void test_table_variants(void **state)
                       "\"type\": \"pressure_probe\", \"x\": 0.1", ORIGIN ": monitors.front.z: missing (expected a number)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"wall_pressure\", \"wall\": \"tank\", \"x\": 0.1",
-                      ORIGIN ": monitors.front.x: a wall_pressure monitor does not take this key (only pressure_probe)");
+                      ORIGIN ": monitors.front.x: a wall_pressure monitor does not take this key (only pressure_probe or "
+                      "wave_gauge)");
     EXPECT_EDIT_ERROR("\"type\": \"front\", \"medium\": \"water\", \"direction\": \"+x\"",
                       "\"type\": \"front\", \"direction\": \"+x\"", ORIGIN ": monitors.front.medium: missing (expected a string)");
 }

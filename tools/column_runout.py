@@ -2,8 +2,9 @@
 """Dry granular columns of several aspect ratios: their deposits against the experimental laws,
 and whether they come to rest.
 
-    python tools/column_runout.py [--aspects 0.5,1,2] [--dx 0.01] [--set KEY=VALUE]... [--out out/column_runout]
-                                  [--jobs J] [--threads N] [--reuse]
+    python tools/column_runout.py [--aspects 0.5,1,2] [--dx 0.01] [--refine] [--threshold 0.02]
+                                  [--set KEY=VALUE]... [--out out/column_runout] [--jobs J] [--threads N] [--reuse]
+                                  [--check]
     mixsph-validate runout ...      (the same, installed by ./tools/do setup)
 
 The case (cases/column_collapse.json): a column of width L0 (the case's parameter, 0.2 m) and
@@ -29,12 +30,28 @@ the front's speed over the last 0.05 s; the fraction of grains slower than 1 mm/
 of a deposit at rest (docs/validation/granular.md): the front below 1 mm/s and at least 95 % of
 the grains below 1 mm/s at 5 T.
 
+The threshold measures (issue 59): the script runs the case with three monitors of its own added
+(OUT/case_column.json): `deposit`, a runout monitor (docs/cases.md) whose run-out is where the
+deposit is still --threshold thick (default 0.02 m: two spacings at dx = 0.01; a grain size, the
+threshold of Feng et al. 2021, is far below what a particle of 5-10 mm resolves), with the
+deposit's thickest column as H_inf; `speed_p99` and `speed_max`, the 0.99 quantile and the
+largest speed of the grains. Criteria, each within 15 % of the fits (2D continuum against
+quasi-2D experiments): the threshold run-out (for 1.8 < a < 2.8, where Lube et al. give no fit,
+within 15 % of the band between the two fits: the ends 1.2 a and 1.9 a^(2/3) scaled by 0.85 and
+1.15), the height H_inf / L0, and 99 % of the grains below 1 mm/s at 5 T. --refine runs each
+column at dx and at dx / 2 and gives the change from one to the other; --check makes the exit
+status 1 when a criterion fails (the validation suite's test).
+
 Written: OUT/column_runout.md, .csv and OUT/column_runout.png (run-out and height against a
-with the laws). Exit status: 0 ok; 1 a run failed; 2 bad usage or input; 130 interrupted.
+with the laws), OUT/column_threshold.md (the threshold measures and criteria). Exit status: 0 ok;
+1 a run failed (or, with --check, a criterion); 2 bad usage or input; 130 interrupted.
 """
 
+import dataclasses
+import json
 import math
 import os
+import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -50,11 +67,14 @@ from mixsph_tools import campaign, fmt, show  # noqa: E402
 PROG = "tools/column_runout.py"
 STOP_SPEED = 1e-3        # [m/s] "at rest"
 AT_REST_FRACTION = 0.95  # of the grains slower than STOP_SPEED
+CRITERION = 0.15         # the threshold run-out and H_inf within 15 % of the fits (issue 59)
+QUANTILE_AT_REST = 0.99  # this quantile of the grains' speeds below STOP_SPEED at 5 T
 SPEED_WINDOW = 0.05      # [s] the front's speed over this window
 REST_TIMES = 5.0         # the deposit is judged at this many T = sqrt(H0 / g)
 T_TOL = 1e-3
 STAMP = "column_runout.json"
 STAMP_KEYS = ("aspect", "L0", "dx", "t_end", "case_sha256", "sets")
+GRAIN_MEDIUM = "sand"    # the column's medium in cases/column_collapse.json
 
 
 def lube_runout(a):
@@ -82,6 +102,9 @@ class Result(campaign.RunResult):
     front_speed: float = math.nan  # [m/s] over SPEED_WINDOW before 5 T
     slow_fraction: float = math.nan  # grains slower than STOP_SPEED in the snapshot at 5 T
     t_snapshot: float = math.nan
+    runout_thr: float = math.nan  # (x where the deposit is --threshold thick - L0) / L0 at 5 T
+    height_thr: float = math.nan  # the deposit's thickest column / L0 at 5 T
+    speed_p99: float = math.nan   # [m/s] the 0.99 quantile of the grains' speeds at 5 T
 
 
 def parse_aspects(text):
@@ -121,6 +144,10 @@ def load_result(job, a, L0, g):
     r.height = value_at(t, np.asarray(mon["height"], float), r.t_rest) / L0
     back = value_at(t, front, r.t_rest - SPEED_WINDOW)
     r.front_speed = abs(value_at(t, front, r.t_rest) - back) / SPEED_WINDOW
+    if "deposit" in mon:
+        r.runout_thr = (value_at(t, np.asarray(mon["deposit"], float), r.t_rest) - L0) / L0
+        r.height_thr = value_at(t, np.asarray(mon["deposit_height"], float), r.t_rest) / L0
+        r.speed_p99 = value_at(t, np.asarray(mon["speed_p99"], float), r.t_rest)
     snap = mt.nearest_snapshot(job.outdir, r.t_rest)
     if snap is not None:
         r.t_snapshot, cols = mt.read_snapshot(snap[1])
@@ -150,6 +177,65 @@ def table(results):
     return columns, rows
 
 
+def with_threshold_monitors(case_json, threshold):
+    """A copy of the column case with the monitors of the threshold measures added: the deposit's
+    run-out and height over the floor (x from 0, the wall, to the floor's end) and the grains'
+    speeds."""
+    out = json.loads(json.dumps(case_json))
+    mons = out.setdefault("monitors", {})
+    mons["deposit"] = {"type": "runout", "medium": GRAIN_MEDIUM, "x_min": 0.0, "x_max": "$floor_end",
+                       "threshold": threshold, "direction": "+x"}
+    mons["speed_p99"] = {"type": "speed", "medium": GRAIN_MEDIUM, "quantile": QUANTILE_AT_REST}
+    mons["speed_max"] = {"type": "speed", "medium": GRAIN_MEDIUM}
+    return out
+
+
+def within_fit(value, lo, hi):
+    """The relative distance [-] of value from the fit (lo == hi) or the band [lo, hi]: 0 inside."""
+    if not math.isfinite(value):
+        return math.nan
+    if value < lo:
+        return (value - lo) / lo
+    return (value - hi) / hi if value > hi else 0.0
+
+
+def criteria(r):
+    """(run-out ok, height ok, at rest ok) of a result against the criteria (CRITERION)."""
+    lo, hi = lube_runout(r.aspect)
+    run = abs(within_fit(r.runout_thr, lo, hi)) <= CRITERION
+    hl = lube_height(r.aspect)
+    height = abs(within_fit(r.height_thr, hl, hl)) <= CRITERION
+    rest = r.speed_p99 < STOP_SPEED
+    return run, height, rest
+
+
+def threshold_table(results, coarse):
+    """The threshold measures, one row per run; coarse[k]: the run at twice the spacing of run k
+    (None): the change from it."""
+    yn = {True: "yes", False: "**no**"}
+    columns = [("", "a", ">"), ("", "dx", ">"), ("", "status", "<"), ("", "wall s", ">"),
+               ("run-out", "run", ">"), ("run-out", "Lube", ">"), ("run-out", "off fit %", ">"),
+               ("run-out", "ok", "<"), ("run-out", "vs 2 dx %", ">"),
+               ("H_inf / L0", "run", ">"), ("H_inf / L0", "Lube", ">"), ("H_inf / L0", "off %", ">"),
+               ("H_inf / L0", "ok", "<"), ("H_inf / L0", "vs 2 dx %", ">"),
+               ("at 5T", "99 % speed mm/s", ">"), ("at 5T", "< 1 mm/s", "<")]
+    rows = []
+    for r, c in zip(results, coarse):
+        lo, hi = lube_runout(r.aspect)
+        hl = lube_height(r.aspect)
+        run_ok, h_ok, rest_ok = criteria(r)
+        law = fmt(lo, ".2f") if lo == hi else f"{lo:.2f}-{hi:.2f}"
+        d_run = 100 * (r.runout_thr - c.runout_thr) / c.runout_thr if c else math.nan
+        d_h = 100 * (r.height_thr - c.height_thr) / c.height_thr if c else math.nan
+        rows.append([fmt(r.aspect, "g"), fmt(r.dx, "g"), "ok" if r.ok else r.status, fmt(r.wall, ".3g"),
+                     fmt(r.runout_thr, ".2f"), law, fmt(100 * within_fit(r.runout_thr, lo, hi), "+.0f"),
+                     yn[run_ok], fmt(d_run, "+.0f", ""),
+                     fmt(r.height_thr, ".2f"), fmt(hl, ".2f"), fmt(100 * within_fit(r.height_thr, hl, hl), "+.0f"),
+                     yn[h_ok], fmt(d_h, "+.0f", ""),
+                     fmt(1e3 * r.speed_p99, ".2g"), yn[rest_ok]])
+    return columns, rows
+
+
 def plot(path, results):
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     aa = np.linspace(0.2, max(3.0, max(r.aspect for r in results) * 1.2), 200)
@@ -175,13 +261,21 @@ OPTIONS = campaign.CaseOptions(
     runs="", known=(), dx=0.01, out="column_runout", case="column_collapse.json", t_end="1.5 s",
     dx_help="particle spacing [m] (default 0.01)", set_example="media.sand.phi=30", twin_help=None, sphera=(),
     progress=120.0,
-    own=(("--aspects", dict(default="0.5,1,2", help="aspect ratios H0 / L0 (default 0.5,1,2)")),))
+    own=(("--aspects", dict(default="0.5,1,2", help="aspect ratios H0 / L0 (default 0.5,1,2)")),
+         ("--threshold", dict(type=float, default=0.02, help="the deposit's thickness at its threshold run-out [m] "
+                                                             "(default 0.02)")),
+         ("--refine", dict(action="store_true", help="also run each column at dx / 2 and give the change")),
+         ("--check", dict(action="store_true", help="exit status 1 when a threshold criterion fails")),
+         ("--doc", dict(help="also write the threshold table (with the command) to this file"))))
 
 
 def run(argv=None, prog=PROG):
     args = campaign.parse_args(prog, OPTIONS, argv)
     aspects = parse_aspects(args.aspects)
-    s = campaign.settings(args, prog, OPTIONS, len(aspects))
+    if not (args.threshold > 0 and math.isfinite(args.threshold)):
+        raise mt.ToolError(f"--threshold {args.threshold:g}: expected a positive thickness [m]")
+    spacings = [args.dx, args.dx / 2] if args.refine else [args.dx]
+    s = campaign.settings(args, prog, OPTIONS, len(aspects) * len(spacings))
     params = s.case_json.get("parameters") or {}
     L0, g = params.get("L0"), s.case_json.get("gravity")
     if not isinstance(L0, (int, float)) or not isinstance(g, (int, float)):
@@ -193,16 +287,29 @@ def run(argv=None, prog=PROG):
     if too_short:
         raise mt.ToolError(f"t_end = {s.t_end:g} s is shorter than 5 sqrt(H0/g) of a = "
                            f"{','.join(f'{a:g}' for a in too_short)}: give --t-end")
-    jobs = []
+    # the case with the threshold monitors, written once the options are known to be good
+    case_json = with_threshold_monitors(s.case_json, args.threshold)
+    case = os.path.join(s.out, "case_column.json")
+    os.makedirs(s.out, exist_ok=True)
+    with open(case, "w") as f:
+        json.dump(case_json, f, indent=2)
+        f.write("\n")
+    s = dataclasses.replace(s, case=case, case_json=case_json, case_sha=campaign.case_digest(case))
+    jobs, runs = [], []
     for a in aspects:
-        t_rest = REST_TIMES * math.sqrt(a * L0 / g)
-        own = list(geometry(a, L0).items()) + [("output.snapshot_interval", t_rest / 5.0)]
-        head = {"aspect": a, "L0": L0, "dx": args.dx}
-        tail = {"sets": [list(x) for x in s.extra]}
-        jobs.append(campaign.make_job(s, a, f"a = {a:g}", args.dx, f"a{a:g}_dx{args.dx:g}", own + list(s.extra),
-                                      head, tail))
-    failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL, what=f" at dx = {args.dx:g} m")
-    results = [load_result(job, a, L0, g) for job, a in zip(jobs, aspects)]
+        for dx in spacings:
+            t_rest = REST_TIMES * math.sqrt(a * L0 / g)
+            own = list(geometry(a, L0).items()) + [("output.snapshot_interval", t_rest / 5.0)]
+            head = {"aspect": a, "L0": L0, "dx": dx}
+            tail = {"sets": [list(x) for x in s.extra]}
+            jobs.append(campaign.make_job(s, a, f"a = {a:g}, dx = {dx:g}", dx, f"a{a:g}_dx{dx:g}",
+                                          own + list(s.extra), head, tail))
+            runs.append((a, dx))
+    spacing_text = " and ".join(f"{dx:g}" for dx in spacings)
+    failed = campaign.run(s, jobs, STAMP, STAMP_KEYS, T_TOL, what=f" at dx = {spacing_text} m")
+    results = [load_result(job, a, L0, g) for job, (a, _) in zip(jobs, runs)]
+    coarse = [next((c for c, (a2, dx2) in zip(results, runs) if a2 == a and abs(dx2 - 2 * dx) < 1e-12), None)
+              for a, dx in runs]
     columns, rows = table(results)
     print()
     mt.print_table(columns, rows)
@@ -213,8 +320,23 @@ def run(argv=None, prog=PROG):
                 + (", " + " ".join(f"--set {k}={mt.num(v)}" for k, v in s.extra) if s.extra else "") + "\n\n")
         f.write("\n".join(mt.markdown_table([(g_, f"{g_} {h}".strip(), al) for g_, h, al in columns], rows)) + "\n")
     plot(png, results)
-    print(f"\ntable: {show(md)}, {show(csv_path)}\nplot:  {show(png)}")
+    t_columns, t_rows = threshold_table(results, coarse)
+    print(f"\nthreshold measures (run-out where the deposit is {args.threshold:g} m thick; criteria within "
+          f"{100 * CRITERION:g} % of the fits, 99 % of the grains below 1 mm/s at 5 T):")
+    mt.print_table(t_columns, t_rows)
+    md_thr = os.path.join(s.out, "column_threshold.md")
+    command = mt.reproduce_command(PROG, list(argv if argv is not None else sys.argv[1:]))
+    text = (f"Columns of cases/column_collapse.json at dx = {spacing_text} m, L0 = {L0:g} m, threshold "
+            f"{args.threshold:g} m" + (", " + " ".join(f"--set {k}={mt.num(v)}" for k, v in s.extra) if s.extra else "")
+            + "\n\n" + "\n".join(mt.markdown_table([(g_, f"{g_} {h}".strip(), al) for g_, h, al in t_columns], t_rows))
+            + "\n\n```sh\n" + command + "\n```\n")
+    for path in [md_thr] + ([args.doc] if args.doc else []):
+        with open(path, "w") as f:
+            f.write(text)
+    print(f"\ntable: {show(md)}, {show(csv_path)}, {show(md_thr)}\nplot:  {show(png)}")
     campaign.check_failed(failed)
+    if args.check and not all(all(criteria(r)) for r in results):
+        raise SystemExit(1)
 
 
 def main(argv=None, prog=PROG):

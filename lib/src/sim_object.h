@@ -33,7 +33,7 @@
 #define SIM_CELL_COLUMNS 4
 #endif
 
-#define SIM_MAX_OUTPUTS (14 + CASE_MAX_MONITORS)
+#define SIM_MAX_OUTPUTS (14 + CASE_MAX_SCALAR_OUTPUTS)
 
 /* The physical state: what a state file or a checkpoint restores (io/state.c). */
 struct sim_physics {

@@ -19,6 +19,25 @@ def num(v):
     return str(int(v)) if v.is_integer() and abs(v) < 1e16 else repr(v)
 
 
+def reproduce_command(script, args, drop=("--mixsph", "--doc", "--out")):
+    """The command that reproduces a script's table from the source folder: ``script`` (its path
+    from there) with ``args``, less the options in ``drop`` and their values (where the
+    executable is, where the runs and the table go do not change the numbers)."""
+    import shlex
+    kept, skip = [], False
+    for a in args:
+        if skip:
+            skip = False
+            continue
+        if a in drop:
+            skip = True
+            continue
+        if any(a.startswith(d + "=") for d in drop):
+            continue
+        kept.append(a)
+    return "PYTHONPATH=$PWD .venv/bin/python " + shlex.join([script] + kept)
+
+
 def fmt(v, spec, na="n/a"):
     """``format(v, spec)`` for a finite number, else ``na``."""
     return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na

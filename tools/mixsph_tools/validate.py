@@ -6,6 +6,8 @@
     mixsph-validate column --runs 1,2,3 --jobs 2      # tools/column_collapse.py, docs/validation/granular.md
     mixsph-validate convergence --set numerics.viscosity=1   # tools/vajont_convergence.py, docs/validation/vajont.md
     mixsph-validate runout --aspects 0.5,1,2                 # tools/column_runout.py, docs/validation/granular.md
+    mixsph-validate heap --refine                            # tools/granular_heap.py, docs/validation/granular.md
+    mixsph-validate impulse --refine                         # tools/impulse_waves.py, docs/validation/granular.md
     mixsph-validate step --case cases/column_collapse.json   # tools/step_independence.py, docs/validation/granular.md
 
 CASE's options, outputs and exit status are its script's (``mixsph-validate CASE --help``).
@@ -22,6 +24,9 @@ CASES = {
     "column": ("column_collapse", "a dry granular column collapse: does the deposit come to rest?"),
     "runout": ("column_runout", "dry columns of several aspect ratios against the run-out and final-height "
                "laws of Lube et al. (2005); do their deposits rest?"),
+    "heap": ("granular_heap", "a heap 3 degrees below phi stays; a 45-degree heap fails and rests near phi"),
+    "impulse": ("impulse_waves", "impulse waves of granular slides against a_M / h = (4/9) P^0.8 of Heller & "
+                "Hager (2010)"),
     "step": ("step_independence", "a case at its default time step, half and a quarter of it, against the "
              "spread of gravity-perturbed twins"),
     "convergence": ("vajont_convergence", "Vajont V1 against the particle spacing, and the cheapest spacing "

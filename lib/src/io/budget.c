@@ -187,7 +187,7 @@ mixsph_status budget_check(const struct case_def *c, char *err, size_t err_len)
     }
     for (size_t k = 0; k < c->n_monitors; k++) {
         const struct monitor_def *md = &c->monitors[k];
-        if (md->kind != MONITOR_PROFILE) continue;
+        if (md->kind != MONITOR_PROFILE && md->kind != MONITOR_RUNOUT) continue;
         const double bins = case_profile_bin_count(md);
         if (within(bins, c->max_profile_bins)) continue;
         num(md->bin, val, sizeof val);

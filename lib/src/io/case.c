@@ -661,7 +661,9 @@ static mixsph_status read_monitors(const struct case_reader *r, const cJSON *roo
         md->point_y = 0.0;
         /* the type first: it says which keys the monitor takes */
         TRY(case_schema_read_key(r, it, path, case_schema_key(sec, "type"), md));
-        if (md->kind == MONITOR_PROFILE) md->bin = c->dx;
+        if (md->kind == MONITOR_PROFILE || md->kind == MONITOR_RUNOUT) md->bin = c->dx;
+        md->window = 2.0 * c->dx;
+        md->quantile = 1.0;
         TRY(case_schema_read(r, it, path, sec, 1u << md->kind, md));
         if (!(md->x_max > md->x_min) || !(md->z_max > md->z_min))
             return FAIL(r, "%s: %s: expected x_min < x_max and z_min < z_max", r->origin, path);
@@ -678,6 +680,12 @@ static mixsph_status read_monitors(const struct case_reader *r, const cJSON *roo
         const char *medium = item(it, "medium")->valuestring;
         md->medium = find_medium(c, medium);
         if (md->medium < 0) return FAIL(r, "%s: %s.medium: '%s' is not one of the media", r->origin, path, medium);
+        for (const char *const *x = case_monitor_extras(md->kind); *x; x++)
+            if (strlen(md->name) + strlen(*x) >= CASE_NAME_LEN)
+                return FAIL(r, "%s: %s: the name is too long for the monitor's output '%s%s' (expected at most %d "
+                            "characters)", r->origin, path, md->name, *x, (int)(CASE_NAME_LEN - 1 - strlen(*x)));
+        if (md->kind == MONITOR_RUNOUT && (!isfinite(md->x_min) || !isfinite(md->x_max)))
+            return FAIL(r, "%s: %s: a runout monitor needs x_min and x_max (the span of its columns)", r->origin, path);
         if (md->kind == MONITOR_PROFILE) {
             if (!isfinite(md->x_min) || !isfinite(md->x_max))
                 return FAIL(r, "%s: %s: a profile needs x_min and x_max", r->origin, path);
@@ -710,7 +718,13 @@ static mixsph_status read_full_scale(const struct case_reader *r, const cJSON *r
     fs->ref_monitor = -1;
     const cJSON *f = item(root, "full_scale");
     size_t n_scalar = 0;
-    for (size_t k = 0; k < c->n_monitors; k++) n_scalar += c->monitors[k].kind != MONITOR_PROFILE;
+    for (size_t k = 0; k < c->n_monitors; k++) {
+        n_scalar += c->monitors[k].kind != MONITOR_PROFILE;
+        for (const char *const *x = case_monitor_extras(c->monitors[k].kind); *x; x++) n_scalar++;
+    }
+    if (!f && n_scalar > CASE_MAX_SCALAR_OUTPUTS)
+        return FAIL(r, "%s: monitors: %zu scalar outputs (expected at most %d; runout has 2, slide_impact 4, "
+                    "the other scalar monitors 1)", r->origin, n_scalar, CASE_MAX_SCALAR_OUTPUTS);
     if (!f) return MIXSPH_OK;
     TRY(case_schema_read(r, f, "full_scale", section("full_scale"), 0, fs));
     for (size_t k = 0; k < c->n_monitors; k++) {
@@ -760,6 +774,14 @@ mixsph_status case_number(const struct case_def *c, const char *key, double *val
         return status_set(err, err_len, MIXSPH_ERR_ARG,
                           "%s: not a numeric key of the case's top level, numerics or output", key);
     return MIXSPH_OK;
+}
+
+const char *const *case_monitor_extras(int kind)
+{
+    static const char *const none[] = {NULL};
+    static const char *const runout[] = {"_height", NULL};
+    static const char *const impact[] = {"_speed", "_thickness", "_mass", NULL};
+    return kind == MONITOR_RUNOUT ? runout : kind == MONITOR_SLIDE_IMPACT ? impact : none;
 }
 
 double case_profile_bin_count(const struct monitor_def *md)

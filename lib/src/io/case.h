@@ -45,7 +45,11 @@ enum monitor_kind {
     MONITOR_WALL_PRESSURE = 3,
     MONITOR_KINETIC_ENERGY = 4,
     MONITOR_WALL_WORK = 5,
-    MONITOR_PRESSURE_PROBE = 6
+    MONITOR_PRESSURE_PROBE = 6,
+    MONITOR_RUNOUT = 7,       /* threshold monitors (monitors.c) */
+    MONITOR_WAVE_GAUGE = 8,
+    MONITOR_SLIDE_IMPACT = 9,
+    MONITOR_SPEED = 10
 };
 
 struct monitor_def {
@@ -56,21 +60,31 @@ struct monitor_def {
                                  sensor (point_x, point_z) sits on, -1 for a point in the flow */
     double point_x, point_z;  /* pressure_probe: the point [m] (on a wall: the sensor, at t = 0) */
     double point_y;           /* pressure_probe in 3D: the point's y [m] */
-    int direction;            /* front: +1 largest x, -1 smallest x */
+    int direction;            /* front, runout: +1 largest x, -1 smallest x; slide_impact: the ramp descends
+                                 towards +x (+1) or -x (-1) */
     double x_min, x_max;      /* region [m] (infinite when not given) */
     double z_min, z_max;
     double y_min, y_max;      /* 3D: the region across y [m] (infinite when not given) */
     int min_neighbours;       /* particles with fewer same-medium neighbours are spray, ignored */
-    double bin;               /* profile: bin width [m] */
+    double bin;               /* profile, runout: bin (column) width [m] */
+    double threshold;         /* runout: a column belongs to the deposit when it is at least this thick [m] */
+    double still;             /* wave_gauge, slide_impact: the still water level (z) [m] */
+    double window;            /* wave_gauge: half-width of the gauge's window around point_x [m] */
+    double angle;             /* slide_impact: the ramp's angle to the horizontal [deg] */
+    double quantile;          /* speed: the quantile of the medium's particle speeds, in (0, 1] */
     size_t n_times;           /* profile: times at which it is written [s] */
     double times[CASE_MAX_PROFILE_TIMES];
     int at_max_of;            /* profile: max_elevation monitor at whose every new maximum the profile is
                                  rewritten (profile_<name>_atmax.csv), -1 for none */
 };
 
-/* Scalar outputs that the case's monitors may add (the scalar monitors and the full-scale
- * outputs below); monitors.c adds its diagnostics and checks that all fit in SIM_MAX_OUTPUTS. */
-#define CASE_MAX_SCALAR_OUTPUTS (CASE_MAX_MONITORS + 1)
+/* Scalar outputs that the case's monitors may add (the scalar monitors, the further outputs of
+ * the monitors that have several, and the full-scale outputs below); monitors.c adds its
+ * diagnostics and checks that all fit in SIM_MAX_OUTPUTS. */
+#define CASE_MAX_SCALAR_OUTPUTS (2 * CASE_MAX_MONITORS + 1)
+/* A monitor's further outputs <name><suffix> beyond its own <name> (runout: the deposit's
+ * height; slide_impact: the slide's speed, thickness and mass at the impact) */
+#define CASE_MAX_MONITOR_EXTRAS 3
 #define CASE_FULL_SCALE_SUFFIX_Z "_Z"        /* output <m>_Z: full-scale elevation of monitor m */
 #define CASE_FULL_SCALE_SUFFIX_ERR "_d_eta"  /* output <m>_d_eta: error (13) [%] of its highest value */
 
@@ -132,6 +146,10 @@ void case_free(struct case_def *c);
  *  "t_end"...: the file's, an override's or the default; a choice as its value). MIXSPH_ERR_ARG,
  *  with a message, for any other key. */
 mixsph_status case_number(const struct case_def *c, const char *key, double *value, char *err, size_t err_len);
+
+/** The suffixes of the further outputs <name><suffix> of a monitor of this kind (NULL-terminated;
+ *  empty for a monitor with one output). */
+const char *const *case_monitor_extras(int kind);
 
 /** Full-scale elevation of a lab elevation z [m] (the case's full_scale map; z itself without one). */
 double case_full_scale_z(const struct case_def *c, double z);

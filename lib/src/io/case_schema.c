@@ -55,6 +55,10 @@ static const struct case_choice monitor_types[] = {{"front", MONITOR_FRONT},
                                                    {"wall_pressure", MONITOR_WALL_PRESSURE},
                                                    {"wall_work", MONITOR_WALL_WORK},
                                                    {"pressure_probe", MONITOR_PRESSURE_PROBE},
+                                                   {"runout", MONITOR_RUNOUT},
+                                                   {"wave_gauge", MONITOR_WAVE_GAUGE},
+                                                   {"slide_impact", MONITOR_SLIDE_IMPACT},
+                                                   {"speed", MONITOR_SPEED},
                                                    {NULL, 0}};
 
 /* ---- the tables ------------------------------------------------------------------------------ */
@@ -200,10 +204,13 @@ static const struct case_key motion_keys[] = {
                 "stroke_scale / time_scale)"},
 };
 
-#define PARTICLE_MONITORS (V(MONITOR_FRONT) | V(MONITOR_MAX_ELEVATION) | V(MONITOR_PROFILE))
-#define MEDIUM_MONITORS (PARTICLE_MONITORS | V(MONITOR_KINETIC_ENERGY))
+#define PARTICLE_MONITORS                                                                                         \
+    (V(MONITOR_FRONT) | V(MONITOR_MAX_ELEVATION) | V(MONITOR_PROFILE) | V(MONITOR_RUNOUT) | V(MONITOR_WAVE_GAUGE) | \
+     V(MONITOR_SLIDE_IMPACT))
+#define MEDIUM_MONITORS (PARTICLE_MONITORS | V(MONITOR_KINETIC_ENERGY) | V(MONITOR_SPEED))
 #define WALL_MONITORS (V(MONITOR_WALL_PRESSURE) | V(MONITOR_WALL_WORK))
-#define REGION_MONITORS (MEDIUM_MONITORS | V(MONITOR_WALL_PRESSURE)) /* (a wall's work is the whole wall's) */
+/* (a wall's work is the whole wall's; a wave gauge's window is its own) */
+#define REGION_MONITORS ((MEDIUM_MONITORS & ~V(MONITOR_WAVE_GAUGE)) | V(MONITOR_WALL_PRESSURE))
 static const struct case_key monitor_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = monitor_types,
      .field = CASE_FIELD(monitor_def, kind), .meaning = "what the monitor measures (below)"},
@@ -213,22 +220,25 @@ static const struct case_key monitor_keys[] = {
      .only = WALL_MONITORS | V(MONITOR_PRESSURE_PROBE),
      .meaning = "name of one of the walls (pressure_probe: the wall whose sensor the point is; without it the point "
                 "is in the flow)"},
-    {.key = "x", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
-     .field = CASE_FIELD(monitor_def, point_x),
-     .meaning = "the probe's point: with `wall`, the sensor's place on that wall (at t = 0), within dx/2 of it"},
+    {.key = "x", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE) | V(MONITOR_WAVE_GAUGE),
+     .unit = "m", .field = CASE_FIELD(monitor_def, point_x),
+     .meaning = "pressure_probe: the probe's point; with `wall`, the sensor's place on that wall (at t = 0), within dx/2 "
+                "of it. wave_gauge: the gauge's station"},
     {.key = "y", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "3D", ANYWHERE,
      .only = V(MONITOR_PRESSURE_PROBE), .unit = "m", .field = CASE_FIELD(monitor_def, point_y),
      .meaning = "3D: the probe's point across"},
     {.key = "z", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .only = V(MONITOR_PRESSURE_PROBE), .unit = "m",
      .field = CASE_FIELD(monitor_def, point_z), .meaning = "height of the probe's point"},
-    {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions, .only = V(MONITOR_FRONT),
-     .field = CASE_FIELD(monitor_def, direction), .meaning = "\"+x\": the largest x of the medium, \"-x\": the smallest"},
+    {.key = "direction", .type = CASE_CHOICE, DEF(1), .choices = directions,
+     .only = V(MONITOR_FRONT) | V(MONITOR_RUNOUT) | V(MONITOR_SLIDE_IMPACT), .field = CASE_FIELD(monitor_def, direction),
+     .meaning = "front, runout: \"+x\": the largest x of the medium (of its deposit), \"-x\": the smallest; "
+                "slide_impact: the way the ramp descends"},
     {.key = "min_neighbours", .type = CASE_INTEGER, RANGE(0, 0, 100, 0), DEF(3), .unit = "-", .only = PARTICLE_MONITORS,
      .field = CASE_FIELD(monitor_def, min_neighbours),
      .meaning = "a particle counts only with at least this many neighbours of its own medium within 2h (not spray)"},
-    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY),
+    {.key = "x_min", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile, runout", ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY),
      .unit = "m", .field = CASE_FIELD(monitor_def, x_min), .meaning = "region the monitor looks at: left end"},
-    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile", ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY),
+    {.key = "x_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "profile, runout", ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY),
      .unit = "m", .field = CASE_FIELD(monitor_def, x_max), .meaning = "right end, > x_min"},
     {.key = "y_min", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(-INFINITY), .unit = "m",
      .field = CASE_FIELD(monitor_def, y_min), .meaning = "3D: the region's side at the smallest y"},
@@ -238,13 +248,29 @@ static const struct case_key monitor_keys[] = {
      .meaning = "bottom"},
     {.key = "z_max", .type = CASE_NUMBER, ANYWHERE, .only = REGION_MONITORS, DEF(INFINITY), .unit = "m", .field = CASE_FIELD(monitor_def, z_max),
      .meaning = "top, > z_min"},
-    {.key = "bin", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .def_text = "dx", .unit = "m", .only = V(MONITOR_PROFILE),
-     .field = CASE_FIELD(monitor_def, bin), .meaning = "width of the x bins"},
+    {.key = "bin", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .def_text = "dx", .unit = "m", .only = V(MONITOR_PROFILE) | V(MONITOR_RUNOUT),
+     .field = CASE_FIELD(monitor_def, bin), .meaning = "width of the x bins (runout: of the deposit's columns)"},
     {.key = "times", .type = CASE_NUMBERS, .need = CASE_SOMETIMES, .need_text = "unless at_max_of", .lo = 1,
      .unit = "s", .only = V(MONITOR_PROFILE), .meaning = "times at which the profile is written, increasing (at most 16)"},
     {.key = "at_max_of", .type = CASE_NAME, .only = V(MONITOR_PROFILE),
      .meaning = "name of a max_elevation monitor: the profile is also written at each new highest value of that "
                 "monitor (`profile_<name>_atmax.csv`)"},
+    {.key = "threshold", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 1e3, 0), .unit = "m",
+     .only = V(MONITOR_RUNOUT), .field = CASE_FIELD(monitor_def, threshold),
+     .meaning = "a column is part of the deposit where the medium is at least this thick (e.g. a grain size, or 2 dx)"},
+    {.key = "still", .type = CASE_NUMBER, .need = CASE_REQUIRED, ANYWHERE, .unit = "m",
+     .only = V(MONITOR_WAVE_GAUGE) | V(MONITOR_SLIDE_IMPACT), .field = CASE_FIELD(monitor_def, still),
+     .meaning = "the still water level (z): wave_gauge: eta is measured from it; slide_impact: the slide's front "
+                "crossing it is the impact"},
+    {.key = "window", .type = CASE_NUMBER, RANGE(0, 1, 1e3, 0), .def_text = "2 dx", .unit = "m",
+     .only = V(MONITOR_WAVE_GAUGE), .field = CASE_FIELD(monitor_def, window),
+     .meaning = "the gauge reads the particles within this distance of x"},
+    {.key = "angle", .type = CASE_NUMBER, .need = CASE_REQUIRED, RANGE(0, 1, 90, 1), .unit = "degree",
+     .only = V(MONITOR_SLIDE_IMPACT), .field = CASE_FIELD(monitor_def, angle),
+     .meaning = "the ramp's angle to the horizontal (the slide's thickness is taken normal to it)"},
+    {.key = "quantile", .type = CASE_NUMBER, RANGE(0, 1, 1, 0), DEF(1), .unit = "-", .only = V(MONITOR_SPEED),
+     .field = CASE_FIELD(monitor_def, quantile),
+     .meaning = "the quantile of the medium's particle speeds: 1 the largest, 0.99 the speed 99 % of them do not exceed"},
 };
 
 static const struct case_key full_scale_keys[] = {
@@ -276,7 +302,7 @@ static const struct case_key output_keys[] = {
      .meaning = "limit of the resource budget: rows of monitors.csv, t_end / monitor_interval + 1"},
     {.key = "max_profile_bins", .type = CASE_NUMBER, RANGE(1, 0, 1e12, 0), DEF(1e5), .unit = "-",
      .field = CASE_FIELD(case_def, max_profile_bins),
-     .meaning = "limit of the resource budget: x bins of one profile monitor, its width / bin"},
+     .meaning = "limit of the resource budget: x bins of one profile or runout monitor, its width / bin"},
     {.key = "max_snapshot_bytes", .type = CASE_NUMBER, RANGE(1, 0, 1e18, 0), DEF(2e10), .unit = "B",
      .field = CASE_FIELD(case_def, max_snapshot_bytes),
      .meaning = "limit of the resource budget: bytes of all particle snapshots (CSV and HDF5), estimated"},

@@ -20,6 +20,10 @@
  *                    A profile with at_max_of = <m> is also rewritten as
  *                    profile_<name>_atmax.csv whenever the max_elevation monitor m reaches a new
  *                    highest value (so it holds the profile at the time of the maximum run-up).
+ *   runout, wave_gauge, slide_impact, speed - the threshold monitors (threshold_monitors.h):
+ *                    a deposit's run-out (and <name>_height, its thickest column), a gauge's
+ *                    free-surface elevation, a slide's impact into still water (the time, and
+ *                    <name>_speed, _thickness, _mass at it; kept once taken), a quantile of speeds.
  * Full-scale outputs (case key full_scale, case.h): <m>_Z = z_scale z + z_offset of every
  * max_elevation monitor m, and <m>_d_eta of the reference monitor: the error (13) of Manenti et
  * al. (2018), 100 |Z_max - Z_observed| / (Z_observed - Z_still) [%], with Z_max the highest value
@@ -42,6 +46,7 @@
 
 #include "monitors.h"
 #include "particle_fields.h"
+#include "threshold_monitors.h"
 
 #include "status.h"
 
@@ -65,14 +70,15 @@ static const char *const diag_names[OUT_N_DIAG] = {"kinetic_energy", "mass", "dt
 #define OUT_DIAG_CODE(d) (-1 - (int)(d))
 
 /* out_monitor[k] of a monitor output: the case monitor m plus CASE_MAX_MONITORS times the kind
- * of output (the monitor's value, its full-scale elevation, the error (13) of its maximum). */
-enum { OUTK_VALUE = 0, OUTK_FULL_Z = 1, OUTK_FULL_ERR = 2 };
+ * of output (the monitor's value, its full-scale elevation, the error (13) of its maximum, its
+ * further outputs OUTK_EXTRA + j: case_monitor_extras). */
+enum { OUTK_VALUE = 0, OUTK_FULL_Z = 1, OUTK_FULL_ERR = 2, OUTK_EXTRA = 3 };
 #define OUT_CODE(m, kind) ((int)(m) + CASE_MAX_MONITORS * (kind))
 
 _Static_assert(OUT_N_DIAG + CASE_MAX_SCALAR_OUTPUTS <= SIM_MAX_OUTPUTS, "outputs do not fit in SIM_MAX_OUTPUTS");
 
 /* Add the output <monitor m's name><suffix> of the given kind. */
-static void out_add_full_scale(mixsph_sim *s, int m, int kind, const char *suffix)
+static void out_add_named(mixsph_sim *s, int m, int kind, const char *suffix)
 {
     char name[2 * CASE_NAME_LEN];
     const size_t a = strlen(s->cfg.monitors[m].name), b = strlen(suffix);
@@ -198,28 +204,20 @@ mixsph_status monitors_init(mixsph_sim *s)
         if (s->cfg.monitors[k].kind == MONITOR_PROFILE) continue;
         s->out.monitor[s->out.n] = OUT_CODE(k, OUTK_VALUE);
         snprintf(s->out.name[s->out.n++], CASE_NAME_LEN, "%s", s->cfg.monitors[k].name);
+        const char *const *extra = case_monitor_extras(s->cfg.monitors[k].kind);
+        for (int j = 0; extra[j]; j++) out_add_named(s, (int)k, OUTK_EXTRA + j, extra[j]);
     }
     /* case.c checked that the names fit and that there are at most CASE_MAX_SCALAR_OUTPUTS */
     const struct full_scale *fs = &s->cfg.full_scale;
     for (size_t k = 0; fs->on && k < s->cfg.n_monitors; k++)
-        if (s->cfg.monitors[k].kind == MONITOR_MAX_ELEVATION) out_add_full_scale(s, (int)k, OUTK_FULL_Z, CASE_FULL_SCALE_SUFFIX_Z);
-    if (fs->on && fs->ref_monitor >= 0) out_add_full_scale(s, fs->ref_monitor, OUTK_FULL_ERR, CASE_FULL_SCALE_SUFFIX_ERR);
+        if (s->cfg.monitors[k].kind == MONITOR_MAX_ELEVATION) out_add_named(s, (int)k, OUTK_FULL_Z, CASE_FULL_SCALE_SUFFIX_Z);
+    if (fs->on && fs->ref_monitor >= 0) out_add_named(s, fs->ref_monitor, OUTK_FULL_ERR, CASE_FULL_SCALE_SUFFIX_ERR);
     for (size_t k = 0; k < s->out.n; k++) {
         s->out.max[k] = s->out.min[k] = NAN;
         s->out.tmax[k] = s->out.tmin[k] = NAN;
     }
     s->out.n_samples = 0;
     return MIXSPH_OK;
-}
-
-/* Whether particle i lies in the region of a monitor (bounds of x and z; and y in 3D). */
-static int in_region(const struct monitor_def *md, const struct particles *P, size_t i)
-{
-    const double x = P->pos[0][i], z = P->pos[DIM_UP][i];
-#if DIM == 3
-    if (!(P->pos[1][i] >= md->y_min && P->pos[1][i] <= md->y_max)) return 0;
-#endif
-    return x >= md->x_min && x <= md->x_max && z >= md->z_min && z <= md->z_max;
 }
 
 /* |v|^2 of particle i */
@@ -230,13 +228,25 @@ static double speed2(const struct particles *P, size_t i)
     return v2;
 }
 
-static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
+/* Output `part` of a monitor: 0 its value, 1 + j its further output j (case_monitor_extras). */
+static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md, int part)
 {
     const struct particles *P = &s->phys.P;
     double best = NAN;
+    if (md->kind == MONITOR_RUNOUT) {
+        double height;
+        const double run = runout_position(s, md, &height);
+        return part == 0 ? run : height;
+    }
+    if (md->kind == MONITOR_WAVE_GAUGE) return wave_gauge_elevation(s, md);
+    if (md->kind == MONITOR_SPEED) return speed_quantile(s, md);
+    if (md->kind == MONITOR_SLIDE_IMPACT) {
+        double impact[IMPACT_N];
+        return slide_impact_now(s, md, impact) ? impact[part] : NAN; /* parts in enum slide_impact_output order */
+    }
     if (md->kind == MONITOR_WALL_PRESSURE) {
         for (size_t i = 0; i < P->n; i++) {
-            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !in_region(md, P, i)) continue;
+            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !monitor_in_region(md, P, i)) continue;
             int at_end;
             double pos[DIM];
             position_of(P, i, pos);
@@ -255,13 +265,12 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md)
     if (md->kind == MONITOR_KINETIC_ENERGY) { /* sum of m |u|^2 / 2 over the medium in the region [J/m] */
         double e = 0.0;
         for (size_t i = 0; i < P->n; i++)
-            if (P->state[i] <= MIXSPH_STATE_FIXED && P->medium[i] == md->medium && in_region(md, P, i))
+            if (P->state[i] <= MIXSPH_STATE_FIXED && P->medium[i] == md->medium && monitor_in_region(md, P, i))
                 e += 0.5 * P->m[i] * speed2(P, i);
         return e;
     }
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P, i)) continue;
+        if (!monitor_counts(md, P, i)) continue;
         const double v = md->kind == MONITOR_FRONT ? md->direction * P->pos[0][i] : P->pos[DIM_UP][i];
         if (isnan(best) || v > best) best = v;
     }
@@ -295,7 +304,11 @@ double monitors_value(const mixsph_sim *s, size_t k)
                                                 : case_full_scale_error(&s->cfg, case_full_scale_z(&s->cfg, s->out.max[j]));
             return NAN;
         }
-        const double v = monitor_eval(s, &s->cfg.monitors[m]);
+        const struct monitor_def *md = &s->cfg.monitors[m];
+        /* a slide's impact is taken once: its first values (the outputs' extremes, which a
+         * checkpoint keeps) */
+        if (md->kind == MONITOR_SLIDE_IMPACT && !isnan(s->out.max[k])) return s->out.max[k];
+        const double v = monitor_eval(s, md, kind >= OUTK_EXTRA ? 1 + kind - OUTK_EXTRA : 0);
         return kind == OUTK_FULL_Z && !isnan(v) ? case_full_scale_z(&s->cfg, v) : v;
     }
     const int d = -1 - s->out.monitor[k];
@@ -343,8 +356,7 @@ static mixsph_status profile_write(mixsph_sim *s, const struct monitor_def *md, 
     if (!top) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (profile)");
     for (size_t b = 0; b < nb; b++) top[b] = -INFINITY;
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] > MIXSPH_STATE_FIXED || P->medium[i] != md->medium) continue;
-        if (P->nneigh[i] < md->min_neighbours || !in_region(md, P, i)) continue;
+        if (!monitor_counts(md, P, i)) continue;
         size_t b = (size_t)((P->pos[0][i] - md->x_min) / md->bin);
         if (b >= nb) b = nb - 1;
         const double top_i = P->pos[DIM_UP][i] + 0.5 * s->phys.dx;
