@@ -270,6 +270,57 @@ static void test_surface_grain_sinks(void **state)
                         worst >= 0.02, worst, -0.005, 0.011);
 }
 
+/* The water_coupling "grains" of the elastic-plastic law (docs/model.md [GW]) with grains of d = 2 mm;
+ * `more` is added to the gravel's keys (e.g. saturated). */
+#define GRAINS_IN_WATER ", \"law\": 1, \"water_coupling\": \"grains\", \"grain_diameter\": 0.002"
+
+/* One grain particle at the lattice site of spacing dx centred at (x, z), its grains of density
+ * rho_s, released at rest: its height [m] and vertical velocity [m/s] after t_end (printed every
+ * 0.1 s). */
+static double single_grain(double x, double z, double dx, double rho_s, const char *extra, double t_end, double *vz)
+{
+    const mixsph_override ov[] = {{"numerics.dx", dx}, {"media.gravel.rho", rho_s}};
+    mixsph_sim *s = NULL;
+    char err[512] = "";
+    const mixsph_status st = mixsph_sim_create_from_text(grains_json(x - 0.5 * dx, x + 0.5 * dx, z - 0.5 * dx,
+                                                                     z + 0.5 * dx, extra),
+                                                         "block_in_water", ov, 2, &s, err, sizeof err);
+    if (st != MIXSPH_OK) print_error("%s\n", err);
+    assert_int_equal(st, MIXSPH_OK);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    const struct particles *P = &s->phys.P;
+    double zg = NAN;
+    long grains = 0;
+    for (int k = 1; k <= (int)lround(t_end / 0.1); k++) {
+        assert_int_equal(mixsph_sim_advance_to(s, 0.1 * k), MIXSPH_OK);
+        grains = 0;
+        for (size_t i = 0; i < P->n; i++)
+            if (P->state[i] != MIXSPH_STATE_WALL && P->medium[i] == 1) {
+                assert_true(P->state[i] != MIXSPH_STATE_LOST);
+                zg = P->pos[DIM_UP][i];
+                *vz = P->vel[DIM_UP][i];
+                grains++;
+            }
+        print_message("    t = %.1f s: z = %.4f m, vz = %.4f m/s\n", mixsph_sim_time(s), zg, *vz);
+    }
+    assert_int_equal(grains, 1);
+    mixsph_sim_destroy(s);
+    return zg;
+}
+
+#define SATURATED ", \"saturated\": true, \"pore_fluid\": \"water\""
+
+static void test_grains_in_water_scratch(void **state)
+{
+    (void)state;
+    double vz;
+    const double dx = 0.02;
+    print_message("dx %g neutral 1000, mid-depth\n", dx);
+    single_grain(0.2 + 0.5 * dx, 0.15 + 0.5 * dx, dx, 1000.0, GRAINS_IN_WATER SATURATED, 1.0, &vz);
+    print_message("dx %g neutral 1000, mid-depth, mixture\n", dx);
+    single_grain(0.2 + 0.5 * dx, 0.15 + 0.5 * dx, dx, 1000.0, ", \"law\": 1" SATURATED, 1.0, &vz);
+}
+
 /* `test_settling` runs the tests the model meets; `test_settling known_failure surface_grain` the
  * criterion it does not meet yet (a test of its own in CTest). */
 int main(int argc, char **argv)
@@ -281,6 +332,10 @@ int main(int argc, char **argv)
         }
         fprintf(stderr, "test_settling: unknown known_failure '%s' (surface_grain)\n", argv[2]);
         return 2;
+    }
+    if (argc > 1 && strcmp(argv[1], "scratch") == 0) {
+        const struct CMUnitTest t[] = {cmocka_unit_test(test_grains_in_water_scratch)};
+        return cmocka_run_group_tests(t, NULL, NULL);
     }
     if (argc > 1 && strcmp(argv[1], "validation") == 0) {
         /* the long version (CTest test_settling_validation, label validation: ./tools/do validate) */
