@@ -88,9 +88,9 @@ static void aligned_block_free(void *p) { free(p); }
 enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS }; /* F, N: DIM each */
 
 /* The per-particle arrays of the grains in water (docs/model.md [GW]; params.grains_in_water): each
- * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, and
- * a grain's Ergun factors (granular.h). */
-enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_ARRAYS };
+ * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, a
+ * grain's Ergun factors (granular.h) and its parcel's volume m / rho0. */
+enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_VOLUME, GW_ARRAYS };
 #define GRAIN_ROLE_FLUID (-1.0) /* a particle of a LAW_FLUID medium */
 #define GRAIN_ROLE_GRAIN 1.0    /* a particle of a LAW_GRAINS_IN_WATER medium; 0: any other (walls) */
 
@@ -498,7 +498,9 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict drag_v = grains ? X->gw[GW_DRAG_VISCOUS] : NULL;
     const double *restrict drag_r = grains ? X->gw[GW_DRAG_INERTIAL] : NULL;
     const double *restrict rho = P->rho;
+    const double *restrict vol0 = grains ? X->gw[GW_VOLUME] : NULL;
     const double role_i = grains ? role[i] : 0.0, p_water_i = grains ? p_water[i] : 0.0;
+    const double vol0_i = grains ? vol0[i] : 0.0;
     const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
 #if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
@@ -532,14 +534,15 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double inv_r2e = inv_d * mus;
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
             /* pressure; a grain in water takes the water's (gi: i is the grain, gj: j is) */
-            double gi = 0.0, gj = 0.0, pi_pair = pi, pj_pair = p[j];
-            if (grains) {
+            double gi = 0.0, gj = 0.0, pi_pair = pi, pj_pair = p[j], vv_pair = vv;
+            if (grains) { /* and the grain's parcel volume m / rho0, however loose its packing */
                 gi = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
                 gj = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
                 pi_pair = gi > 0.0 ? p_water_i : pi;
                 pj_pair = gj > 0.0 ? p_water[j] : p[j];
+                vv_pair = gi > 0.0 ? vol0_i * vol[j] : gj > 0.0 ? voli * vol0[j] : vv;
             }
-            double fr = -vv * (pi_pair + pj_pair);
+            double fr = -vv_pair * (pi_pair + pj_pair);
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
@@ -565,7 +568,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 for (int d = 0; d < DIM; d++) slip2 += (uvi[d] - uv[d][j]) * (uvi[d] - uv[d][j]);
                 const double beta = gi > 0.0 ? drag_vi * mu[j] + drag_ri * rho[j] * sqrt(slip2)
                                              : drag_v[j] * mui + drag_r[j] * rhoi * sqrt(slip2);
-                cd = (gi + gj) * beta * voli * vol[j] * w;
+                cd = (gi + gj) * beta * vv_pair * w;
             }
             double f[DIM];
             if (implicit) {
@@ -1058,6 +1061,7 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
 {
     const struct particles *P = S->P;
     double *role = F->gw[GW_ROLE], *dv = F->gw[GW_DRAG_VISCOUS], *dr = F->gw[GW_DRAG_INERTIAL];
+    double *vol0 = F->gw[GW_VOLUME];
     for (size_t i = 0; i < n; i++) {
         const struct medium *m = &S->media[P->medium[i]];
         const int wall = P->state[i] == MIXSPH_STATE_WALL;
@@ -1065,8 +1069,9 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
         role[i] = grain ? GRAIN_ROLE_GRAIN : !wall && (m->features & LAW_FLUID) ? GRAIN_ROLE_FLUID : 0.0;
         dv[i] = grain ? m->granular.drag_viscous : 0.0;
         dr[i] = grain ? m->granular.drag_inertial : 0.0;
+        vol0[i] = grain ? P->m[i] / m->rho0 : 0.0;
     }
-    for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = 0.0;
+    for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = vol0[i] = 0.0;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = F->gw[q];
 }
 
