@@ -22,7 +22,8 @@
  * Sensitivity (measured by making forces.c subtract (1 + delta) times each pair force from j):
  * delta = 1e-13 drifts by 3-5e-12, 0.3-0.6 of the bound; delta = 1e-12 fails.
  *
- * The grains under both granular laws, each with the default numerics and with every switch
+ * The grains under both granular laws (the elastic-plastic one also with water_coupling "grains"),
+ * each with the default numerics and with every switch
  * that changes what the pair force carries or the pressures it uses (ALL_SWITCHES):
  * elastic_plastic (the deviatoric stress of each grain enters the pair force; mu = 0, so water and
  * grains exchange no laminar viscous force), and the paper's law (its mixture viscosity,
@@ -185,6 +186,17 @@ static void test_elastic_plastic_grains(void **state)
     assert_true(run_box("\"law\": \"elastic_plastic\"", ALL_SWITCHES, 0.0, 0.08) > 1000);
 }
 
+/* The same with water_coupling "grains" (docs/model.md [GW]): the grain's side of a grain-water pair
+ * takes the water's interpolated pressure instead of its own and Ergun's drag acts between them;
+ * both stay pair forces added to i and subtracted from j, so the same round-off bound holds. */
+static void test_grains_in_water(void **state)
+{
+    (void)state;
+    const char *grains = "\"law\": \"elastic_plastic\", \"water_coupling\": \"grains\", \"grain_diameter\": 0.002";
+    assert_true(run_box(grains, "", 0.0, 0.08) > 1000);
+    assert_true(run_box(grains, ALL_SWITCHES, 0.0, 0.08) > 1000);
+}
+
 /* The paper's law with the Vajont mu_thr and mu0 = 1 Pa s (a viscous time step near the acoustic
  * one); sheared by the random velocities, no grain reaches mu_thr in these 0.08 s (checked: the
  * comparison stops at the first held grain, and it must come after the blocks met). */
@@ -219,6 +231,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_elastic_plastic_grains),
+        cmocka_unit_test(test_grains_in_water),
         cmocka_unit_test(test_paper_grains),
         cmocka_unit_test(test_implicit_viscosity_conserves_to_its_tolerance),
     };

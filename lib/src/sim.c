@@ -350,6 +350,8 @@ static void set_scheme_params(mixsph_sim *s)
 #define NUMERICS_KEY COPY_NUMERICS_KEY
 #include "numerics_keys.def"
 #undef NUMERICS_KEY
+    for (size_t k = 0; k < c->n_media; k++) /* a medium's finish may set it (not its law's features) */
+        if (c->media[k].features & LAW_GRAINS_IN_WATER) s->scheme.pair.grains_in_water = 1;
 }
 
 /* The failure of a particle i outside the domain: "a particle at (x, z) lies outside it". */

@@ -24,6 +24,8 @@
 #include "team.h"
 
 static const struct case_choice granular_ep_type[] = {{"granular", LAW_ELASTIC_PLASTIC}, {NULL, 0}};
+static const struct case_choice water_couplings[] = {
+    {"mixture", WATER_COUPLING_MIXTURE}, {"grains", WATER_COUPLING_GRAINS}, {NULL, 0}};
 
 static const struct case_key elastic_plastic_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_ep_type,
@@ -56,6 +58,14 @@ static const struct case_key elastic_plastic_keys[] = {
     {.key = "pore_fluid", .type = CASE_NAME, .need = CASE_SOMETIMES, .need_text = "if saturated",
      .meaning = "name of a fluid medium defined before this one"},
     PORE_PRESSURE_KEY,
+    {.key = "water_coupling", .type = CASE_CHOICE, SCHEMA_DEF(WATER_COUPLING_MIXTURE), .choices = water_couplings,
+     .numeric_choice = CASE_CHOICE_BY_VALUE, .field = CASE_FIELD(medium, granular.water_coupling),
+     .meaning = "how a grain particle meets a fluid particle: mixture (0), as one continuum, its own pressure and "
+                "stress in the pair (model.md [WG]); grains (1), a parcel of grains in the water: the water's "
+                "pressure interpolated at it, no stress, Ergun's drag with grain_diameter (model.md [GW])"},
+    {.key = "grain_diameter", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "if water_coupling is grains",
+     SCHEMA_RANGE(0, 1, 1, 0), .unit = "m", .field = CASE_FIELD(medium, granular.grain_diameter),
+     .meaning = "diameter d of the grains: the drag of the water through them (water_coupling grains)"},
 };
 
 static const struct case_section elastic_plastic_section = {
@@ -76,6 +86,20 @@ static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_f
                                       &m->dp.alpha_phi, &m->dp.k_c, &m->dp.alpha_psi);
     if (why) return FAIL(ctx, "%s: %s: %s", ctx->origin, ctx->path, why);
     m->granular.sin_phi = sin(m->granular.phi_deg * GEOM_PI / 180.0);
+    if (m->granular.water_coupling == WATER_COUPLING_GRAINS) {
+        if (!ctx->given(ctx->entry, "grain_diameter"))
+            return FAIL(ctx, "%s: %s.grain_diameter: missing (water_coupling \"grains\" needs the grains' diameter "
+                        "for their drag)", ctx->origin, ctx->path);
+        /* Ergun's drag per unit volume of a packed bed of porosity n (Gidaspow 1994, eq. 5.64 for
+         * n < 0.8): beta = 150 (1-n)^2 mu_f / (n d^2) + 1.75 (1-n) rho_f |u_f - u_s| / d */
+        const double n = m->granular.porosity, d = m->granular.grain_diameter;
+        m->granular.drag_viscous = 150.0 * (1.0 - n) * (1.0 - n) / (n * d * d);
+        m->granular.drag_inertial = 1.75 * (1.0 - n) / d;
+        m->features |= LAW_GRAINS_IN_WATER;
+    } else if (ctx->given(ctx->entry, "grain_diameter")) {
+        return FAIL(ctx, "%s: %s.grain_diameter: used only with water_coupling \"grains\" (the mixture coupling has "
+                    "no drag of its own)", ctx->origin, ctx->path);
+    }
     m->mu = 0.0;
     /* The grains' dissipation (docs/model.md [DP-AV]): Monaghan's term with alpha_M c = c_p, the
      * acoustic impedance rho c_p of the P wave on the approach speed of a pair, as a linearised

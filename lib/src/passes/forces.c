@@ -87,6 +87,13 @@ static void aligned_block_free(void *p) { free(p); }
  * weight times their coefficient, and the weight of the walls that take the grain's own. */
 enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS }; /* F, N: DIM each */
 
+/* The per-particle arrays of the grains in water (docs/model.md [GW]; params.grains_in_water): each
+ * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, a
+ * grain's Ergun factors (granular.h) and its parcel's volume m / rho0. */
+enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_VOLUME, GW_ARRAYS };
+#define GRAIN_ROLE_FLUID (-1.0) /* a particle of a LAW_FLUID medium */
+#define GRAIN_ROLE_GRAIN 1.0    /* a particle of a LAW_GRAINS_IN_WATER medium; 0: any other (walls) */
+
 struct forces {
     double *fk;               /* kernel factors of the pair lanes, density -> momentum pass */
     size_t *fk_off;           /* particle i's lanes start at fk + fk_off[i] */
@@ -98,6 +105,7 @@ struct forces {
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
     double *wall_sum[WALL_SUMS]; /* momentum pass with stress: each particle's wall sums (above) */
     double *diffusion_sum;    /* density pass: sum_j V_j psi_ij (-F_ij) of the density diffusion */
+    double *gw[GW_ARRAYS];    /* the grains in water (above) */
     size_t scratch_cap;
     /* implicit viscosity: the viscous coupling w_ij >= 0 of every lane (layout of fk), stored by
      * the momentum pass, so that m_i du_i/dt = -sum_j w_ij (u_i - u_j) */
@@ -131,6 +139,8 @@ struct pair_ctx {
     const int32_t *group;      /* forces_viscous_group_couplings: each particle's group, or -1 */
     long group_stride;         /* groups per row of the group grid */
     double *group_w;           /* and its sums, 5 per group */
+    double *gw[GW_ARRAYS];     /* the grains in water (struct forces), or NULL: none */
+    double p_background;       /* the water's pressure at a free surface [Pa] (the grains in water) */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -161,6 +171,8 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->group = NULL;
     X->group_stride = 0;
     X->group_w = NULL;
+    for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = NULL;
+    X->p_background = fp->p_background;
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -201,11 +213,13 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * hydrostatic density difference of the linear EOS (Fourtakas et al. 2019 with gamma = 1; the
  * initial state of sim.c, p = rho0 g depth, is left exactly at rest), 0 keeps the whole
  * difference. psi_ji = -psi_ij, so sum_i V_i e_i = 0: the diffusion moves density between
- * particles and creates none. */
+ * particles and creates none. With `grains` (docs/model.md [GW]) a grain in water takes no
+ * density rate from its fluid neighbours: water flowing past or through a parcel of grains does
+ * not pack them (the fluid's rate keeps the grains: they take room from it). */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                     const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
-                                    const int wendland, const int store, const int diffuse)
+                                    const int wendland, const int store, const int diffuse, const int grains)
 {
     const double ti = P->tag[i], voli = P->vol[i], rhoi = P->rho[i];
     double xi[DIM], vi[DIM];
@@ -220,6 +234,8 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const double *restrict vol = P->vol, *restrict tag = P->tag, *restrict rho = P->rho;
     const struct pair_ctx Xl = *X;
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
+    const double *restrict role = grains ? X->gw[GW_ROLE] : NULL;
+    const double role_i = grains ? role[i] : 0.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0}, dif[FORCES_CHUNK] = {0};
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK], ej[FORCES_CHUNK];
@@ -239,9 +255,16 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             uf *= F;
             const double c = (r2 < Xl.K.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
             if (store) fk[k] = F;
-            acc[k] += vol[j] * uf;
+            if (grains) { /* a grain's side of a grain-fluid pair drops out */
+                const double keep_i = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
+                const double keep_j = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
+                acc[k] += keep_i * vol[j] * uf;
+                dj[k] = keep_j * voli * uf;
+            } else {
+                acc[k] += vol[j] * uf;
+                dj[k] = voli * uf;
+            }
             cnt[k] += c;
-            dj[k] = voli * uf;
             cj[k] = c;
             if (diffuse) {
                 const double one = (tag[j] == ti ? 1.0 : 0.0) * fluid_i; /* F is 0 on masked lanes */
@@ -300,6 +323,54 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
             su[k] += w * vol[j];
             aj[k] = -b * voli;
             uj[k] = w * voli;
+        }
+        chunk_add(sum, jb, m, aj);
+        chunk_add(weight, jb, m, uj);
+    }
+    for (size_t k = 0; k < FORCES_CHUNK; k++) {
+        *ai += sa[k];
+        *ui += su[k];
+    }
+}
+
+/* The water's pressure at the grains in water (docs/model.md [GW]): between i and its ranges, for a
+ * pair of a grain and a fluid particle, the grain's sums a += V_f W (p_f + rho_f g (z_f - z_grain))
+ * (the fluid's pressure carried hydrostatically to the grain's height) and u += V_f W, whose
+ * quotient (Shepard's interpolation) is the water's pressure at the grain. */
+FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
+                                        const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
+                                        double *restrict sum, double *restrict weight, const int wendland)
+{
+    const double pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
+    const double *restrict role = X->gw[GW_ROLE];
+    const double role_i = role[i];
+    double xi[DIM];
+    const double *restrict x[DIM];
+    for (int d = 0; d < DIM; d++) {
+        xi[d] = P->pos[d][i];
+        x[d] = P->pos[d];
+    }
+    const double *restrict p = P->p, *restrict rho = P->rho, *restrict vol = P->vol;
+    const struct pair_ctx Xl = *X;
+    double sa[FORCES_CHUNK] = {0}, su[FORCES_CHUNK] = {0};
+    FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
+        double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
+#pragma omp simd
+        for (size_t k = 0; k < FORCES_CHUNK; k++) {
+            const size_t j = jb + k;
+            double r[DIM], r2 = 0.0;
+            DIM_UNROLL
+            for (int d = 0; d < DIM; d++) {
+                r[d] = xi[d] - x[d][j];
+                r2 += r[d] * r[d];
+            }
+            const double w = kernel_w_q(&Xl.K, kernel_q(&Xl.K, r2), wendland) * FORCES_LANE_IN(k, m);
+            const double gi = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? w : 0.0;
+            const double gj = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? w : 0.0;
+            sa[k] += gi * vol[j] * (p[j] - rho[j] * g * r[DIM_UP]);
+            su[k] += gi * vol[j];
+            aj[k] = gj * voli * (pi + rhoi * g * r[DIM_UP]);
+            uj[k] = gj * voli;
         }
         chunk_add(sum, jb, m, aj);
         chunk_add(weight, jb, m, uj);
@@ -384,13 +455,19 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
  * is added to i and subtracted from j (acc holds forces during the pass; forces_momentum divides
  * by the masses after it). With `implicit` the viscous force is left out and its coupling
  * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
- * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). */
+ * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). With `grains` a pair of a
+ * grain in water and a fluid particle is that of docs/model.md [GW]: the grain's pressure in it is
+ * the water's interpolated at the grain (water_pressure_range), it carries no deviatoric stress,
+ * and Ergun's drag c_ij (u_i - u_j), c_ij = beta V_i V_j W_ij, beta the grain's (granular.h) with
+ * the fluid particle's mu and rho and the pair's slip |u_i - u_j|, acts between them (in the
+ * implicit couplings w_ij with `implicit`). Every term stays a pair force, added to i and
+ * subtracted from j. */
 enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double f_i[DIM],
                                   const double *restrict fk, double *restrict wl, const int wendland,
-                                  const int cached, const int implicit, const int stress)
+                                  const int cached, const int implicit, const int stress, const int grains)
 {
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
     const double ti = P->tag[i], avci = P->avc[i];
@@ -416,6 +493,15 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict avc = P->avc;
     const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
     const double roughi = stress ? wall_rough[i] : 0.0, mu_wi = stress ? wall_mu[i] : 0.0;
+    /* the grains in water (grains): roles, the water's pressure at the grains, Ergun's factors */
+    const double *restrict role = grains ? X->gw[GW_ROLE] : NULL, *restrict p_water = grains ? X->gw[GW_PRESSURE] : NULL;
+    const double *restrict drag_v = grains ? X->gw[GW_DRAG_VISCOUS] : NULL;
+    const double *restrict drag_r = grains ? X->gw[GW_DRAG_INERTIAL] : NULL;
+    const double *restrict rho = P->rho;
+    const double *restrict vol0 = grains ? X->gw[GW_VOLUME] : NULL;
+    const double role_i = grains ? role[i] : 0.0, p_water_i = grains ? p_water[i] : 0.0;
+    const double vol0_i = grains ? vol0[i] : 0.0;
+    const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
 #if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
     const double mbi = ni[0] * ni[0] - ni[1] * ni[1];
@@ -447,8 +533,16 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double inv_d = 1.0 / (r2e * mus);
             const double inv_r2e = inv_d * mus;
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
-            /* pressure */
-            double fr = -vv * (pi + p[j]);
+            /* pressure; a grain in water takes the water's (gi: i is the grain, gj: j is) */
+            double gi = 0.0, gj = 0.0, pi_pair = pi, pj_pair = p[j], vv_pair = vv;
+            if (grains) { /* and the grain's parcel volume m / rho0, however loose its packing */
+                gi = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
+                gj = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
+                pi_pair = gi > 0.0 ? p_water_i : pi;
+                pj_pair = gj > 0.0 ? p_water[j] : p[j];
+                vv_pair = gi > 0.0 ? vol0_i * vol[j] : gj > 0.0 ? voli * vol0[j] : vv;
+            }
+            double fr = -vv_pair * (pi_pair + pj_pair);
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
@@ -466,14 +560,29 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double fv = implicit == MOMENTUM_IMPLICIT_ARITHMETIC && tag[j] == ti
                                   ? vv * mus * mus * r2 * inv_d
                                   : vv * 4.0 * mu_i * muj * r2 * inv_d;
+            double cd = 0.0; /* Ergun's drag of a grain-fluid pair, c_ij */
+            if (grains) {
+                const double w = kernel_w_q(&Xl.K, kernel_q(&Xl.K, r2), wendland) * in;
+                double slip2 = 0.0;
+                DIM_UNROLL
+                for (int d = 0; d < DIM; d++) slip2 += (uvi[d] - uv[d][j]) * (uvi[d] - uv[d][j]);
+                const double beta = gi > 0.0 ? drag_vi * mu[j] + drag_ri * rho[j] * sqrt(slip2)
+                                             : drag_v[j] * mui + drag_r[j] * rhoi * sqrt(slip2);
+                cd = (gi + gj) * beta * vv_pair * w;
+            }
             double f[DIM];
             if (implicit) {
                 wl[k] = -F * fv;
+                if (grains) wl[k] += cd;
                 DIM_UNROLL
                 for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d]);
             } else {
                 DIM_UNROLL
                 for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d] + fv * (uvi[d] - uv[d][j]));
+                if (grains) {
+                    DIM_UNROLL
+                    for (int d = 0; d < DIM; d++) f[d] -= cd * (uvi[d] - uv[d][j]);
+                }
             }
             if (stress) { /* the deviatoric stress: V_i V_j (s_i + s_j) . grad_i W. A wall holds none of
                            * its own: a wall particle takes the stress s of the particle it meets, as
@@ -502,6 +611,10 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 DIM_UNROLL
                 for (int c = 0; c < SYM_N; c++) t[c] = vv * (ci * si[c] + cj * sj[c] + mi_[c] + mj_[c]);
 #endif
+                if (grains) { /* a grain's skeleton does not push on the water: no stress in their pairs */
+                    DIM_UNROLL
+                    for (int c = 0; c < SYM_N; c++) t[c] *= 1.0 - gi - gj;
+                }
                 DIM_UNROLL
                 for (int a = 0; a < DIM; a++) {
                     double tr = 0.0;
@@ -580,14 +693,15 @@ static inline double diffusion_rate(double delta_h, const struct medium *m, doub
 
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
 FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                   size_t b0, size_t b1, const int diffuse, const int wendland, const int store)
+                                   size_t b0, size_t b1, const int grains, const int diffuse, const int wendland,
+                                   const int store)
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0, ei = 0.0;
         const int diffuse_i = diffuse && diffuses(X, P, i);
         const double hyd_i = diffuse_i ? diffusion_hydrostatic(X, P, i) : 0.0;
         continuity_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
-                         X->diffusion, hyd_i, wendland, store, diffuse_i);
+                         X->diffusion, hyd_i, wendland, store, diffuse_i, grains);
         P->drho[i] += di;
         X->count[i] += ni;
         if (diffuse_i) X->diffusion[i] += ei;
@@ -608,13 +722,13 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                  size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
-                                 const int stress)
+                                 const int stress, const int grains)
 {
     for (size_t i = b0; i < b1; i++) {
         double f[DIM] = {0.0};
         momentum_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, f,
                        cached ? X->fk + X->fk_off[i] : NULL, implicit ? X->visc_w + X->fk_off[i] : NULL, wendland,
-                       cached, implicit, stress);
+                       cached, implicit, stress, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
@@ -706,6 +820,21 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
 }
 
 FORCES_CLONES
+static void water_pressure_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
+                                size_t b0, size_t b1)
+{
+    double *sum = X->gw[GW_SUM], *weight = X->gw[GW_WEIGHT];
+    for (size_t i = b0; i < b1; i++) {
+        double a = 0.0, u = 0.0;
+        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        if (X->wendland) water_pressure_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, sum, weight, 1);
+        else water_pressure_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, sum, weight, 0);
+        sum[i] += a;
+        weight[i] += u;
+    }
+}
+
+FORCES_CLONES
 static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P, size_t b0,
                         size_t b1)
 {
@@ -733,26 +862,33 @@ FORCES_CLONES
 static void continuity_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                             size_t b0, size_t b1)
 {
-    if (X->diffusion) FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 1);
-    else FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 0);
+    if (X->gw[GW_ROLE]) {
+        if (X->diffusion) FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 1, 1);
+        else FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 1, 0);
+    } else {
+        if (X->diffusion) FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 0, 1);
+        else FORCES_DISPATCH(continuity_walk, X, NB, P, b0, b1, 0, 0);
+    }
 }
 
-/* The momentum band walk, one inlined copy with and one without the stress term. */
+/* The momentum band walk, one inlined copy with and one without the stress term, and with the
+ * grains in water. */
 FORCES_INLINE void momentum_band_variant(const struct pair_ctx *X, const struct neighbours *NB,
-                                         struct particles *restrict P, size_t b0, size_t b1, const int stress)
+                                         struct particles *restrict P, size_t b0, size_t b1, const int stress,
+                                         const int grains)
 {
     if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
         if (X->arithmetic_mean) {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, grains);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, grains);
         } else {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, grains);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, grains);
         }
         return;
     }
 #define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
-    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress)
+    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress, grains)
     FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
 #undef MOMENTUM_EXPLICIT
 }
@@ -761,8 +897,14 @@ FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1);
-    else momentum_band_variant(X, NB, P, b0, b1, 0);
+    if (X->gw[GW_ROLE]) {
+        if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1, 1);
+        else momentum_band_variant(X, NB, P, b0, b1, 0, 1);
+    } else if (X->stress) {
+        momentum_band_variant(X, NB, P, b0, b1, 1, 0);
+    } else {
+        momentum_band_variant(X, NB, P, b0, b1, 0, 0);
+    }
 }
 
 struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
@@ -776,6 +918,7 @@ void forces_free(struct forces *F)
     free(F->smooth_sum);
     free(F->smooth_weight);
     for (int q = 0; q < WALL_SUMS; q++) free(F->wall_sum[q]);
+    for (int q = 0; q < GW_ARRAYS; q++) free(F->gw[q]);
     free(F->diffusion_sum);
     aligned_block_free(F->visc_w);
     free(F);
@@ -830,9 +973,10 @@ static int scratch_reserve(struct forces *F, size_t n)
 {
     if (F->scratch_cap >= n) return 0;
     const size_t cap = n + n / 4 + 64;
-    double **a[4 + WALL_SUMS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight, &F->diffusion_sum};
+    double **a[4 + WALL_SUMS + GW_ARRAYS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight, &F->diffusion_sum};
     for (int q = 0; q < WALL_SUMS; q++) a[4 + q] = &F->wall_sum[q];
-    for (int k = 0; k < 4 + WALL_SUMS; k++) {
+    for (int q = 0; q < GW_ARRAYS; q++) a[4 + WALL_SUMS + q] = &F->gw[q];
+    for (int k = 0; k < 4 + WALL_SUMS + GW_ARRAYS; k++) {
         double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
         if (!q) return -1;
         memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
@@ -911,6 +1055,44 @@ static void bands_region(void *arg, int tid, int nth)
 
 static size_t active_count(const struct pair_system *S) { return S->C->start[S->C->ncell]; }
 
+/* The roles of the n active particles and the grains' Ergun factors (docs/model.md [GW]), into X's
+ * arrays; the padding after them neutral. Needs scratch_reserve(F, n). */
+static void grains_in_water_roles(struct forces *F, const struct pair_system *S, size_t n, struct pair_ctx *X)
+{
+    const struct particles *P = S->P;
+    double *role = F->gw[GW_ROLE], *dv = F->gw[GW_DRAG_VISCOUS], *dr = F->gw[GW_DRAG_INERTIAL];
+    double *vol0 = F->gw[GW_VOLUME];
+    for (size_t i = 0; i < n; i++) {
+        const struct medium *m = &S->media[P->medium[i]];
+        const int wall = P->state[i] == MIXSPH_STATE_WALL;
+        const int grain = !wall && (m->features & LAW_GRAINS_IN_WATER);
+        role[i] = grain ? GRAIN_ROLE_GRAIN : !wall && (m->features & LAW_FLUID) ? GRAIN_ROLE_FLUID : 0.0;
+        dv[i] = grain ? m->granular.drag_viscous : 0.0;
+        dr[i] = grain ? m->granular.drag_inertial : 0.0;
+        vol0[i] = grain ? P->m[i] / m->rho0 : 0.0;
+    }
+    for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = vol0[i] = 0.0;
+    for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = F->gw[q];
+}
+
+/* The water's pressure interpolated at each grain in water (water_pressure_range), at least the
+ * background pressure (the water's at a free surface: it holds no tension on a grain); a grain
+ * with no fluid neighbour keeps its own (it meets no fluid particle). */
+static void water_pressure_region(void *arg, int tid, int nth)
+{
+    struct pass_region *R = arg;
+    struct particles *P = R->S->P;
+    const struct pair_ctx *X = R->X;
+    const double pb = R->S->params.p_background;
+    bands_in_team(R->S, water_pressure_band, X, R->bands, 0);
+    size_t b, e;
+    team_share(R->n, tid, nth, &b, &e);
+    const double *role = X->gw[GW_ROLE], *sum = X->gw[GW_SUM], *weight = X->gw[GW_WEIGHT];
+    double *pw = X->gw[GW_PRESSURE];
+    for (size_t i = b; i < e; i++)
+        pw[i] = role[i] == GRAIN_ROLE_GRAIN && weight[i] > 0.0 ? fmax(sum[i] / weight[i], pb) : P->p[i];
+}
+
 /* The density pass, and with `grad` the velocity gradient of the grains, in one parallel
  * region: the gradient reads positions, velocities and volumes, which the density pass does not
  * write, so it runs while the last bands finish; the per-particle loop after the bands waits for
@@ -950,6 +1132,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
     memset(P->drho, 0, n * sizeof(double));
     memset(F->nbr_count, 0, n * sizeof(double));
     X.count = F->nbr_count;
+    if (S->params.grains_in_water) grains_in_water_roles(F, S, n, &X);
     const double delta_h = S->params.diffusion * X.K.h;
     if (delta_h > 0.0) {
         memset(F->diffusion_sum, 0, n * sizeof(double));
@@ -1094,7 +1277,16 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     }
     F->fk_valid = 0;
     const int friction = X.stress;
-    if (friction && scratch_reserve(F, n) != 0) return -1;
+    if ((friction || S->params.grains_in_water) && scratch_reserve(F, n) != 0) return -1;
+    if (S->params.grains_in_water) { /* the water's pressure at the grains, before the pairs use it */
+        grains_in_water_roles(F, S, n, &X);
+        memset(F->gw[GW_SUM], 0, n * sizeof(double));
+        memset(F->gw[GW_WEIGHT], 0, n * sizeof(double));
+        struct pass_region W;
+        pass_region_init(&W, S, &X, water_pressure_band, n);
+        team_run(S->n_threads, water_pressure_region, &W);
+        for (size_t i = n; i < n + FORCES_CHUNK; i++) F->gw[GW_PRESSURE][i] = 0.0;
+    }
     if (friction)
         for (int q = 0; q < WALL_SUMS; q++) {
             memset(F->wall_sum[q], 0, n * sizeof(double));
@@ -1171,7 +1363,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress);
+    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0);
     for (int d = 0; d < DIM; d++) {
         a[d] = f[d] * P->inv_m[i];
         P->acc[d][j] = save[d];
@@ -1179,10 +1371,10 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
     const double delta_h = S->params.diffusion * X.K.h;
     if (delta_h > 0.0 && diffuses(&X, P, i)) {
         continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
-                         X.wendland, 0, 1);
+                         X.wendland, 0, 1, 0);
         *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
     } else {
-        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0);
+        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0, 0);
         *drho = P->rho[i] * di;
     }
     P->drho[j] = save[DIM];

@@ -29,6 +29,8 @@ struct forces_params {
     int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
                                stress (P->stress; a law with LAW_HAS_STRESS) and bounds the
                                shear of no-slip walls on elastic-plastic grains (wall friction) */
+    int grains_in_water;    /* a medium has LAW_GRAINS_IN_WATER: its pairs with fluid particles take the
+                               water's interpolated pressure and Ergun's drag (docs/model.md [GW]) */
 #define NUMERICS_KEY NUMERICS_MEMBER_OF_PAIR
 #include "numerics_keys.def"
 #undef NUMERICS_KEY

@@ -565,6 +565,11 @@ static void density_update_range(void *arg, size_t b, size_t e)
          * Only for a medium that carries no tension, where a density below rho0 is grains parting;
          * in any other medium a density that low is a blow-up, which the step must report. */
         if (media[P->medium[i]].tension_cutoff && rho < P->m[i] * w0) rho = P->m[i] * w0;
+        /* A parcel of grains in water (LAW_GRAINS_IN_WATER, docs/model.md [GW]) keeps its packing rho0
+         * at least: its grains part only by water coming between them, which is the water's room,
+         * not a larger parcel (whose volume m / rho would carry more of the pore pressure's push) */
+        if ((media[P->medium[i]].features & LAW_GRAINS_IN_WATER) && rho < media[P->medium[i]].rho0)
+            rho = media[P->medium[i]].rho0;
         if (density_out_of_bound(&media[P->medium[i]], bound, rho)) {
             s->work.excluding[i] = 1;
             beyond++;
