@@ -511,7 +511,7 @@ static void test_index_against_brute_force(void **state)
         for (int d = 0; d < 3; d++) {
             seed = seed * 1103515245u + 12345u;
             const double u = (double)(seed >> 8) / (double)(1u << 24);
-            p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : -3.0 + 6.0 * u * u * u; /* many near z = 0 */
+            p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : 3.0 * pow(2.0 * u - 1.0, 3); /* many near z = 0 */
         }
         const double exact = mesh_distance(&copy, p, NULL, NULL), d = surface_signed_distance(&s, p, NULL);
         assert_true(fabs(d) == exact);
