@@ -511,7 +511,7 @@ static void test_index_against_brute_force(void **state)
         for (int d = 0; d < 3; d++) {
             seed = seed * 1103515245u + 12345u;
             const double u = (double)(seed >> 8) / (double)(1u << 24);
-            p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : -3.0 + 6.0 * u * u * u; /* many near z = 0 */
+            p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : 3.0 * pow(2.0 * u - 1.0, 3); /* many near z = 0 */
         }
         const double exact = mesh_distance(&copy, p, NULL, NULL), d = surface_signed_distance(&s, p, NULL);
         assert_true(fabs(d) == exact);
@@ -530,6 +530,37 @@ static void test_index_against_brute_force(void **state)
     terrain_free(&t);
 }
 
+/* A moving wall sweeps over a particle at rest: the tank's x_min face, moving at 1 m/s, passes a
+ * particle 1 mm inside it in a step of 2 ms. The path in the wall's frame crosses the face from
+ * the fluid side, so the particle is put at `gap` in front of the face where it is now and takes
+ * the wall's normal velocity (its velocity into the wall, relative to the wall's, removed). */
+static void test_moving_wall_pushes(void **state)
+{
+    (void)state;
+    double t[] = {0.0, 1.0}, vx[] = {1.0, 1.0}, vz[] = {0.0, 0.0};
+    const struct motion m = {.n = 2, .t = t, .vx = vx, .vz = vz, .speed_scale = 1.0, .time_scale = 1.0};
+    const double lo[3] = {0.0, 0.0, 0.0}, hi[3] = {0.5, 0.3, 0.3}, dt = 0.002, gap = 1e-4;
+    struct wall wl = box_wall(lo, hi, MESH_BOX_OPEN_TOP, 0);
+    wl.motion = 0;
+    assert_int_equal(wall_surface_build(&wl, NULL, err, sizeof err), MIXSPH_OK);
+    struct walls W;
+    walls_of(&W, &wl, 1, &m, 3);
+    struct particles P = {0};
+    assert_int_equal(particles_alloc(&P, 16), 0);
+    double o_old[1][DIM];
+    memcpy(o_old[0], W.state[0].o, sizeof o_old[0]);
+    walls_move(&W, &P, 0.0, dt);
+    double p0[3] = {0.001, 0.15, 0.1}, p1[3] = {0.001, 0.15, 0.1}, v[3] = {0.0, 0.2, 0.0};
+    long clips = 0;
+    walls_keep_fluid_side(&W, (const double (*)[DIM])o_old, gap, p0, p1, v, &clips);
+    assert_int_equal(clips, 1);
+    assert_float_equal(p1[0], 1.0 * dt + gap, 1e-12); /* in front of the face at x = 0.002 */
+    assert_float_equal(v[0], 1.0, 1e-12);              /* the wall's normal velocity */
+    assert_float_equal(v[1], 0.2, 1e-15);              /* the tangential one kept */
+    particles_free(&P);
+    surface_free(&wl.surface);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -542,6 +573,7 @@ int main(void)
         cmocka_unit_test(test_moving_box_wall),
         cmocka_unit_test(test_extrapolation_in_a_tank),
         cmocka_unit_test(test_index_against_brute_force),
+        cmocka_unit_test(test_moving_wall_pushes),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -81,6 +81,8 @@ mixsph_status wall_side_walls(const struct wall *flume, struct wall *sides, char
                            .motion = -1,
                            .slip = flume->side_walls,
                            .friction_deg = flume->friction_deg};
-    snprintf(sides->name, sizeof sides->name, "%s_sides", flume->name);
+    const size_t len = strlen(flume->name); /* checked above: the name and "_sides" fit */
+    memcpy(sides->name, flume->name, len);
+    memcpy(sides->name + len, "_sides", sizeof "_sides");
     return wall_surface_build(sides, NULL, err, err_len);
 }
