@@ -331,6 +331,19 @@ double mesh_volume(const struct mesh *m)
     return six_v / 6.0;
 }
 
+double mesh_area(const struct mesh *m)
+{
+    double area = 0.0;
+    for (size_t t = 0; t < m->n_triangles; t++) {
+        double ab[3], ac[3], n[3];
+        vec3_sub(m->vertex[m->triangle[t][1]], m->vertex[m->triangle[t][0]], ab);
+        vec3_sub(m->vertex[m->triangle[t][2]], m->vertex[m->triangle[t][0]], ac);
+        vec3_cross(ab, ac, n);
+        area += 0.5 * sqrt(vec3_dot(n, n));
+    }
+    return area;
+}
+
 /* A directed edge of a triangle, keyed by its undirected vertex pair. */
 struct edge_use {
     size_t lo, hi, triangle;

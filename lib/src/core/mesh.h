@@ -80,6 +80,9 @@ void mesh_bounds(const struct mesh *m, double lo[3], double hi[3]);
  *  tetrahedra of the triangles and the origin) [m3]; negative for an inward-oriented mesh. */
 double mesh_volume(const struct mesh *m);
 
+/** The area of the mesh's triangles [m2]. */
+double mesh_area(const struct mesh *m);
+
 /** Is the mesh closed and consistently oriented by its indices: every edge used by exactly two
  *  triangles, once in each direction? On failure returns MIXSPH_ERR_ARG and names an edge, the
  *  triangle using it and how often it is used in each direction. */

@@ -81,9 +81,11 @@ static double body_box3(const struct case_def *c, size_t k, double lo[3], double
     return volume;
 }
 
-/* Wall particles of wall k: a strip of wall_layers rows behind its length. */
+/* Wall particles of wall k: a strip of wall_layers rows behind its length (2D), a sheet of
+ * wall_layers layers behind its surface (3D). */
 static double wall_particles(const struct case_def *c, size_t k)
 {
+    if (c->dimensions == 3) return mesh_area(&c->walls[k].surface.mesh) * c->wall_layers / (c->dx * c->dx);
     return geom_polyline_length(&c->walls[k].line) * c->wall_layers / c->dx;
 }
 
@@ -91,6 +93,12 @@ static double wall_particles(const struct case_def *c, size_t k)
 static double wall_sites(const struct case_def *c, size_t k)
 {
     const double depth = c->wall_layers * c->dx;
+    if (c->dimensions == 3) {
+        double lo[3], hi[3], sites = 1.0;
+        mesh_bounds(&c->walls[k].surface.mesh, lo, hi);
+        for (int d = 0; d < 3; d++) sites *= fmax(0.0, floor((hi[d] - lo[d] + 2.0 * depth) / c->dx)) + 3.0;
+        return sites;
+    }
     double x0 = INFINITY, x1 = -INFINITY, z0 = INFINITY, z1 = -INFINITY;
     geom_grow_box(&c->walls[k].line, &x0, &x1, &z0, &z1);
     return box_sites(x0 - depth, x1 + depth, z0 - depth, z1 + depth, c->dx);
@@ -171,6 +179,13 @@ mixsph_status budget_check(const struct case_def *c, char *err, size_t err_len)
         char wl[32], len[32];
         num(b.particles + b.wall_particles, est, sizeof est);
         num(wall_particles(c, w), wl, sizeof wl);
+        if (c->dimensions == 3) {
+            num(mesh_area(&c->walls[w].surface.mesh), len, sizeof len);
+            return status_set(err, err_len, MIXSPH_ERR_CASE,
+                              "%s: walls.%s: %s m2 of surface with %d layers at dx = %s m gives about %s wall "
+                              "particles, about %s particles in all, " OVER,
+                              c->origin, c->walls[w].name, len, c->wall_layers, val, wl, est, lim, "numerics.max_particles");
+        }
         num(geom_polyline_length(&c->walls[w].line), len, sizeof len);
         return status_set(err, err_len, MIXSPH_ERR_CASE,
                           "%s: walls.%s.polyline: %s m long with %d layers at dx = %s m gives about %s wall "
