@@ -118,7 +118,9 @@ static mixsph_status granular_finish(struct medium *md, const struct law_finish_
         md->paper.mu_thr = ctx->number(ctx->entry, "mu1"); /* mu0 keeps its default: no limit */
         md->paper.mu1_mode = 1;
     } else if (!ctx->given(ctx->entry, "mu_thr")) {
-        return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1)", ctx->origin, ctx->path);
+        return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1): the paper's law, the default of a "
+                         "granular medium, holds its grains above the threshold viscosity mu_thr; \"law\": "
+                         "\"elastic_plastic\" needs neither (docs/model.md section 10)", ctx->origin, ctx->path);
     }
     md->mu = 0.0; /* set by the rheology */
     md->held_takes_kicks = mixture_paper_held_grain_kicked(md, 0);
