@@ -376,3 +376,42 @@ def test_tools_read_the_snapshots_of_a_run_without_csv(full, tmp_path):
         assert set(h) - set(c) == {"m"}    # run.h5 also holds the mass, the CSV not
         for k in c:
             assert np.allclose(c[k][order], h[k], rtol=1e-5, atol=1e-9), k
+
+
+def test_3d_run_file_xdmf_csv_and_plots(tmp_path):
+    """A 3D case (cases/falling_block_3d.json, 1000 particles, to 0.02 s) through the same
+    executable: run.h5 holds 3-component positions and velocities, run.xdmf is read by meshio as
+    3D points with every field, the CSV snapshots have y columns, and plot_snapshot draws the
+    side view of a y band (only the particles in it) and the plan view."""
+    out = tmp_path / "block"
+    run([str(ROOT / "cases" / "falling_block_3d.json"), "--set", "numerics.t_end=0.02", "--set",
+         "output.snapshot_interval=0.01", "--out", str(out), "--threads", "1", "--quiet"])
+    with h5py.File(out / "run.h5", "r") as f:
+        snaps = [f["snapshots"][name] for name in sorted(f["snapshots"])]
+        assert len(snaps) == 3
+        for g in snaps:
+            assert g["position"].shape == (1000, 3) and g["velocity"].shape == (1000, 3)
+        first = snaps[0]["position"][()]
+        # the cube's lattice: x, y, z = (i + 1/2) dx, 10 sites a side
+        np.testing.assert_allclose(np.unique(np.round(first[:, 1], 9)), 0.005 + 0.01 * np.arange(10), atol=1e-12)
+        with TimeSeriesReader(str(out / "run.xdmf")) as reader:
+            points, _ = reader.read_points_cells()
+            np.testing.assert_array_equal(points, first)
+            _, point_data, _ = reader.read_data(len(snaps) - 1)
+            assert point_data["velocity"].shape == (1000, 3)
+            for name in ("density", "pressure", "mass", "medium", "state", "id"):
+                np.testing.assert_array_equal(point_data[name], snaps[-1][name][()])
+    header = (out / "snap_0001.csv").read_text().splitlines()[1]
+    assert header.startswith("id,x,y,z,vx,vy,vz,")
+    tool = ROOT / "tools" / "plot_snapshot.py"
+    for args in (["--view", "side", "--y-band", "0.04", "0.06"], ["--view", "plan", "--color", "speed"]):
+        png = tmp_path / f"{args[1]}.png"
+        r = subprocess.run([PYTHON, str(tool), str(out), *args, "-o", str(png)], capture_output=True, text=True,
+                           timeout=300)
+        assert r.returncode == 0, r.stderr
+        assert png.stat().st_size > 5000
+    sys.path.insert(0, str(ROOT / "tools"))
+    import plot_snapshot
+    band = plot_snapshot.Run(str(out))
+    band.set_view("side", (0.04, 0.06))
+    assert len(band.snapshot(0)["position"]) == 2 * 10 * 10  # two y layers of the cube
