@@ -32,8 +32,11 @@ enum law_feature {
     LAW_DENSITY_DIFFUSION = 8u, /* its particles take the continuity pass's density diffusion (a fluid: a
                                    grain's density carries its packing or its elastic pressure, which
                                    diffused would let a standing heap creep; docs/numerics.md 2c) */
-    LAW_WALL_FRICTION = 16u,    /* no-slip walls bound the shear they give its particles by their friction
-                                   (docs/model.md [DP-W]; with LAW_HAS_STRESS) */
+    LAW_WALL_FRICTION = 16u,    /* the shear a no-slip wall gives its particles is the wall's Coulomb
+                                   friction (docs/model.md [BF]), delta the wall's friction or the
+                                   medium's phi where the wall gives none */
+    LAW_WALL_FRICTION_GIVEN = 64u, /* the same, at the no-slip walls that give their friction angle
+                                      only (elsewhere the law's own no-slip shear: the paper's) */
     LAW_HOLDS_PARTICLES = 32u   /* its update holds particles fixed (MIXSPH_STATE_FIXED) and returns how
                                    many; its finish says how a held particle is integrated (struct
                                    medium's held_takes_kicks, held_viscosity) */
