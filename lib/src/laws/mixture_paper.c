@@ -252,6 +252,7 @@ static void mixture_region(void *arg, int tid, int nth)
         velocity_gradient_corrected(step->grad, i, grad);
         const double sii = rheology_sqrt_ii(grad);
         const double pw = pore_pressure(M->pore, m, P->pos[0][i], P->pos[DIM_UP][i]);
+        if (P->pore_p) P->pore_p[i] = pw > 0.0 ? pw : 0.0; /* the bed friction's (passes/bed_friction.h) */
         const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
         const double mu_app = rheology_apparent(sigma, m->granular.sin_phi, sii, m->paper.eps_f_mu_f, m->paper.mu_thr);
         double mu;

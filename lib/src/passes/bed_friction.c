@@ -15,7 +15,7 @@ void bed_friction_change(const struct bed_contact *c, double change[DIM])
     }
     double t_wall[DIM]; /* the law's tangential wall force, which the contact replaces */
     for (int d = 0; d < DIM; d++) t_wall[d] = c->wall_force[d] - fn * e[d];
-    const double n_eff = fn - 2.0 * c->p_background * c->volume * nn;
+    const double n_eff = fn - 2.0 * (c->p_background + c->pore_pressure) * c->volume * nn;
     if (n_eff <= 0.0) { /* no contact: the walls neither pull the grain nor shear it */
         for (int d = 0; d < DIM; d++) change[d] = -t_wall[d] - (n_eff < 0.0 ? n_eff * e[d] : 0.0);
         return;

@@ -5,7 +5,8 @@
  * material law gave (the elastic-plastic law's mirrored stress, the paper law's viscous term with
  * the wall's no-slip velocity) is replaced by a Coulomb contact:
  *
- *   N' = N - 2 p_b V_i |n|                        (the background pressure is not a contact force)
+ *   N' = N - 2 (p_b + p_w) V_i |n|                (neither the background pressure nor the pore
+ *                                                  water's is a contact force of the grains)
  *   F_stick = -m_i u_t / dt - F_other,t           (the tangential force that stops the grain's slip
  *                                                  u_t over the next step, given the others)
  *   F_t = F_stick                 if |F_stick| <= tan(delta) N'   (the grain sticks)
@@ -32,6 +33,7 @@ struct bed_contact {
     double mass;             /* [kg per m] */
     double volume;           /* [m2] */
     double p_background;     /* [Pa] */
+    double pore_pressure;    /* its pore pressure p_w >= 0 [Pa]: the walls' normal force holds its part too */
     double dt;               /* the time step [s]; 0: the stick force holds the other forces only */
 };
 

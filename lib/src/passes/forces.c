@@ -1044,7 +1044,7 @@ static void bed_friction_apply(const struct pass_region *R, const struct particl
     if (!(q > 0.0)) return;
     struct bed_contact c = {.tan_delta = (ws[WALL_QMU_GIVEN][i] + ws[WALL_Q_OWN][i] * tan_phi) / q,
                             .mass = P->m[i], .volume = P->vol[i], .p_background = R->S->params.p_background,
-                            .dt = R->S->dt};
+                            .pore_pressure = P->pore_p[i], .dt = R->S->dt};
     for (int d = 0; d < DIM; d++) {
         c.wall_force[d] = ws[WALL_F + d][i];
         c.normal[d] = ws[WALL_N + d][i];
