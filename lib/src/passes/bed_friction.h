@@ -16,7 +16,8 @@
  * grain and never pulls it. Summed over the grains of a body sliding on a bed, the friction is
  * tan(delta) times the normal load whatever the law's own shear at the wall: the Coulomb block.
  * (A bound alone, |F_t| <= tan(delta) N', left a sliding elastic-plastic block with the shear its
- * stress gave at the wall, below tan(delta) N: it slid 1.35 times too fast.) A pure function of a
+ * stress gave at the wall, about 70 % of tan(delta) N: on a 45-degree ramp with delta = 30 it
+ * slid 1.15-1.18 times too fast, docs/validation/coulomb_block.md.) A pure function of a
  * grain's sums: forces.c gathers them in the momentum pass and calls it per grain. */
 #ifndef MIXSPH_BED_FRICTION_H
 #define MIXSPH_BED_FRICTION_H
