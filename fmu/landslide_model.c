@@ -7,7 +7,7 @@
  * How the parameters reach the case (docs/fmu.md, docs/cases.md):
  *   - the physical ones (reservoir_level, phi, mu0, mu_thr, saturated, porosity, grain_density,
  *     tension_cutoff, plate_duration_scale, plate_stroke_scale, rheology, grain_bulk_modulus, nu,
- *     cohesion) are overrides "parameters.NAME"
+ *     cohesion, bed_friction) are overrides "parameters.NAME"
  *     of the case's `parameters` block: a case declares there the names it lets a host set and
  *     uses them as "$NAME" values, so any case file that declares them works, whatever its
  *     media, bodies and walls are called. One the host sets and the case does not declare is an
@@ -57,6 +57,7 @@ enum {
     P_GRAIN_BULK_MODULUS,
     P_NU,
     P_COHESION,
+    P_BED_FRICTION,
     N_REAL_PARAMS
 };
 static const struct real_param real_params[N_REAL_PARAMS] = {
@@ -74,6 +75,7 @@ static const struct real_param real_params[N_REAL_PARAMS] = {
     [P_GRAIN_BULK_MODULUS] = CASE_PARAM(grain_bulk_modulus),
     [P_NU] = CASE_PARAM(nu),
     [P_COHESION] = CASE_PARAM(cohesion),
+    [P_BED_FRICTION] = CASE_PARAM(bed_friction),
 };
 
 /* Boolean parameters: passed to the case as 0/1 overrides of `key` when the host sets them. */

@@ -42,6 +42,38 @@ struct site {
     size_t body;     /* the body it belongs to */
 };
 
+/* A wall's friction angle delta from which the bed friction is "none" (docs/model.md [BF]): the
+ * law's own no-slip shear, unbounded [deg]. */
+#define WALL_FRICTION_NONE_DEG 90.0
+
+/* Whether some grain of the case takes a wall's Coulomb friction (bed_friction.h): a medium whose
+ * law bounds the shear of every no-slip wall (LAW_WALL_FRICTION) and a no-slip wall that does not
+ * give delta = 90, or a law that takes it where a wall gives its angle (LAW_WALL_FRICTION_GIVEN)
+ * and such a wall. */
+static int bed_friction_on(const struct case_def *c)
+{
+    unsigned features = 0u;
+    for (size_t k = 0; k < c->n_media; k++) features |= law_get(c->media[k].law)->features;
+    for (size_t w = 0; w < c->n_walls; w++) {
+        const struct wall *wl = &c->walls[w];
+        if (wl->slip != WALL_NO_SLIP || wl->friction_deg >= WALL_FRICTION_NONE_DEG) continue;
+        if ((features & LAW_WALL_FRICTION) || ((features & LAW_WALL_FRICTION_GIVEN) && !isnan(wl->friction_deg)))
+            return 1;
+    }
+    return 0;
+}
+
+/* A wall particle's friction coefficient (particles.h wall_friction): tan(delta) of its wall's
+ * friction, -1 where the wall takes the grains' phi, -2 where it bounds nothing (delta = 90); 0
+ * for a particle that is not a wall's. */
+static double wall_friction_coefficient(const struct wall *w)
+{
+    if (!w) return 0.0;
+    if (isnan(w->friction_deg)) return -1.0;
+    if (w->friction_deg >= WALL_FRICTION_NONE_DEG) return -2.0;
+    return tan(w->friction_deg * GEOM_PI / 180.0);
+}
+
 static int site_cmp(const void *a, const void *b)
 {
     const struct site *p = a, *q = b;
@@ -212,6 +244,7 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     s->phys.P.features = s->cfg.viscosity_implicit ? PARTICLE_FEATURE_IMPLICIT_VISCOUS : 0u;
     for (size_t k = 0; k < s->cfg.n_media; k++)
         if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->phys.P.features |= PARTICLE_FEATURE_STRESS;
+    if (bed_friction_on(&s->cfg)) s->phys.P.features |= PARTICLE_FEATURE_BED_FRICTION;
     if (particles_alloc(&s->phys.P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
@@ -312,7 +345,6 @@ static mixsph_status create_laws(mixsph_sim *s)
             struct particles *P = &s->phys.P;
             const int wall = P->state[i] == MIXSPH_STATE_WALL;
             const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
-            P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
             double n[DIM] = {0.0};
             if (wall && w->slip == WALL_FREE_SLIP) {
                 double pos[DIM];
@@ -320,7 +352,14 @@ static mixsph_status create_laws(mixsph_sim *s)
                 walls_normal(&s->phys.walls, particles_wall_index(P, i), pos, n);
             }
             for (int d = 0; d < DIM; d++) P->wall_n[d][i] = n[d];
-            P->wall_friction[i] = !wall ? 0.0 : isnan(w->friction_deg) ? -1.0 : tan(w->friction_deg * GEOM_PI / 180.0);
+        }
+    if (s->phys.P.features & PARTICLE_FEATURE_BED_FRICTION) /* the walls' friction on grains (bed_friction.h) */
+        for (size_t i = 0; i < s->phys.P.n; i++) {
+            struct particles *P = &s->phys.P;
+            const int wall = P->state[i] == MIXSPH_STATE_WALL;
+            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
+            P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
+            P->wall_friction[i] = wall_friction_coefficient(w);
         }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
@@ -345,7 +384,8 @@ static void set_scheme_params(mixsph_sim *s)
         .pair = {.K = s->phys.K,
                  .eta2 = c->eta2_over_h2 * s->phys.h * s->phys.h,
                  .g = c->g,
-                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0},
+                 .stress = (s->phys.law_features & LAW_HAS_STRESS) != 0,
+                 .bed_friction = (s->phys.P.features & PARTICLE_FEATURE_BED_FRICTION) != 0},
     };
 #define NUMERICS_KEY COPY_NUMERICS_KEY
 #include "numerics_keys.def"

@@ -86,8 +86,9 @@ static void test_declared_parameters(void **state)
     char names[512];
     size_t n = 0;
     assert_int_equal(mixsph_case_parameter_names(CASE("slope_tank.json"), names, sizeof names, &n, err, sizeof err), MIXSPH_OK);
-    assert_string_equal(names, "reservoir_level, phi, porosity, grain_density, saturated, plate_duration_scale, plate_stroke_scale");
-    assert_int_equal(n, 7);
+    assert_string_equal(names, "reservoir_level, phi, porosity, grain_density, saturated, plate_duration_scale, "
+                               "plate_stroke_scale, bed_friction");
+    assert_int_equal(n, 8);
     assert_int_equal(mixsph_case_parameter_names(CASE("dambreak_water.json"), names, sizeof names, &n, err, sizeof err), MIXSPH_OK);
     assert_string_equal(names, "");
     assert_int_equal(n, 0);
@@ -95,7 +96,7 @@ static void test_declared_parameters(void **state)
     char short_buf[10];
     assert_int_equal(mixsph_case_parameter_names(CASE("slope_tank.json"), short_buf, sizeof short_buf, &n, err, sizeof err), MIXSPH_OK);
     assert_string_equal(short_buf, "reservoir");
-    assert_int_equal(n, 7);
+    assert_int_equal(n, 8);
 }
 
 static void test_unreadable_cases_are_errors_with_a_message(void **state)

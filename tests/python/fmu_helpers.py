@@ -27,7 +27,8 @@ COARSE = {"dx": 0.03, "mu0": 1000.0}
 # The FMU's physical parameters reach a case through its `parameters` block (override
 # "parameters.NAME"), the numerical ones through keys every case has (fmu/landslide_model.c).
 PHYSICAL = ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "tension_cutoff", "porosity", "grain_density",
-            "plate_duration_scale", "plate_stroke_scale", "rheology", "grain_bulk_modulus", "nu", "cohesion"]
+            "plate_duration_scale", "plate_stroke_scale", "rheology", "grain_bulk_modulus", "nu", "cohesion",
+            "bed_friction"]
 CASE_KEYS = {
     **{name: f"parameters.{name}" for name in PHYSICAL},
     "dx": "numerics.dx",

@@ -331,6 +331,29 @@ def test_sweep_on_an_existing_cluster_without_the_repository(tmp_path):
                 os.killpg(p.pid, signal.SIGKILL)
 
 
+def test_bed_friction_is_swept_and_is_a_physical_emulator_input(tmp_path):
+    # bed_friction (the bed's Coulomb friction angle, docs/model.md [BF]) varied by a sweep: each
+    # run is the FMU's own with that value, the values change the slide, and the emulator takes
+    # the column as a physical input
+    from fmpy import simulate_fmu
+    from tools.dss import emulator as E
+    fmu = fmu_path()
+    out = tmp_path / "sweep"
+    stop = 0.4
+    dss("sweep", out, "--fmu", fmu, "--grid", "bed_friction=20,90", *COARSE, "--stop-time", stop, "--step", 0.05,
+        "--workers", 1, "--no-report", "--quiet")
+    df = ResultStore(str(out)).latest().sort_values("bed_friction")
+    assert list(df["bed_friction"]) == [20.0, 90.0] and (df["status"] == "ok").all(), df.get("error")
+    for rec in df.to_dict(orient="records"):
+        r = simulate_fmu(fmu, start_values={"bed_friction": rec["bed_friction"], "dx": 0.05, "threads": 1},
+                         stop_time=stop, output_interval=0.05, output=["landslide_front"])
+        assert rec["landslide_front"] == pytest.approx(float(r[-1]["landslide_front"]), rel=1e-12, abs=1e-12)
+    assert df["landslide_front"].iloc[0] != df["landslide_front"].iloc[1]
+    assert "bed_friction" in E.PHYSICAL
+    names, kinds = E.choose_inputs(df)
+    assert names == ["bed_friction"], names
+
+
 def test_the_granular_law_is_swept_by_its_item_name_and_is_a_binary_emulator_input(tmp_path):
     # rheology (an Enumeration of the FMU) given by item names: the scenario table, its ids and
     # the results hold the items' values (0 paper, 1 elastic_plastic), each run is the FMU's own

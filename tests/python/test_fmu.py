@@ -33,7 +33,7 @@ def test_validate_fmu_finds_no_problem():
     names = {v.name: v for v in md.modelVariables}
     for p in ["reservoir_level", "phi", "mu0", "mu_thr", "saturated", "dx", "plate_duration_scale",
               "plate_stroke_scale", "porosity", "grain_density", "output_interval", "case_file", "tension_cutoff",
-              "pressure_smoothing", "av_wall", "rheology", "grain_bulk_modulus", "nu", "cohesion"]:
+              "pressure_smoothing", "av_wall", "rheology", "grain_bulk_modulus", "nu", "cohesion", "bed_friction"]:
         assert names[p].causality == "parameter", p
     for o in H.OUT_REAL + H.OUT_INT:
         assert names[o].causality == "output" and names[o].start is None, o
@@ -455,6 +455,27 @@ def test_elastic_plastic_parameters_act_on_their_law_only(fmu_run_ep, fmu_run_ph
                            output_interval=0.02)
     assert viscous["max_run_up"][-1] == fmu_run_ep["max_run_up"][-1]
     assert viscous["steps"][-1] == fmu_run_ep["steps"][-1]
+
+
+def test_bed_friction_reaches_the_bed_wall(fmu_run_phi35, tmp_path):
+    from fmpy import simulate_fmu
+    # bed_friction reaches the case as parameters.bed_friction, the Vajont bed wall's friction: the
+    # FMU's run is the executable's with that override, and a Coulomb bed (delta = 20 degrees, the
+    # paper law's grains then slide on it) moves the slide's front from the default's (90: the
+    # paper's no-slip bed); an angle out of [0, 90] is an fmi2Error naming it
+    res = simulate_fmu(H.fmu_path(), start_values={**RUN, "bed_friction": 20.0}, stop_time=EP_STOP,
+                       output_interval=0.02)
+    cli = H.run_mixsph({**RUN, "bed_friction": 20.0}, tmp_path / "cli", t_end=EP_STOP)
+    assert res["max_run_up"][-1] == cli["outputs"]["run_up"]["max"]
+    assert res["steps"][-1] == cli["steps"]
+    default = fmu_run_phi35[fmu_run_phi35["time"] <= EP_STOP + 1e-9]
+    assert res["landslide_front"][-1] != default["landslide_front"][-1]
+    v = H.vrs()
+    log = H.Logger()
+    f = H.instance("bed_friction", logger=log)
+    _expect_error(log, f.setReal, [v["bed_friction"]], [95.0], text="bed_friction = 95 is out of range [0, 90]")
+    assert f.getReal([v["bed_friction"]]) == [90.0]  # the instance keeps the value it had
+    f.freeInstance()
 
 
 def test_bad_rheology_values_give_fmi2error_and_a_logged_message():

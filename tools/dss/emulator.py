@@ -54,10 +54,11 @@ MODES = ("product", "binary", "separate")
 # the FMU's physical parameters and the numerical ones an emulator may take as inputs when a
 # sweep varies them; never inputs: threads, file names, output settings. rheology (the granular
 # law, 0 paper / 1 elastic_plastic) is a two-level input like saturated; mu0, mu_thr and
-# tension_cutoff are the paper law's, nu and cohesion the elastic-plastic law's; the grains' bulk
+# tension_cutoff are the paper law's, nu and cohesion the elastic-plastic law's, bed_friction
+# the bed's Coulomb friction angle of either law (90: none); the grains' bulk
 # modulus is the weakly compressible stiffness (numerical, as dx)
 PHYSICAL = ("reservoir_level", "phi", "saturated", "porosity", "grain_density",
-            "plate_duration_scale", "plate_stroke_scale", "nu", "cohesion")
+            "plate_duration_scale", "plate_stroke_scale", "nu", "cohesion", "bed_friction")
 NUMERICAL = ("dx", "rheology", "mu0", "mu_thr", "pressure_smoothing", "tension_cutoff", "av_wall",
              "implicit_viscosity", "grain_bulk_modulus")
 NOT_INPUTS = ("threads", "case_file", "output_interval")

@@ -96,14 +96,18 @@ const struct particle_field particle_fields[] = {
      , .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_STRESS, .where = OUT, .csv_digits = 6},
     {.name = "wall_rough", COMPONENTS1(wall_rough), .unit = "1",
      .description = "1 for a particle of a no-slip wall (its friction applies), 0 for the others",
-     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
     {.name = "wall_normal", VECTOR(wall_n, "wall_n"), .unit = "1",
      .description = "a free-slip wall particle's unit normal toward the solid, across which it mirrors "
                     "the solid's stress (0 for the others)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
     {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
-     .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi))",
-     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+     .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi), -2: none)",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
+    {.name = "pore_pressure", COMPONENTS1(pore_p), .unit = "Pa",
+     .description = "a grain's pore pressure p_w (>= 0) of its law's last update, left out of the bed friction's "
+                    "normal force (0 for the others)",
+     .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
 };
 
 const size_t particle_field_count = sizeof particle_fields / sizeof particle_fields[0];

@@ -35,7 +35,8 @@ enum {
  * file, no state). */
 enum {
     PARTICLE_FEATURE_IMPLICIT_VISCOUS = 1u << 0, /* numerics.viscosity = "implicit" (viscous.h) */
-    PARTICLE_FEATURE_STRESS = 1u << 1            /* a medium's law carries a stress (laws/law.h) */
+    PARTICLE_FEATURE_STRESS = 1u << 1,           /* a medium's law carries a stress (laws/law.h) */
+    PARTICLE_FEATURE_BED_FRICTION = 1u << 2      /* walls' Coulomb friction on grains (sim.c bed_friction_on) */
 };
 
 struct particle_field {

@@ -179,10 +179,12 @@ static const struct case_key wall_keys[] = {
                 "is above it"},
     {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .numeric_choice = 1,
      .field = CASE_FIELD(wall, slip), .meaning = "the condition on the tangential velocity"},
-    {.key = "friction", .type = CASE_NUMBER, RANGE(0, 0, 89, 0), .def_text = "φ of the grains", .unit = "deg",
+    {.key = "friction", .type = CASE_NUMBER, RANGE(0, 0, 90, 0),
+     .def_text = "elastic_plastic: φ of the grains; paper: 90", .unit = "deg",
      .field = CASE_FIELD(wall, friction_deg),
-     .meaning = "wall friction angle δ on elastic-plastic grains at a no-slip wall: its shear on a grain is at most "
-                "tan δ times the effective normal force (0: smooth)"},
+     .meaning = "bed friction angle δ of a no-slip wall on grains (docs/model.md [BF]): its shear on a sliding grain "
+                "is tan δ times the normal force it exerts, on a grain at rest at most that (0: smooth; 90: none, "
+                "the law's own no-slip shear)"},
     {.key = "motion", .type = CASE_NAME, .def_text = "fixed", .meaning = "name of one of the motions"},
 };
 

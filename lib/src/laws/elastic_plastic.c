@@ -151,6 +151,7 @@ static void plastic_range(void *arg, size_t b, size_t e)
                                                    .alpha_phi = m->dp.alpha_phi, .k_c = m->dp.k_c,
                                                    .alpha_psi = m->dp.alpha_psi};
         const double pw = fmax(pore_pressure(pore, m, P->pos[0][i], P->pos[DIM_UP][i]), 0.0);
+        if (P->pore_p) P->pore_p[i] = pw; /* the bed friction's (passes/bed_friction.h) */
         double p_eff = P->p[i] - pb - pw;
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
         if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb + pw; /* the tension cut-off */

@@ -32,17 +32,20 @@ enum law_feature {
     LAW_DENSITY_DIFFUSION = 8u, /* its particles take the continuity pass's density diffusion (a fluid: a
                                    grain's density carries its packing or its elastic pressure, which
                                    diffused would let a standing heap creep; docs/numerics.md 2c) */
-    LAW_WALL_FRICTION = 16u,    /* no-slip walls bound the shear they give its particles by their friction
-                                   (docs/model.md [DP-W]; with LAW_HAS_STRESS) */
+    LAW_WALL_FRICTION = 16u,    /* the shear a no-slip wall gives its particles is the wall's Coulomb
+                                   friction (docs/model.md [BF]), delta the wall's friction or the
+                                   medium's phi where the wall gives none */
     LAW_HOLDS_PARTICLES = 32u,  /* its update holds particles fixed (MIXSPH_STATE_FIXED) and returns how
                                    many; its finish says how a held particle is integrated (struct
                                    medium's held_takes_kicks, held_viscosity) */
     LAW_FLUID = 64u,            /* a fluid: the water that grains with LAW_GRAINS_IN_WATER sink in */
-    LAW_GRAINS_IN_WATER = 128u  /* in its pairs with a LAW_FLUID particle its particle is a parcel of grains in
+    LAW_GRAINS_IN_WATER = 128u, /* in its pairs with a LAW_FLUID particle its particle is a parcel of grains in
                                    the fluid (docs/model.md [GW]): it takes the fluid's pressure interpolated at
                                    it instead of its own, no deviatoric stress, the drag of the fluid through
                                    its grains, and leaves the fluid out of its density rate; set by a
                                    medium's finish (a granular law's key water_coupling = "grains") */
+    LAW_WALL_FRICTION_GIVEN = 256u /* as LAW_WALL_FRICTION, at the no-slip walls that give their friction angle
+                                      only (elsewhere the law's own no-slip shear: the paper's) */
 };
 
 struct medium {

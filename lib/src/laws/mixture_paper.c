@@ -254,6 +254,7 @@ static void mixture_region(void *arg, int tid, int nth)
         velocity_gradient_corrected(step->grad, i, grad);
         const double sii = rheology_sqrt_ii(grad);
         const double pw = pore_pressure(M->pore, m, P->pos[0][i], P->pos[DIM_UP][i]);
+        if (P->pore_p) P->pore_p[i] = pw > 0.0 ? pw : 0.0; /* the bed friction's (passes/bed_friction.h) */
         const double sigma = rheology_effective_stress(P->p[i] - pb, pw);
         const double mu_app = rheology_apparent(sigma, m->granular.sin_phi, sii, m->paper.eps_f_mu_f, m->paper.mu_thr);
         double mu;
@@ -327,7 +328,7 @@ const struct material_law law_mixture_paper = {
     .type = "granular",
     .name = "paper",
     .keys = &granular_section,
-    .features = LAW_USES_GRADIENT | LAW_HOLDS_PARTICLES,
+    .features = LAW_USES_GRADIENT | LAW_HOLDS_PARTICLES | LAW_WALL_FRICTION_GIVEN,
     .finish = granular_finish,
     .wave_speed = granular_wave_speed,
     .viscosity_bound = mixture_paper_held_viscosity,

@@ -48,6 +48,8 @@
 
 #include "forces.h"
 
+#include "bed_friction.h"
+
 #include <stdint.h>
 
 #include "mixsph.h"
@@ -81,11 +83,13 @@ static void *aligned_block(size_t bytes) { return aligned_alloc(64, bytes); }
 static void aligned_block_free(void *p) { free(p); }
 #endif
 
-/* The sums over its wall neighbours j that a particle's wall friction needs (momentum pass with
- * stress, no-slip walls): the walls' force on it, the wall normal n = -sum_j V_j F_ij x_ij (out of
- * the walls), the weight q = -sum_j V_j F_ij of the walls with a given friction coefficient, that
- * weight times their coefficient, and the weight of the walls that take the grain's own. */
-enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_SUMS }; /* F, N: DIM each */
+/* The sums over its wall neighbours j that a particle's bed friction needs (bed_friction.h; the
+ * momentum pass with bed friction, over the no-slip walls that bound its shear): the walls' force
+ * on it, the wall normal n = -sum_j V_j F_ij x_ij (out of the walls), the weight q = -sum_j V_j F_ij
+ * of the walls with a given friction coefficient, that weight times their coefficient, the weight
+ * of the walls that take the grain's own, and the weighted sum of the walls' velocities. */
+enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_OWN, WALL_V,
+       WALL_SUMS = WALL_V + DIM }; /* F, N, V: DIM each */
 
 /* The per-particle arrays of the grains in water (docs/model.md [GW]; params.grains_in_water): each
  * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, a
@@ -103,7 +107,8 @@ struct forces {
     double *nbr_count;        /* density pass: same-medium neighbours within 2h */
     double *smooth_sum;       /* smoothing: sum_j B_ij W_ij V_j */
     double *smooth_weight;    /* smoothing: sum_j W_ij V_j */
-    double *wall_sum[WALL_SUMS]; /* momentum pass with stress: each particle's wall sums (above) */
+    double *wall_sum[WALL_SUMS]; /* momentum pass with bed friction: each particle's wall sums (above) */
+    double *bed_given, *bed_own; /* momentum pass with bed friction: which walls bound a particle's shear */
     double *diffusion_sum;    /* density pass: sum_j V_j psi_ij (-F_ij) of the density diffusion */
     double *gw[GW_ARRAYS];    /* the grains in water (above) */
     size_t scratch_cap;
@@ -124,7 +129,11 @@ struct pair_ctx {
     int wendland;
     int arithmetic_mean;  /* implicit viscosity with the pair viscosity (mu_i + mu_j) / 2 */
     int stress;           /* the particles' deviatoric stresses enter the momentum pass */
-    double *wall_sum[WALL_SUMS]; /* with stress: the wall sums (struct forces) */
+    int bed_friction;     /* the momentum pass gathers the wall sums of the bed friction */
+    double *wall_sum[WALL_SUMS]; /* with bed_friction: the wall sums (struct forces) */
+    const double *bed_given, *bed_own; /* with bed_friction, per particle: 1 where the walls that give
+                                        * their friction angle (bed_given) or take its own medium's
+                                        * (bed_own) bound its shear, else 0 */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -155,7 +164,9 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->wendland = fp->K.type == KERNEL_WENDLAND_C2;
     X->arithmetic_mean = fp->arithmetic_mean;
     X->stress = fp->stress;
+    X->bed_friction = fp->bed_friction;
     for (int q = 0; q < WALL_SUMS; q++) X->wall_sum[q] = NULL;
+    X->bed_given = X->bed_own = NULL;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -467,7 +478,8 @@ enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict rng, int nr, double f_i[DIM],
                                   const double *restrict fk, double *restrict wl, const int wendland,
-                                  const int cached, const int implicit, const int stress, const int grains)
+                                  const int cached, const int implicit, const int stress, const int friction,
+                                  const int grains)
 {
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
     const double ti = P->tag[i], avci = P->avc[i];
@@ -492,7 +504,11 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
     const double *restrict avc = P->avc;
     const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
-    const double roughi = stress ? wall_rough[i] : 0.0, mu_wi = stress ? wall_mu[i] : 0.0;
+    const double *restrict bed_given = X->bed_given, *restrict bed_own = X->bed_own;
+    const double roughi = friction ? wall_rough[i] : 0.0, mu_wi = friction ? wall_mu[i] : 0.0;
+    const double bgi = friction ? bed_given[i] : 0.0, boi = friction ? bed_own[i] : 0.0;
+    /* wall particle i's friction: given (tan delta >= 0), the grains' own (-1) or none (-2: no bound) */
+    const double given_i = mu_wi >= 0.0 ? 1.0 : 0.0, own_i = mu_wi < 0.0 && mu_wi > -1.5 ? 1.0 : 0.0;
     /* the grains in water (grains): roles, the water's pressure at the grains, Ergun's factors */
     const double *restrict role = grains ? X->gw[GW_ROLE] : NULL, *restrict p_water = grains ? X->gw[GW_PRESSURE] : NULL;
     const double *restrict drag_v = grains ? X->gw[GW_DRAG_VISCOUS] : NULL;
@@ -570,9 +586,19 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                                              : drag_v[j] * mui + drag_r[j] * rhoi * sqrt(slip2);
                 cd = (gi + gj) * beta * vv_pair * w;
             }
+            /* bed friction: to_i = 1 where wall particle j bounds grain i's shear (bed_friction.h),
+             * to_j = 1 where wall particle i bounds grain j's */
+            double given_j = 0.0, own_j = 0.0, to_i = 0.0, to_j = 0.0;
+            if (friction) {
+                given_j = wall_mu[j] >= 0.0 ? 1.0 : 0.0;
+                own_j = wall_mu[j] < 0.0 && wall_mu[j] > -1.5 ? 1.0 : 0.0;
+                to_i = wall_rough[j] * (1.0 - walli) * (given_j * bgi + own_j * boi);
+                to_j = roughi * (1.0 - wallj) * (given_i * bed_given[j] + own_i * bed_own[j]);
+            }
             double f[DIM];
             if (implicit) {
-                wl[k] = -F * fv;
+                /* a bed's viscous shear on a grain is its Coulomb contact's (explicit): not in the solve */
+                wl[k] = friction ? -F * fv * (1.0 - to_i - to_j) : -F * fv;
                 if (grains) wl[k] += cd;
                 DIM_UNROLL
                 for (int d = 0; d < DIM; d++) f[d] = F * (fr * r[d]);
@@ -622,24 +648,26 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                     for (int b = 0; b < DIM; b++) tr += t[sym_index(a, b)] * r[b];
                     f[a] += F * tr;
                 }
-                /* the wall sums of the wall friction: i's from a rough wall particle j, j's from
-                 * a rough wall particle i (its force on j is -f, its normal at j -V_i F x_ji) */
-                const double to_i = wall_rough[j] * (1.0 - walli), to_j = roughi * (1.0 - wallj);
-                const double mu_gj = wall_mu[j] >= 0.0 ? 1.0 : 0.0, mu_gi = mu_wi >= 0.0 ? 1.0 : 0.0;
+            }
+            if (friction) { /* the wall sums of the bed friction: i's from a rough wall particle j that
+                             * bounds i's shear, j's from such a wall particle i (its force on j is -f,
+                             * its normal at j -V_i F x_ji) */
                 const double qi = -vol[j] * F * to_i, qj = -voli * F * to_j;
                 DIM_UNROLL
                 for (int d = 0; d < DIM; d++) {
                     ws[WALL_F + d][k] += to_i * f[d];
                     ws[WALL_N + d][k] += qi * r[d];
+                    ws[WALL_V + d][k] += qi * v[d][j];
                     wj[WALL_F + d][k] = -to_j * f[d];
                     wj[WALL_N + d][k] = -qj * r[d];
+                    wj[WALL_V + d][k] = qj * vi[d];
                 }
-                ws[WALL_Q_GIVEN][k] += qi * mu_gj;
-                ws[WALL_QMU_GIVEN][k] += qi * mu_gj * wall_mu[j];
-                ws[WALL_Q_OWN][k] += qi * (1.0 - mu_gj);
-                wj[WALL_Q_GIVEN][k] = qj * mu_gi;
-                wj[WALL_QMU_GIVEN][k] = qj * mu_gi * mu_wi;
-                wj[WALL_Q_OWN][k] = qj * (1.0 - mu_gi);
+                ws[WALL_Q_GIVEN][k] += qi * given_j;
+                ws[WALL_QMU_GIVEN][k] += qi * given_j * wall_mu[j];
+                ws[WALL_Q_OWN][k] += qi * own_j;
+                wj[WALL_Q_GIVEN][k] = qj * given_i;
+                wj[WALL_QMU_GIVEN][k] = qj * given_i * mu_wi;
+                wj[WALL_Q_OWN][k] = qj * own_i;
             }
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -648,7 +676,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             }
         }
         for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], jb, n, fj[d]);
-        if (stress && roughi != 0.0 && Xl.wall_sum[0])
+        if (friction && roughi != 0.0 && Xl.wall_sum[0])
             for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], jb, n, wj[q]);
         if (cached) fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
@@ -658,7 +686,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         for (size_t k = 0; k < FORCES_CHUNK; k++) t += sf[d][k];
         f_i[d] += t;
     }
-    if (stress && Xl.wall_sum[0])
+    if (friction && Xl.wall_sum[0])
         for (int q = 0; q < WALL_SUMS; q++) {
             double t = 0.0;
             for (size_t k = 0; k < FORCES_CHUNK; k++) t += ws[q][k];
@@ -722,13 +750,13 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                  size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
-                                 const int stress, const int grains)
+                                 const int stress, const int friction, const int grains)
 {
     for (size_t i = b0; i < b1; i++) {
         double f[DIM] = {0.0};
         momentum_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, f,
                        cached ? X->fk + X->fk_off[i] : NULL, implicit ? X->visc_w + X->fk_off[i] : NULL, wendland,
-                       cached, implicit, stress, grains);
+                       cached, implicit, stress, friction, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
@@ -871,24 +899,24 @@ static void continuity_band(const struct pair_ctx *X, const struct neighbours *N
     }
 }
 
-/* The momentum band walk, one inlined copy with and one without the stress term, and with the
- * grains in water. */
+/* The momentum band walk, one inlined copy per use of the stress term, of the bed friction's sums and of
+ * the grains in water. */
 FORCES_INLINE void momentum_band_variant(const struct pair_ctx *X, const struct neighbours *NB,
                                          struct particles *restrict P, size_t b0, size_t b1, const int stress,
-                                         const int grains)
+                                         const int friction, const int grains)
 {
     if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
         if (X->arithmetic_mean) {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, grains);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, grains);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, friction, grains);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, friction, grains);
         } else {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, grains);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, grains);
+            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, friction, grains);
+            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, friction, grains);
         }
         return;
     }
 #define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
-    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress, grains)
+    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress, friction, grains)
     FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
 #undef MOMENTUM_EXPLICIT
 }
@@ -897,14 +925,11 @@ FORCES_CLONES
 static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                           size_t b0, size_t b1)
 {
-    if (X->gw[GW_ROLE]) {
-        if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1, 1);
-        else momentum_band_variant(X, NB, P, b0, b1, 0, 1);
-    } else if (X->stress) {
-        momentum_band_variant(X, NB, P, b0, b1, 1, 0);
-    } else {
-        momentum_band_variant(X, NB, P, b0, b1, 0, 0);
-    }
+    /* the grains in water come with a granular law that has a stress (the elastic-plastic law) */
+    if (X->gw[GW_ROLE]) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 1);
+    else if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 0);
+    else if (X->bed_friction) momentum_band_variant(X, NB, P, b0, b1, 0, 1, 0);
+    else momentum_band_variant(X, NB, P, b0, b1, 0, 0, 0);
 }
 
 struct forces *forces_create(void) { return calloc(1, sizeof(struct forces)); }
@@ -919,6 +944,8 @@ void forces_free(struct forces *F)
     free(F->smooth_weight);
     for (int q = 0; q < WALL_SUMS; q++) free(F->wall_sum[q]);
     for (int q = 0; q < GW_ARRAYS; q++) free(F->gw[q]);
+    free(F->bed_given);
+    free(F->bed_own);
     free(F->diffusion_sum);
     aligned_block_free(F->visc_w);
     free(F);
@@ -973,10 +1000,11 @@ static int scratch_reserve(struct forces *F, size_t n)
 {
     if (F->scratch_cap >= n) return 0;
     const size_t cap = n + n / 4 + 64;
-    double **a[4 + WALL_SUMS + GW_ARRAYS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight, &F->diffusion_sum};
-    for (int q = 0; q < WALL_SUMS; q++) a[4 + q] = &F->wall_sum[q];
-    for (int q = 0; q < GW_ARRAYS; q++) a[4 + WALL_SUMS + q] = &F->gw[q];
-    for (int k = 0; k < 4 + WALL_SUMS + GW_ARRAYS; k++) {
+    double **a[6 + WALL_SUMS + GW_ARRAYS] = {&F->nbr_count, &F->smooth_sum, &F->smooth_weight, &F->diffusion_sum,
+                                             &F->bed_given, &F->bed_own};
+    for (int q = 0; q < WALL_SUMS; q++) a[6 + q] = &F->wall_sum[q];
+    for (int q = 0; q < GW_ARRAYS; q++) a[6 + WALL_SUMS + q] = &F->gw[q];
+    for (int k = 0; k < 6 + WALL_SUMS + GW_ARRAYS; k++) {
         double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
         if (!q) return -1;
         memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
@@ -1026,7 +1054,8 @@ struct pass_region {
     const double *diffusion;          /* density pass: the density diffusion's sums, or NULL (off) */
     double delta_h;                   /* density pass: delta h of the density diffusion */
     double g;                         /* momentum pass: gravity */
-    const double *const *wall_sums;   /* momentum pass with stress: the walls' sums of the wall friction */
+    const double *const *wall_sums;   /* momentum pass with bed friction: the walls' sums */
+    const double *bed_given, *bed_own; /* and which walls bound each particle's shear */
     double theta_dt_over_h;           /* smoothing */
     const double *sum, *weight;       /* smoothing: its sums */
     int bad;                          /* a non-finite rate (| over the threads) */
@@ -1183,42 +1212,28 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
     team_run(S->n_threads, gradient_region, &R);
 }
 
-/* The wall friction of an elastic-plastic grain i (docs/model.md [DP-W]): the tangential part F_t
- * of the force F_w its no-slip walls exert on it (their pressure, artificial viscosity and the
- * grain's own stress) is bounded by mu N', N' = F_w . n/|n| - 2 p_b V_i |n| its normal part
- * without the background pressure's, mu the walls' tan(delta) weighted by q (the grain's tan(phi)
- * where a wall takes it). Where N' < 0 (a cohesive grain's tension mirrored by the wall) the
- * contact is unilateral: the walls' effective force on the grain is removed altogether, so the
- * walls' normal forces on a body sum to its load and their friction to tan(delta) times it. Adds
- * the change to the force (fx, fz). */
-static void wall_friction_bound(const double *const ws[WALL_SUMS], size_t i, double vol_i, double tan_phi,
-                                double p_background, double f[DIM])
+/* The bed friction of grain i (bed_friction.h) from its wall sums: its walls' friction coefficient
+ * is their tan(delta) weighted by q (its medium's tan(phi) where a wall takes it), their velocity
+ * the q-weighted mean. `f` holds its pair force; gravity is added for the stick force only. */
+static void bed_friction_apply(const struct pass_region *R, const struct particles *P, size_t i, double tan_phi,
+                               double f[DIM])
 {
+    const double *const *ws = R->wall_sums;
     const double q = ws[WALL_Q_GIVEN][i] + ws[WALL_Q_OWN][i];
-    double n[DIM], fw[DIM], e[DIM], t[DIM];
+    if (!(q > 0.0)) return;
+    struct bed_contact c = {.tan_delta = (ws[WALL_QMU_GIVEN][i] + ws[WALL_Q_OWN][i] * tan_phi) / q,
+                            .mass = P->m[i], .volume = P->vol[i], .p_background = R->S->params.p_background,
+                            .pore_pressure = P->pore_p[i], .dt = R->S->dt};
     for (int d = 0; d < DIM; d++) {
-        n[d] = ws[WALL_N + d][i];
-        fw[d] = ws[WALL_F + d][i];
+        c.wall_force[d] = ws[WALL_F + d][i];
+        c.normal[d] = ws[WALL_N + d][i];
+        c.wall_velocity[d] = ws[WALL_V + d][i] / q;
+        c.force[d] = d == DIM_UP ? f[d] - P->m[i] * R->g : f[d];
+        c.velocity[d] = P->vel[d][i];
     }
-    const double nn = dim_norm(n);
-    if (!(q > 0.0) || !(nn > 0.0)) return;
-    const double mu = (ws[WALL_QMU_GIVEN][i] + ws[WALL_Q_OWN][i] * tan_phi) / q;
-    double fn = 0.0;
-    for (int d = 0; d < DIM; d++) {
-        e[d] = n[d] / nn;
-        fn += fw[d] * e[d];
-    }
-    for (int d = 0; d < DIM; d++) t[d] = fw[d] - fn * e[d];
-    const double ft = dim_norm(t);
-    const double n_eff = fn - 2.0 * p_background * vol_i * nn;
-    if (n_eff < 0.0) { /* a wall pushes a grain, never pulls it (no adhesion), and then has no shear on it */
-        for (int d = 0; d < DIM; d++) f[d] -= t[d] + n_eff * e[d];
-        return;
-    }
-    const double bound = mu * n_eff;
-    if (ft <= bound) return;
-    const double cut = (ft - bound) / ft;
-    for (int d = 0; d < DIM; d++) f[d] -= cut * t[d];
+    double change[DIM];
+    bed_friction_change(&c, change);
+    for (int d = 0; d < DIM; d++) f[d] += change[d];
 }
 
 static void momentum_region(void *arg, int tid, int nth)
@@ -1226,18 +1241,18 @@ static void momentum_region(void *arg, int tid, int nth)
     struct pass_region *R = arg;
     struct particles *P = R->S->P;
     const struct medium *M = R->S->media;
-    const double g = R->g, pb = R->S->params.p_background;
+    const double g = R->g;
     bands_in_team(R->S, momentum_band, R->X, R->bands, 0);
     size_t b, e;
     team_share(R->n, tid, nth, &b, &e);
     int bad = 0;
     for (size_t i = b; i < e; i++) {
         if (P->state[i] == MIXSPH_STATE_WALL) continue; /* keeps the force on it: its wall's work (walls_move) */
-        if (R->wall_sums && (M[P->medium[i]].features & LAW_WALL_FRICTION)) {
+        if (R->wall_sums && (R->bed_given[i] != 0.0 || R->bed_own[i] != 0.0)) {
             const double s = M[P->medium[i]].granular.sin_phi;
             double f[DIM];
             for (int d = 0; d < DIM; d++) f[d] = P->acc[d][i];
-            wall_friction_bound(R->wall_sums, i, P->vol[i], s / sqrt(1.0 - s * s), pb, f);
+            bed_friction_apply(R, P, i, s / sqrt(1.0 - s * s), f);
             for (int d = 0; d < DIM; d++) P->acc[d][i] = f[d];
         }
         double sum = 0.0;
@@ -1276,7 +1291,7 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         X.fk_off = F->fk_off;
     }
     F->fk_valid = 0;
-    const int friction = X.stress;
+    const int friction = X.bed_friction;
     if ((friction || S->params.grains_in_water) && scratch_reserve(F, n) != 0) return -1;
     if (S->params.grains_in_water) { /* the water's pressure at the grains, before the pairs use it */
         grains_in_water_roles(F, S, n, &X);
@@ -1287,15 +1302,25 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
         team_run(S->n_threads, water_pressure_region, &W);
         for (size_t i = n; i < n + FORCES_CHUNK; i++) F->gw[GW_PRESSURE][i] = 0.0;
     }
-    if (friction)
+    if (friction) {
         for (int q = 0; q < WALL_SUMS; q++) {
             memset(F->wall_sum[q], 0, n * sizeof(double));
             X.wall_sum[q] = F->wall_sum[q];
         }
+        for (size_t i = 0; i < n; i++) { /* which walls bound a grain's shear: its law's (laws/medium.h) */
+            const unsigned ft = P->state[i] == MIXSPH_STATE_WALL ? 0u : S->media[P->medium[i]].features;
+            F->bed_given[i] = ft & (LAW_WALL_FRICTION | LAW_WALL_FRICTION_GIVEN) ? 1.0 : 0.0;
+            F->bed_own[i] = ft & LAW_WALL_FRICTION ? 1.0 : 0.0;
+        }
+        X.bed_given = F->bed_given;
+        X.bed_own = F->bed_own;
+    }
     struct pass_region R;
     pass_region_init(&R, S, &X, momentum_band, n);
     R.g = X.g;
     R.wall_sums = friction ? (const double *const *)F->wall_sum : NULL;
+    R.bed_given = F->bed_given;
+    R.bed_own = F->bed_own;
     team_run(S->n_threads, momentum_region, &R);
     F->visc_valid = X.visc_w != NULL;
     return R.bad;
@@ -1363,7 +1388,7 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         return;
     }
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0);
+    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0, 0);
     for (int d = 0; d < DIM; d++) {
         a[d] = f[d] * P->inv_m[i];
         P->acc[d][j] = save[d];

@@ -27,8 +27,10 @@ struct forces_params {
     double eta2;        /* eta^2 of the Morris and Monaghan terms [m2] */
     double g;           /* gravity [m/s2] */
     int stress;             /* the momentum pass adds the divergence of the particles' deviatoric
-                               stress (P->stress; a law with LAW_HAS_STRESS) and bounds the
-                               shear of no-slip walls on elastic-plastic grains (wall friction) */
+                               stress (P->stress; a law with LAW_HAS_STRESS) */
+    int bed_friction;       /* the momentum pass replaces the shear of no-slip walls on grains by their
+                               Coulomb friction (bed_friction.h) where a grain's law asks for it
+                               (LAW_WALL_FRICTION, LAW_WALL_FRICTION_GIVEN) */
     int grains_in_water;    /* a medium has LAW_GRAINS_IN_WATER: its pairs with fluid particles take the
                                water's interpolated pressure and Ergun's drag (docs/model.md [GW]) */
 #define NUMERICS_KEY NUMERICS_MEMBER_OF_PAIR
@@ -50,6 +52,7 @@ struct pair_system {
     const struct gather *G;   /* gather ranges (the velocity gradient of grains) */
     const struct medium *media;
     struct forces_params params;
+    double dt;                /* the time step just taken [s] (the bed friction's stick force) */
     int n_threads;
 };
 
