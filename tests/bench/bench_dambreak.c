@@ -32,6 +32,7 @@
  * time into stepping, CSV snapshots and HDF5 snapshots (run.h5 + run.xdmf); then 3 checkpoints
  * are written and timed. It prints the time per step and per snapshot, the bytes per snapshot,
  * and the share of the run's wall time spent writing at the case's own snapshot interval. */
+#define _DEFAULT_SOURCE /* getloadavg */
 #include <dirent.h>
 #include <stdio.h>
 #include <stdlib.h>
