@@ -6,14 +6,18 @@ views of the water surface's elevation.
     .venv/bin/python tools/basin_slide_3d.py RUN [--times 0.4,0.6,0.8,1.0] [-o FIG.png]
 
 RUN is the output folder of `mixsph run cases/basin_slide_3d.json`. A gauge's amplitude is the
-largest value its max_elevation monitor took over the run minus its value at t = 0 (the top
-particle centre of the still water, so the dx/2 between a centre and the surface cancels). The
+largest value its max_elevation monitor took after the impact minus its value at the impact (the
+first sample at which the slide's front, `slide_front`, reaches the still water line x = -0.3464
+m): the top particle centre of the water still at rest there, so the dx/2 between a centre and the
+surface cancels, and the few millimetres the basin's water settles by before the impact (its
+start from a lattice) do not count as a wave. The
 decay a = C r^(-n) is fitted by least squares on log a against log r, per ray (the slide's axis,
 a0_*, and the ray 45 degrees off it, a45_*), over the gauges r >= --r-min (default 0.6 m: the far
 field, beyond the slide's own width and run-out in the water, which disturb the near field). The plan
-view: per square column dx wide, the highest water particle centre minus the still level, over
-the whole basin (the half y >= 0 the case models, mirrored to y < 0 for the picture), at each of
---times (the nearest snapshots). Prints a table of r, amplitude and the time of the maximum, and
+view: per square column 2 dx wide (one dx would leave columns that a lattice column has just
+left), the highest water particle centre minus that of the first snapshot (t = 0, the still
+water: the lattice's rounding cancels), over the basin (the half y >= 0 the case models,
+mirrored to y < 0 for the picture), at each of --times (the nearest snapshots). Prints a table of r, amplitude and the time of the maximum, and
 the exponents; writes RUN/basin_decay.png and RUN/basin_plan.png (or -o's stem + _decay/_plan).
 Exit codes: 0 ok, 2 bad arguments or missing files.
 """
@@ -32,23 +36,30 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixsph_tools.readers import (ToolError, list_snapshots, read_monitors, read_snapshot,  # noqa: E402
                                   nearest_snapshot)
 
-STILL = 0.2          # the basin's still water level [m] (the case's basin body)
 IMPACT = (-0.3464, 0.0)  # the still water line on the slide's axis [m]
 GAUGE = re.compile(r"^a(0|45)_r(\d\d)$")
+
+
+def impact_index(mon):
+    """The first sample at which the slide's front reaches the still water line."""
+    k = np.flatnonzero(mon["slide_front"] >= IMPACT[0])
+    if len(k) == 0:
+        raise ToolError("the slide never reaches the water (slide_front < %g m)" % IMPACT[0])
+    return int(k[0])
 
 
 def amplitudes(mon):
     """{ray: [(r, amplitude, t_max)]} of the gauges of monitors.csv."""
     rays = {}
+    k0 = impact_index(mon)
     for name, v in mon.items():
         m = GAUGE.match(name)
         if not m:
             continue
-        ok = np.isfinite(v)
-        if not ok.any() or not np.isfinite(v[0]):
+        if not np.isfinite(v[k0]) or not np.isfinite(v[k0:]).any():
             continue
-        k = int(np.nanargmax(v))
-        rays.setdefault(int(m.group(1)), []).append((int(m.group(2)) / 10.0, v[k] - v[0], mon["t"][k]))
+        k = k0 + int(np.nanargmax(v[k0:]))
+        rays.setdefault(int(m.group(1)), []).append((int(m.group(2)) / 10.0, v[k] - v[k0], mon["t"][k]))
     return {a: sorted(g) for a, g in rays.items()}
 
 
@@ -62,8 +73,8 @@ def fit_decay(points, r_min):
     return -slope, float(np.exp(icpt))
 
 
-def plan_elevation(cols, dx, x_range, y_range):
-    """The highest water particle centre minus the still level, per dx x dx column."""
+def plan_top(cols, dx, x_range, y_range):
+    """The highest water particle centre per dx x dx column (nan where there is none)."""
     water = (cols["state"] != 2) & (cols["medium"] == 0)
     x, y, z = cols["x"][water], cols["y"][water], cols["z"][water]
     nx = int(round((x_range[1] - x_range[0]) / dx))
@@ -75,7 +86,7 @@ def plan_elevation(cols, dx, x_range, y_range):
     for i, j, h in zip(iy[ok], ix[ok], z[ok]):
         if not (grid[i, j] >= h):
             grid[i, j] = h
-    return grid + 0.5 * dx - STILL
+    return grid
 
 
 def main(argv=None):
@@ -96,7 +107,12 @@ def main(argv=None):
         import json
         with open(os.path.join(a.run, "summary.json")) as f:
             dx = float(json.load(f)["numerics"]["dx"])
-    rays = amplitudes(mon)
+    try:
+        rays = amplitudes(mon)
+    except ToolError as e:
+        print(f"basin_slide_3d: {e}", file=sys.stderr)
+        return 2
+    print(f"impact (slide front at x = {IMPACT[0]} m): t = {mon['t'][impact_index(mon)]:.3f} s")
     if not rays:
         print("basin_slide_3d: no gauge a0_rNN / a45_rNN in monitors.csv", file=sys.stderr)
         return 2
@@ -131,10 +147,11 @@ def main(argv=None):
     if snaps and times:
         fig, axes = plt.subplots(1, len(times), figsize=(3.2 * len(times), 3.6), squeeze=False)
         xr, yr = (-0.6, 1.6), (0.0, 1.2)
+        base = plan_top(read_snapshot(snaps[0][1])[1], 2 * dx, xr, yr)
         for ax, t in zip(axes[0], times):
             ts, ref = nearest_snapshot(a.run, t)
             _, cols = read_snapshot(ref)
-            g = plan_elevation(cols, dx, xr, yr)
+            g = plan_top(cols, 2 * dx, xr, yr) - base
             full = np.vstack([g[::-1], g])  # mirrored about the symmetry plane y = 0
             im = ax.imshow(1e3 * full, origin="lower", extent=(xr[0], xr[1], -yr[1], yr[1]), cmap="RdBu_r",
                            vmin=-30, vmax=30, aspect="equal")
