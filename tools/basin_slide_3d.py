@@ -5,12 +5,14 @@ views of the water surface's elevation.
 
     .venv/bin/python tools/basin_slide_3d.py RUN [--times 0.4,0.6,0.8,1.0] [-o FIG.png]
 
-RUN is the output folder of `mixsph run cases/basin_slide_3d.json`. A gauge's amplitude is the
-largest value its max_elevation monitor took after the impact minus its value at the impact (the
+RUN is the output folder of `mixsph run cases/basin_slide_3d.json`. A gauge's amplitude is that
+of the leading crest: the largest value its max_elevation monitor took after the impact until it
+first falls back by a fifth of that rise (the crest has passed), minus its value at the impact (the
 first sample at which the slide's front, `slide_front`, reaches the still water line x = -0.3464
 m): the top particle centre of the water still at rest there, so the dx/2 between a centre and the
 surface cancels, and the few millimetres the basin's water settles by before the impact (its
-start from a lattice) do not count as a wave. The
+start from a lattice) do not count as a wave. A gauge whose rise has not fallen back by the run's
+end is truncated (the crest not yet past): listed, marked, and left out of the fit. The
 decay a = C r^(-n) is fitted by least squares on log a against log r, per ray (the slide's axis,
 a0_*, and the ray 45 degrees off it, a45_*), over the gauges r >= --r-min (default 0.6 m: the far
 field, beyond the slide's own width and run-out in the water, which disturb the near field). The plan
@@ -58,15 +60,25 @@ def amplitudes(mon):
             continue
         if not np.isfinite(v[k0]) or not np.isfinite(v[k0:]).any():
             continue
-        k = k0 + int(np.nanargmax(v[k0:]))
-        rays.setdefault(int(m.group(1)), []).append((int(m.group(2)) / 10.0, v[k] - v[k0], mon["t"][k]))
+        rise = v[k0:] - v[k0]
+        best, kb, passed = 0.0, 0, False
+        for j, e in enumerate(rise):
+            if not np.isfinite(e):
+                continue
+            if e > best:
+                best, kb = e, j
+            elif best > 1e-3 and e < 0.8 * best:
+                passed = True
+                break
+        rays.setdefault(int(m.group(1)), []).append((int(m.group(2)) / 10.0, best, mon["t"][k0 + kb], passed))
     return {a: sorted(g) for a, g in rays.items()}
 
 
 def fit_decay(points, r_min):
-    """(n, C) of a = C r^-n over the points with r >= r_min and a > 0."""
-    r = np.array([p[0] for p in points if p[0] >= r_min - 1e-9 and p[1] > 0])
-    a = np.array([p[1] for p in points if p[0] >= r_min - 1e-9 and p[1] > 0])
+    """(n, C) of a = C r^-n over the passed crests with r >= r_min and a > 0."""
+    use = [p for p in points if p[0] >= r_min - 1e-9 and p[1] > 0 and p[3]]
+    r = np.array([p[0] for p in use])
+    a = np.array([p[1] for p in use])
     if len(r) < 2:
         return float("nan"), float("nan")
     slope, icpt = np.polyfit(np.log(r), np.log(a), 1)
@@ -119,15 +131,18 @@ def main(argv=None):
     stem = os.path.splitext(a.o)[0] if a.o else os.path.join(a.run, "basin")
     print(f"run {a.run}: t_end {mon['t'][-1]:.3f} s, dx {dx}")
     print(f"{'ray':>4} {'r [m]':>6} {'a [mm]':>8} {'t_max [s]':>9}")
+    print("(leading crest; * truncated: not yet past at the run's end, not fitted)")
     fig, ax = plt.subplots(figsize=(5, 4))
     for ray, pts in sorted(rays.items()):
-        for r, amp, t in pts:
-            print(f"{ray:>4} {r:>6.2f} {1e3 * amp:>8.2f} {t:>9.3f}")
+        for r, amp, t, passed in pts:
+            print(f"{ray:>4} {r:>6.2f} {1e3 * amp:>8.2f} {t:>9.3f}{'' if passed else ' *'}")
         n, c = fit_decay(pts, a.r_min)
         print(f"ray {ray} deg: a ~ r^-n, n = {n:.2f} (gauges r >= {a.r_min} m)")
         r = np.array([p[0] for p in pts])
         amp = np.array([p[1] for p in pts])
-        ax.loglog(r, 1e3 * amp, "o", label=f"{ray} deg: n = {n:.2f}")
+        passed = np.array([p[3] for p in pts])
+        ax.loglog(r[passed], 1e3 * amp[passed], "o", label=f"{ray} deg: n = {n:.2f}")
+        ax.loglog(r[~passed], 1e3 * amp[~passed], "x", color=ax.lines[-1].get_color())
         if np.isfinite(n):
             rr = np.linspace(a.r_min, r.max(), 20)
             ax.loglog(rr, 1e3 * c * rr ** -n, "-", color=ax.lines[-1].get_color())
