@@ -747,6 +747,37 @@ static void test_granular_law_by_number(void **state)
     free(j);
 }
 
+/* A granular medium that names no law: with mu_thr (or mu1), the paper's law, as every case written
+ * for it; with only what a new user knows (rho, K or c, porosity, phi), the elastic-plastic law; a
+ * key of the paper's law without its mu_thr is refused by name; "law": "paper" still needs mu_thr. */
+static void test_granular_law_unnamed(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    char *j = with_sand("");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(c.media[1].law, LAW_MIXTURE_PAPER);
+    case_free(&c);
+    free(j);
+    char *plain = edit("\"alpha_m\": 0.1 }\n",
+                 "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, "
+                 "\"porosity\": 0.35, \"phi\": 35.0 }\n");
+    assert_int_equal(case_parse(plain, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_int_equal(c.media[1].law, LAW_ELASTIC_PLASTIC);
+    case_free(&c);
+    free(plain);
+    j = edit("\"alpha_m\": 0.1 }\n", "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, "
+                                       "\"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, \"mu0\": 5e3 }\n");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.mu0: a key of the paper law",
+                              "runs the elastic_plastic law", (const char *)NULL));
+    free(j);
+    j = edit("\"alpha_m\": 0.1 }\n", "\"alpha_m\": 0.1 },\n    \"sand\": { \"type\": \"granular\", \"rho\": 2650.0, "
+                                       "\"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, \"law\": \"paper\" }\n");
+    assert_true(error_matches(j, NULL, 0, MIXSPH_ERR_CASE, "media.sand.mu_thr: missing", (const char *)NULL));
+    free(j);
+}
+
 /* Every table row is well formed: a key once per section, a meaning, a field only where the
  * type has one, choices for a choice, a finite default inside the range. */
 static void test_table_rows(void **state)
@@ -990,6 +1021,7 @@ int main(void)
         cmocka_unit_test(test_table_defaults),
         cmocka_unit_test(test_d50_refused),
         cmocka_unit_test(test_granular_law_by_number),
+        cmocka_unit_test(test_granular_law_unnamed),
         cmocka_unit_test(test_table_rows),
         cmocka_unit_test(test_numerics_reach_the_step),
         cmocka_unit_test(test_parameters),

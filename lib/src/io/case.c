@@ -293,6 +293,23 @@ static mixsph_status drop_other_laws_keys(const struct case_reader *r, const cJS
     return MIXSPH_OK;
 }
 
+/* A medium that names no law runs the one its keys imply (law_unnamed); a key of its type's first
+ * law that the implied law has not is refused by name, with what would make it valid. */
+static mixsph_status read_unnamed_law(const struct case_reader *r, const cJSON *entry, const char *path,
+                                      struct medium *md)
+{
+    const int first = md->law;
+    md->law = law_unnamed(first, entry_given, entry);
+    if (md->law == first) return MIXSPH_OK;
+    for (const cJSON *k = entry->child; k; k = k->next)
+        if (!case_schema_key(law_get(md->law)->keys, k->string) && case_schema_key(law_get(first)->keys, k->string))
+            return FAIL(r, "%s: %s.%s: a key of the %s law, which this medium does not run: with no \"law\" and "
+                           "none of that law's required keys, it runs the %s law (docs/cases.md); name \"law\": "
+                           "\"%s\" and give its keys, or remove %s", r->origin, path, k->string, law_get(first)->name,
+                        law_get(md->law)->name, law_get(first)->name, k->string);
+    return MIXSPH_OK;
+}
+
 /* A medium: its type selects its material law (laws/law_registry.h), whose key table it is read
  * by; a law with both K and c takes exactly one of them; then the law's own rules (finish). */
 static mixsph_status read_medium(const struct case_reader *r, const cJSON *entry, const char *path, struct case_def *c,
@@ -311,7 +328,8 @@ static mixsph_status read_medium(const struct case_reader *r, const cJSON *entry
     TRY(case_schema_read_key(r, entry, path, &type_key, md));
     /* a type with several laws: its key `law` (a row of each of their tables) chooses one */
     const struct case_key *law_key = case_schema_key(law_get(md->law)->keys, "law");
-    if (law_key) TRY(case_schema_read_key(r, entry, path, law_key, md));
+    if (law_key && item(entry, "law")) TRY(case_schema_read_key(r, entry, path, law_key, md));
+    else if (law_key) TRY(read_unnamed_law(r, entry, path, md));
     const struct material_law *law = law_get(md->law);
     cJSON *own = NULL; /* the entry without the other laws' keys, when a number chose the law */
     if (cJSON_IsNumber(item(entry, "law"))) TRY(drop_other_laws_keys(r, entry, path, md->law, &own));

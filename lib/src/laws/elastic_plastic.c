@@ -30,10 +30,11 @@ static const struct case_choice water_couplings[] = {
 static const struct case_key elastic_plastic_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_ep_type,
      .field = CASE_FIELD(medium, law), .meaning = "\"granular\""},
-    {.key = "law", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = law_granular_choices,
-     .numeric_choice = CASE_CHOICE_BY_POSITION, .field = CASE_FIELD(medium, law),
-     .meaning = "\"elastic_plastic\" (this table): Drucker-Prager, experimental; chosen by its number (a case "
-                "parameter), the medium may hold the paper law's keys too (above)"},
+    {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices, .numeric_choice = CASE_CHOICE_BY_POSITION,
+     SCHEMA_DEF(LAW_ELASTIC_PLASTIC), .def_text = "this law when the medium gives neither mu_thr nor mu1",
+     .field = CASE_FIELD(medium, law),
+     .meaning = "\"elastic_plastic\" (this table): Drucker-Prager; chosen by its number (a case parameter), the "
+                "medium may hold the paper law's keys too (above)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
      .field = CASE_FIELD(medium, granular.rho_grain), .meaning = "density of the grains ρ_s"},
     {.key = "K", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "one of K, c", SCHEMA_RANGE(0, 1, 1e12, 0),

@@ -14,6 +14,12 @@ static const struct material_law *const laws[LAW_COUNT] = {
 
 const struct material_law *law_get(int id) { return id >= 0 && id < LAW_COUNT ? laws[id] : NULL; }
 
+int law_unnamed(int law, int (*given)(const void *entry, const char *key), const void *entry)
+{
+    if (law == LAW_MIXTURE_PAPER && !given(entry, "mu_thr") && !given(entry, "mu1")) return LAW_ELASTIC_PLASTIC;
+    return law;
+}
+
 double law_max_wave_speed(const struct medium *media, size_t n_media)
 {
     double c = 0.0;

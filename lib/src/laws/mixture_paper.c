@@ -56,7 +56,8 @@ static const struct case_key granular_keys[] = {
     {.key = "type", .type = CASE_CHOICE, .need = CASE_REQUIRED, .choices = granular_type,
      .field = CASE_FIELD(medium, law), .meaning = "\"granular\": a mixture at the packing limit"},
     {.key = "law", .type = CASE_CHOICE, .choices = law_granular_choices, .numeric_choice = CASE_CHOICE_BY_POSITION,
-     SCHEMA_DEF(LAW_MIXTURE_PAPER), .field = CASE_FIELD(medium, law),
+     SCHEMA_DEF(LAW_MIXTURE_PAPER), .def_text = "this law when the medium gives mu_thr or mu1, else elastic_plastic",
+     .field = CASE_FIELD(medium, law),
      .meaning = "its material law: \"paper\" (this table) or \"elastic_plastic\" (the next); chosen by its number "
                 "(a case parameter), the medium may hold the other law's keys too (below)"},
     {.key = "rho", .type = CASE_NUMBER, .need = CASE_REQUIRED, SCHEMA_RANGE(0, 1, 1e5, 0), .unit = "kg/m³",
@@ -118,9 +119,10 @@ static mixsph_status granular_finish(struct medium *md, const struct law_finish_
         md->paper.mu_thr = ctx->number(ctx->entry, "mu1"); /* mu0 keeps its default: no limit */
         md->paper.mu1_mode = 1;
     } else if (!ctx->given(ctx->entry, "mu_thr")) {
-        return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1): the paper's law, the default of a "
-                         "granular medium, holds its grains above the threshold viscosity mu_thr; \"law\": "
-                         "\"elastic_plastic\" needs neither (docs/model.md section 10)", ctx->origin, ctx->path);
+        return FAIL(ctx, "%s: %s.mu_thr: missing (expected a number, or mu1): the paper's law, which this medium "
+                         "names, holds its grains above the threshold viscosity mu_thr; without \"law\" a medium "
+                         "that gives neither runs the elastic-plastic law (docs/model.md section 10)", ctx->origin,
+                    ctx->path);
     }
     md->mu = 0.0; /* set by the rheology */
     md->held_takes_kicks = mixture_paper_held_grain_kicked(md, 0);
