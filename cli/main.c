@@ -181,6 +181,16 @@ static int write_summary(const char *dir, const mixsph_sim *s, const char *case_
         fprintf(f, ",\n  \"viscous_solve_fraction\": ");
         json_number(f, wall > 0 ? visc_wall / wall : NAN);
     }
+    /* the law each medium ran: the one it names, or the one its keys imply (docs/cases.md) */
+    fprintf(f, ",\n  \"media\": {");
+    for (size_t k = 0; k < mixsph_sim_medium_count(s); k++) {
+        fprintf(f, "%s", k ? ", " : "");
+        json_string(f, mixsph_sim_medium_name(s, k));
+        fprintf(f, ": {\"law\": ");
+        json_string(f, mixsph_sim_medium_law(s, k));
+        fprintf(f, "}");
+    }
+    fprintf(f, "}");
     /* the numerics the run used (the case file's, its overrides' or the defaults) */
     static const char *const numerics[] = {"dx", "h_over_dx", "cfl", "cfl_visc", "viscosity", "pressure_smoothing"};
     fprintf(f, ",\n  \"numerics\": {");
@@ -511,6 +521,10 @@ static int cmd_run(int argc, char **argv)
     printf("%s: %s, %zu particles, %llu steps, %.2f s wall, %.3g particle-steps/s, t = %.4g s\n", mixsph_sim_name(s),
            st != MIXSPH_OK ? "FAILED" : stopped ? "STOPPED" : "done", mixsph_sim_particles(s), (unsigned long long)mixsph_sim_steps(s), wall,
            wall > 0 ? psteps / wall : 0.0, mixsph_sim_time(s));
+    printf("  media:");
+    for (size_t k = 0; k < mixsph_sim_medium_count(s); k++)
+        printf("%s %s (law %s)", k ? "," : "", mixsph_sim_medium_name(s, k), mixsph_sim_medium_law(s, k));
+    printf("\n");
     for (size_t k = 0; k < mixsph_sim_output_count(s); k++) {
         double mx, tmx, mn, tmn;
         mixsph_sim_output_extremes(s, k, &mx, &tmx, &mn, &tmn);

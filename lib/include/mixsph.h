@@ -267,6 +267,14 @@ size_t mixsph_sim_wall_count(const mixsph_sim *s);
 /** Name of wall `k` as the case names it (the name mixsph_sim_set_wall_velocity takes), or NULL
  *  when k >= mixsph_sim_wall_count. */
 const char *mixsph_sim_wall_name(const mixsph_sim *s, size_t k);
+/** Number of media of the case (the "media" object, in file order). */
+size_t mixsph_sim_medium_count(const mixsph_sim *s);
+/** Name of medium `k` as the case names it, or NULL when k >= mixsph_sim_medium_count. */
+const char *mixsph_sim_medium_name(const mixsph_sim *s, size_t k);
+/** The material law medium `k` runs ("newtonian", "paper", "elastic_plastic", "linear"): the one
+ *  its `law` names or, when it names none, the one its keys imply (docs/cases.md); NULL when k is
+ *  out of range. */
+const char *mixsph_sim_medium_law(const mixsph_sim *s, size_t k);
 /** 1 if wall `k` has a prescribed motion in the case (it can be driven by
  *  mixsph_sim_set_wall_velocity), 0 if it is fixed or k is out of range. */
 int mixsph_sim_wall_moves(const mixsph_sim *s, size_t k);

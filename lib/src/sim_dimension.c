@@ -71,6 +71,9 @@ BOTH(mixsph_status, sim_set_csv_snapshots, (sim_build *s, int on))
 BOTH(void, sim_output_time, (const sim_build *s, double *csv_s, double *hdf5_s, double *checkpoint_s))
 BOTH(const char *, sim_case_text, (const sim_build *s))
 BOTH(const char *, sim_case_origin, (const sim_build *s))
+BOTH(size_t, sim_medium_count, (const sim_build *s))
+BOTH(const char *, sim_medium_name, (const sim_build *s, size_t k))
+BOTH(const char *, sim_medium_law, (const sim_build *s, size_t k))
 BOTH(size_t, sim_wall_count, (const sim_build *s))
 BOTH(const char *, sim_wall_name, (const sim_build *s, size_t k))
 BOTH(int, sim_wall_moves, (const sim_build *s, size_t k))
@@ -298,6 +301,9 @@ void mixsph_sim_output_time(const mixsph_sim *s, double *csv_s, double *hdf5_s, 
 }
 const char *mixsph_sim_case_text(const mixsph_sim *s) { return CALL0(s, sim_case_text); }
 const char *mixsph_sim_case_origin(const mixsph_sim *s) { return CALL0(s, sim_case_origin); }
+size_t mixsph_sim_medium_count(const mixsph_sim *s) { return CALL0(s, sim_medium_count); }
+const char *mixsph_sim_medium_name(const mixsph_sim *s, size_t k) { return CALL(s, sim_medium_name, k); }
+const char *mixsph_sim_medium_law(const mixsph_sim *s, size_t k) { return CALL(s, sim_medium_law, k); }
 size_t mixsph_sim_wall_count(const mixsph_sim *s) { return CALL0(s, sim_wall_count); }
 const char *mixsph_sim_wall_name(const mixsph_sim *s, size_t k) { return CALL(s, sim_wall_name, k); }
 int mixsph_sim_wall_moves(const mixsph_sim *s, size_t k) { return CALL(s, sim_wall_moves, k); }

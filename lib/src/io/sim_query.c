@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "law_registry.h"
 #include "particle_fields.h"
 #include "sim.h"
 #include "status.h"
@@ -27,6 +28,21 @@ size_t mixsph_sim_wall_count(const mixsph_sim *s)
 const char *mixsph_sim_wall_name(const mixsph_sim *s, size_t k)
 {
     return s && k < s->cfg.n_walls ? s->cfg.walls[k].name : NULL;
+}
+
+size_t mixsph_sim_medium_count(const mixsph_sim *s)
+{
+    return s ? s->cfg.n_media : 0;
+}
+
+const char *mixsph_sim_medium_name(const mixsph_sim *s, size_t k)
+{
+    return s && k < s->cfg.n_media ? s->cfg.media[k].name : NULL;
+}
+
+const char *mixsph_sim_medium_law(const mixsph_sim *s, size_t k)
+{
+    return s && k < s->cfg.n_media ? law_get(s->cfg.media[k].law)->name : NULL;
 }
 
 int mixsph_sim_wall_moves(const mixsph_sim *s, size_t k)
