@@ -658,6 +658,8 @@ static mixsph_status read_monitor_dimension(const struct case_reader *r, const c
                            "(x, y, z)", r->origin, path);
         if (!item(it, "y")) return FAIL(r, "%s: %s.y: missing (a 3D probe's point is x, y, z)", r->origin, path);
     }
+    if (md->kind == MONITOR_WAVE_GAUGE && !item(it, "y"))
+        return FAIL(r, "%s: %s.y: missing (a 3D wave gauge's station is x, y)", r->origin, path);
     if (!(md->y_max > md->y_min)) return FAIL(r, "%s: %s: expected y_min < y_max", r->origin, path);
     return MIXSPH_OK;
 }

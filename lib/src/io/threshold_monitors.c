@@ -11,9 +11,9 @@
  *                  (a thin layer on a bed of any shape counts as thin) and does not jump with the
  *                  highest particle. The deposit's height is the largest h_b (H_inf of a column
  *                  collapse on a flat bed).
- *   wave_gauge   - the free surface at a station x: the top (centre + dx/2, as the profile
- *                  monitor) of the highest particle of the medium in its column in the window
- *                  |x_j - x| <= window, minus the still level. Splash is excluded by two rules:
+ *   wave_gauge   - the free surface at a station x (3D: (x, y)): the top (centre + dx/2, as the
+ *                  profile monitor) of the highest particle of the medium in its column in the
+ *                  window |x_j - x| <= window (3D: and |y_j - y| <= window), minus the still level. Splash is excluded by two rules:
  *                  a particle counts only with min_neighbours neighbours of its medium, and the
  *                  column is followed up from the medium's lowest particle through gaps of at
  *                  most GAUGE_GAP_OVER_DX dx, so a drop or jet separated from the water below by
@@ -103,7 +103,11 @@ double runout_position(const mixsph_sim *s, const struct monitor_def *md, double
 static int in_gauge_column(const struct monitor_def *md, const struct particles *P, size_t i)
 {
     return P->state[i] <= MIXSPH_STATE_FIXED && P->nneigh[i] >= md->min_neighbours &&
-           fabs(P->pos[0][i] - md->point_x) <= md->window;
+           fabs(P->pos[0][i] - md->point_x) <= md->window
+#if DIM == 3
+           && fabs(P->pos[1][i] - md->point_y) <= md->window /* a square column about (x, y) */
+#endif
+        ;
 }
 
 double wave_gauge_elevation(const mixsph_sim *s, const struct monitor_def *md)
