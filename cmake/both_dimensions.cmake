@@ -8,6 +8,12 @@
 #
 # <target> is a static library (the dispatcher) whose link interface holds both renamed archives;
 # the caller adds what both builds link (cJSON, HDF5, OpenMP, threads) to <target>.
+#
+#   mixsph_dim3_executable(<executable> <both-dimensions target> <source>)
+#
+# An executable compiled at DIM = 3 against the library's internal headers (a DIM = 3 test) that
+# links <target>'s 3D build: its object is renamed with the 3D archive's map, so its calls reach
+# the dim3_ symbols. The DIM = 3 tests need no third build of the library.
 set(MIXSPH_PREFIX_SYMBOLS ${CMAKE_CURRENT_LIST_DIR}/prefix_symbols.cmake)
 
 function(mixsph_both_dimensions target lib2 lib3)
@@ -21,7 +27,7 @@ function(mixsph_both_dimensions target lib2 lib3)
             -DOUTPUT=${out2} -DPREFIX=dim2_ -DMATCH=^mixsph_ -P ${MIXSPH_PREFIX_SYMBOLS}
     DEPENDS ${lib2} ${MIXSPH_PREFIX_SYMBOLS}
     COMMENT "The 2D build's public API as dim2_mixsph_* (${target})" VERBATIM)
-  add_custom_command(OUTPUT ${out3}
+  add_custom_command(OUTPUT ${out3} ${out3}.map
     COMMAND ${CMAKE_COMMAND} -DNM=${CMAKE_NM} -DOBJCOPY=${CMAKE_OBJCOPY} -DINPUT=$<TARGET_FILE:${lib3}>
             -DOUTPUT=${out3} -DPREFIX=dim3_ -P ${MIXSPH_PREFIX_SYMBOLS}
     DEPENDS ${lib3} ${MIXSPH_PREFIX_SYMBOLS}
@@ -33,4 +39,26 @@ function(mixsph_both_dimensions target lib2 lib3)
   # the dispatcher's own code is the 2D build's (it calls its state and checkpoint readers)
   target_compile_definitions(${target} PRIVATE MIXSPH_DIM=2)
   target_link_libraries(${target} PUBLIC ${out2} ${out3})
+  set_target_properties(${target} PROPERTIES MIXSPH_DIM3_SYMBOL_MAP ${out3}.map)
+endfunction()
+
+function(mixsph_dim3_executable name dims source)
+  get_target_property(map ${dims} MIXSPH_DIM3_SYMBOL_MAP)
+  add_library(${name}_objects OBJECT ${source})
+  target_include_directories(${name}_objects PRIVATE ${PROJECT_SOURCE_DIR}/lib/include ${MIXSPH_INTERNAL_INCLUDES})
+  target_compile_definitions(${name}_objects PRIVATE MIXSPH_DIM=3)
+  # as the library's: the same OpenMP flags (simd pragmas of the internal headers)
+  if(MIXSPH_OPENMP)
+    target_link_libraries(${name}_objects PRIVATE OpenMP::OpenMP_C)
+  endif()
+  set(renamed ${CMAKE_CURRENT_BINARY_DIR}/${name}_renamed_dim3${CMAKE_C_OUTPUT_EXTENSION})
+  add_custom_command(OUTPUT ${renamed}
+    COMMAND ${CMAKE_COMMAND} -DOBJCOPY=${CMAKE_OBJCOPY} -DINPUT=$<TARGET_OBJECTS:${name}_objects>
+            -DOUTPUT=${renamed} -DMAP=${map} -P ${MIXSPH_PREFIX_SYMBOLS}
+    DEPENDS ${name}_objects $<TARGET_OBJECTS:${name}_objects> ${map} ${MIXSPH_PREFIX_SYMBOLS}
+    COMMENT "${name}: its calls to the 3D build as dim3_*" VERBATIM)
+  add_executable(${name} ${renamed})
+  set_target_properties(${name} PROPERTIES LINKER_LANGUAGE C)
+  add_dependencies(${name} ${dims}_archives)
+  target_link_libraries(${name} PRIVATE ${dims})
 endfunction()

@@ -4,10 +4,25 @@
 #
 #   cmake -DNM=nm -DOBJCOPY=objcopy -DINPUT=lib.a -DOUTPUT=out.a -DPREFIX=dim3_ [-DMATCH=^mixsph_]
 #         -P prefix_symbols.cmake
+#   cmake -DOBJCOPY=objcopy -DINPUT=test.o -DOUTPUT=test_renamed.o -DMAP=out.a.map -P prefix_symbols.cmake
 #
 # MATCH (a regular expression) limits the renaming to the symbols it matches (the 2D build renames
-# only its public API, which the dispatcher lib/src/sim_dimension.c then defines).
-foreach(var NM OBJCOPY INPUT OUTPUT PREFIX)
+# only its public API, which the dispatcher lib/src/sim_dimension.c then defines). The map of the
+# renaming is written beside OUTPUT (OUTPUT.map); the second form renames with such a map an
+# object compiled against the archive (a DIM = 3 test: its calls then reach the renamed archive).
+foreach(var OBJCOPY INPUT OUTPUT)
+  if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
+    message(FATAL_ERROR "prefix_symbols.cmake: ${var} is not set")
+  endif()
+endforeach()
+if(DEFINED MAP)
+  execute_process(COMMAND ${OBJCOPY} --redefine-syms=${MAP} ${INPUT} ${OUTPUT} RESULT_VARIABLE rc)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "prefix_symbols.cmake: ${OBJCOPY} failed on ${INPUT} (map ${MAP})")
+  endif()
+  return()
+endif()
+foreach(var NM PREFIX)
   if(NOT DEFINED ${var} OR "${${var}}" STREQUAL "")
     message(FATAL_ERROR "prefix_symbols.cmake: ${var} is not set")
   endif()

@@ -1,4 +1,5 @@
-/* test_sim3d.c - the whole library in a DIM = 3 build (build-dim3/, ./tools/do test stage "DIM = 3"):
+/* test_sim3d.c - the whole library in its DIM = 3 build (compiled at DIM = 3 and linked to the
+ * executable's 3D build: tests/CMakeLists.txt, MIXSPH_DIM3_TESTS):
  * 3D cases from text, their bodies (box, extruded polygon, closed STL, the domain below a level),
  * the hydrostatic initial state, every law and both viscous schemes on a falling block, monitors
  * with y, and a bit-identical restart. Until 3D walls come (lib/src/walls/) the cases have none:

@@ -1,4 +1,4 @@
-/* test_tank3d.c - water at rest in 3D tanks (DIM = 3 build, ./tools/do test stage "DIM = 3"):
+/* test_tank3d.c - water at rest in 3D tanks (DIM = 3 build; tests/CMakeLists.txt, MIXSPH_DIM3_TESTS):
  * cases/hydrostatic_tank_3d.json (an open-top box tank, 0.2 x 0.12 m, H = 0.24 m) and
  * cases/beach_tank_3d.json (a 0.4 x 0.12 m box tank with a 30 degree beach read from the STL file
  * cases/beach_30deg.stl, water filled below z = 0.14 m inside the walls), dx = 0.02, run to
