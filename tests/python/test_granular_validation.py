@@ -63,6 +63,20 @@ def test_column_threshold_criteria():
     assert case["monitors"]["deposit"]["threshold"] == 0.02 and case["monitors"]["speed_p99"]["quantile"] == 0.99
 
 
+def test_column_thresholds_in_metres_or_spacings():
+    # "0.02": 0.02 m at every spacing; "1.5dx": 1.5 spacings at each; one runout monitor per
+    # threshold, the criterion's first; anything else refused, naming the option
+    assert cr.parse_threshold("0.02").at(0.005) == 0.02
+    assert cr.parse_threshold("1.5dx").at(0.005) == pytest.approx(0.0075)
+    assert str(cr.parse_threshold("2dx")) == "2 dx"
+    for bad in ("", "dx", "-1dx", "0", "2 mm", "nan"):
+        with pytest.raises(cr.mt.ToolError, match="--threshold"):
+            cr.parse_threshold(bad)
+    case = cr.with_threshold_monitors(load("column_collapse.json"), [0.015, 0.02])
+    mons = case["monitors"]
+    assert mons["deposit"]["threshold"] == 0.015 and mons[cr.deposit_monitor(1)]["threshold"] == 0.02
+
+
 def test_flank_angle_of_a_lattice_heap():
     # the tops of a 30-degree heap on a lattice of dx = 0.005: within 1.5 degrees (the lattice's
     # staircase), both sides
