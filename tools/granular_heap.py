@@ -65,7 +65,10 @@ def heap_case(base, phi, slope, t_end):
 
 def flank_angle(x, z, dx):
     """The mean slope [deg] of the two flanks (module docstring), NaN when a side has < 2 columns."""
-    x0 = x.min() - dx
+    # columns with edges at multiples of dx, so the lattice's sites x = (i + 1/2) dx are at their
+    # centres: columns placed from the leftmost grain had every site on an edge, where a motion of
+    # 0.01 dx moved whole columns of tops across (4 degrees on a heap that had not moved)
+    x0 = (math.floor(x.min() / dx) - 1) * dx
     b = np.floor((x - x0) / dx).astype(int)
     top = np.full(b.max() + 1, -np.inf)
     np.maximum.at(top, b, z)

@@ -63,6 +63,20 @@ def test_column_threshold_criteria():
     assert case["monitors"]["deposit"]["threshold"] == 0.02 and case["monitors"]["speed_p99"]["quantile"] == 0.99
 
 
+def test_column_thresholds_in_metres_or_spacings():
+    # "0.02": 0.02 m at every spacing; "1.5dx": 1.5 spacings at each; one runout monitor per
+    # threshold, the criterion's first; anything else refused, naming the option
+    assert cr.parse_threshold("0.02").at(0.005) == 0.02
+    assert cr.parse_threshold("1.5dx").at(0.005) == pytest.approx(0.0075)
+    assert str(cr.parse_threshold("2dx")) == "2 dx"
+    for bad in ("", "dx", "-1dx", "0", "2 mm", "nan"):
+        with pytest.raises(cr.mt.ToolError, match="--threshold"):
+            cr.parse_threshold(bad)
+    case = cr.with_threshold_monitors(load("column_collapse.json"), [0.015, 0.02])
+    mons = case["monitors"]
+    assert mons["deposit"]["threshold"] == 0.015 and mons[cr.deposit_monitor(1)]["threshold"] == 0.02
+
+
 def test_flank_angle_of_a_lattice_heap():
     # the tops of a 30-degree heap on a lattice of dx = 0.005: within 1.5 degrees (the lattice's
     # staircase), both sides
@@ -78,3 +92,29 @@ def test_reproduce_command_drops_where_things_go():
     import mixsph_tools as mt
     cmd = mt.reproduce_command("tools/x.py", ["--dx", "0.01", "--mixsph", "/a/b/mixsph", "--doc=d.md", "--out", "o", "--check"])
     assert cmd == "PYTHONPATH=$PWD .venv/bin/python tools/x.py --dx 0.01 --check"
+
+
+def test_deposit_motion_tells_creep_from_ringing(tmp_path):
+    # two grains, snapshots every 5 ms over 0.2 s: grain 1 creeps at 2 mm/s along x, grain 2
+    # oscillates in place (amplitude 1e-5 m, period 0.01 s, so it is back at its place every
+    # 5 ms while its speed is 2 pi 1e-5 / 0.01 = 6.3 mm/s at the samples). With the quantile 1
+    # (the largest): the speed is the ringing grain's, the drift over every window the creeping
+    # one's, and the ringing (speed less the net motion over 5 ms) the ringing grain's.
+    import deposit_motion as dm
+    dx = 0.01
+    with open(tmp_path / "summary.json", "w") as f:
+        json.dump({"numerics": {"dx": dx}}, f)
+    for k in range(41):
+        t = 0.005 * k
+        x1, x2 = 0.1 + 2e-3 * t, 0.2 + 1e-5 * math.sin(2 * math.pi * t / 0.01)
+        v2 = 2 * math.pi * 1e-5 / 0.01 * math.cos(2 * math.pi * t / 0.01)
+        with open(tmp_path / f"snap_{k:04d}.csv", "w") as f:
+            f.write(f"# t = {t:.9g} s\nid,x,z,vx,vz,rho,p,mu,medium,state\n")
+            f.write(f"0,{x1!r},0.005,0.002,0,1700,0,0,0,0\n1,{x2!r},0.005,{v2!r},0,1700,0,0,0,0\n")
+            f.write("2,0,-0.005,0,0,1700,0,0,0,2\n")   # a wall particle: not a grain
+    m = dm.motion(str(tmp_path), 0, None, [0.005, 0.05, 0.2], 1.0)
+    assert m["n"] == 2 and m["t"] == pytest.approx(0.2)
+    assert m["speed"] == pytest.approx(2 * math.pi * 1e-3, rel=1e-6)   # the ringing grain's
+    assert m["drift"] == pytest.approx([2e-3] * 3, rel=1e-3)           # the creeping grain's
+    assert m["ringing"] == pytest.approx(2 * math.pi * 1e-3, rel=1e-3)
+    assert m["largest"] / dx == pytest.approx(2e-3 * 0.2 / dx, rel=1e-3)
