@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""How the Vajont slide moves in a run of cases/vajont_padua.json: the plate's push against the
+grains' motion, the slide's shape and how much of it enters the water, from the run's snapshots
+(docs/validation/vajont_elastic_plastic.md uses it to compare the granular laws).
+
+    PYTHONPATH=$PWD python -m tools.vajont_slide RUN_DIR [RUN_DIR...] [--times 0.2,0.4,0.6,0.8,1.0]
+        [--level 0.46] [--markdown]
+
+RUN_DIR is the output folder of one run (e.g. out/ep/v1_dx0.01/V1_dx0.01, as
+tools/vajont_validate.py writes it). At each snapshot nearest to the requested times (snapshots
+come every output.snapshot_interval, 0.1 s in the case), per run:
+
+- ``plate``: the plate's stroke [m] (mean x of its wall particles, wall index 1 of the case,
+  against the first snapshot) and its speed u_p [m/s] (their mean vx);
+- ``grains``: the displacement of the grains' centroid [m] and their mean speed along x [m/s], as
+  a fraction of the plate's speed while it moves (1: the slide moves as a block with the plate);
+  the 10th and 90th percentiles of the grains' vx [m/s] (their spread: 0 for a rigid translation);
+- ``entered``: the grains' area below the still water level z = --level and outside the slide's
+  initial polygon (the case's body slide_above / slide_below), i.e. where water stood at t = 0
+  [m^2 per m depth]: each grain stands for dx^2 of the lattice, which its density changes by
+  less than 2 % here; the water the slide has pushed out of the reservoir's cross-section;
+- ``front``: the 99.5th percentile of the grains' x [m] (the toe, without the odd grain that
+  splashes ahead), and ``top``: the grains' highest z [m].
+
+A grain is a particle of the case's granular media (slide, slide_wet: media 1 and 2), the water
+medium 0; wall particles carry their wall's index (0 bed, 1 plate) in the medium column.
+
+Exit status: 0 ok; 2 a folder without snapshots or a snapshot that cannot be read.
+"""
+
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+from matplotlib.path import Path
+
+from tools.mixsph_tools.readers import (STATE_LOST, STATE_WALL, ToolError, list_snapshots,
+                                        read_snapshot)
+
+GRAIN_MEDIA = (1.0, 2.0)   # slide, slide_wet in cases/vajont_padua.json
+PLATE_WALL = 1.0           # the wall index of "plate" (walls: bed, plate)
+STILL_LEVEL = 0.46         # the case's parameters.reservoir_level [m]
+SLIDE_POLYGON = Path([(0.0, 0.73), (0.434, 0.46), (0.627, 0.34), (0.66, 0.22), (0.0, 0.28)])  # the case's bodies
+
+
+def run_dx(run_dir):
+    """The run's particle spacing [m] from its summary.json."""
+    path = os.path.join(run_dir, "summary.json")
+    try:
+        with open(path) as f:
+            return float(json.load(f)["numerics"]["dx"])
+    except (OSError, KeyError, ValueError, TypeError) as e:
+        raise ToolError(f"{path}: no numerics.dx ({e})") from None
+
+
+def slide_state(snap, dx, level):
+    """The measures of the module docstring for one snapshot (a dict)."""
+    state, medium = snap["state"], snap["medium"]
+    plate = (state == STATE_WALL) & (medium == PLATE_WALL)
+    grains = (state != STATE_WALL) & (state != STATE_LOST) & np.isin(medium, GRAIN_MEDIA)
+    gx, gz, gvx = snap["x"][grains], snap["z"][grains], snap["vx"][grains]
+    return {
+        "plate_x": float(np.mean(snap["x"][plate])),
+        "plate_u": float(np.mean(snap["vx"][plate])),
+        "grain_x": float(np.mean(gx)),
+        "grain_u": float(np.mean(gvx)),
+        "u10": float(np.percentile(gvx, 10)),
+        "u90": float(np.percentile(gvx, 90)),
+        "entered": float(np.count_nonzero((gz < level) & ~SLIDE_POLYGON.contains_points(np.column_stack((gx, gz)))))
+                   * dx * dx,
+        "front": float(np.percentile(gx, 99.5)),
+        "top": float(np.max(gz)),
+    }
+
+
+def report(run_dir, times, level):
+    """[(t, measures)] at the snapshots nearest to `times`, with the displacements against the
+    first snapshot."""
+    snaps = list_snapshots(run_dir)
+    if not snaps:
+        raise ToolError(f"{run_dir}: no snapshots")
+    dx = run_dx(run_dir)
+    t0, s0 = read_snapshot(snaps[0][1])
+    first = slide_state(s0, dx, level)
+    rows = []
+    for t in times:
+        ts, ref = min(snaps, key=lambda s: abs(s[0] - t))
+        _, snap = read_snapshot(ref)
+        m = slide_state(snap, dx, level)
+        m["stroke"] = m["plate_x"] - first["plate_x"]
+        m["moved"] = m["grain_x"] - first["grain_x"]
+        rows.append((ts, m))
+    return rows
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("runs", nargs="+", help="output folders of runs of cases/vajont_padua.json")
+    ap.add_argument("--times", default="0.2,0.4,0.6,0.8,1.0,1.2", help="times [s], comma-separated")
+    ap.add_argument("--level", type=float, default=STILL_LEVEL, help="the still water level [m]")
+    ap.add_argument("--markdown", action="store_true", help="print Markdown table rows")
+    a = ap.parse_args(argv)
+    try:
+        times = [float(v) for v in a.times.split(",")]
+    except ValueError:
+        print(f"--times {a.times}: expected numbers separated by commas", file=sys.stderr)
+        return 2
+    head = ("run", "t [s]", "stroke [m]", "u_p [m/s]", "grains moved [m]", "u_g [m/s]", "u_g/u_p",
+            "vx p10 [m/s]", "vx p90 [m/s]", "entered [m2/m]", "front [m]", "top [m]")
+    if a.markdown:
+        print("| " + " | ".join(head) + " |")
+        print("|" + " --- |" * len(head))
+    else:
+        print("  ".join(head))
+    try:
+        for run_dir in a.runs:
+            for t, m in report(run_dir, times, a.level):
+                ratio = m["grain_u"] / m["plate_u"] if abs(m["plate_u"]) > 1e-3 else float("nan")
+                cells = (os.path.basename(os.path.normpath(run_dir)) if a.markdown else run_dir, f"{t:.2f}",
+                         f"{m['stroke']:.3f}", f"{m['plate_u']:.3f}", f"{m['moved']:.3f}", f"{m['grain_u']:.3f}",
+                         "-" if ratio != ratio else f"{ratio:.2f}", f"{m['u10']:.3f}", f"{m['u90']:.3f}",
+                         f"{m['entered']:.4f}", f"{m['front']:.3f}", f"{m['top']:.3f}")
+                print(("| " + " | ".join(cells) + " |") if a.markdown else "  ".join(cells))
+    except ToolError as e:
+        print(f"vajont_slide: {e}", file=sys.stderr)
+        return e.code
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
