@@ -410,7 +410,7 @@ def criterion_check(results, deta_limit, known_band):
     by = {r.paper.run: r for r in results if r.ok and math.isfinite(r.run_up) and not r.paper.twin}
     missing = [f"V{k}" for k in (1, 2, 4) if k not in by]
     if missing:
-        return False, f"--check: {', '.join(missing)} did not finish (or were not among --runs)"
+        return False, f"--check: {', '.join(missing)}: not finished, or not among --runs"
     deta = by[1].d_eta
     holds = dict((what, verdict) for what, verdict, _ in ordering(results))
     met = deta <= deta_limit and all(v is True for v in holds.values())
