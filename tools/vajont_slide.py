@@ -24,7 +24,7 @@ come every output.snapshot_interval, 0.1 s in the case), per run:
 
 --plot draws, per run (rows) and per --plot-times (columns), the grains (brown; darker the faster) and
 the water (blue) of the nearest snapshot over the bed, with the experiment's maximum run-up line;
---labels names the rows (default: the folders' names).
+--labels names the runs in the table and the plot (default: the folders' names).
 
 A grain is a particle of the case's granular media (slide, slide_wet: media 1 and 2), the water
 medium 0; wall particles carry their wall's index (0 bed, 1 plate) in the medium column.
@@ -142,7 +142,7 @@ def main(argv=None):
     ap.add_argument("--markdown", action="store_true", help="print Markdown table rows")
     ap.add_argument("--plot", metavar="FILE", help="draw the grains and the water at --plot-times into FILE (PNG)")
     ap.add_argument("--plot-times", default="0.4,0.8,1.1", help="times [s] of --plot, comma-separated")
-    ap.add_argument("--labels", help="names of the runs in --plot, comma-separated (default: the folders')")
+    ap.add_argument("--labels", help="names of the runs, comma-separated (default: the folders')")
     a = ap.parse_args(argv)
     try:
         times = [float(v) for v in a.times.split(",")]
@@ -162,10 +162,10 @@ def main(argv=None):
     else:
         print("  ".join(head))
     try:
-        for run_dir in a.runs:
+        for run_dir, label in zip(a.runs, labels):
             for t, m in report(run_dir, times, a.level):
                 ratio = m["grain_u"] / m["plate_u"] if abs(m["plate_u"]) > 1e-3 else float("nan")
-                cells = (os.path.basename(os.path.normpath(run_dir)) if a.markdown else run_dir, f"{t:.2f}",
+                cells = (label, f"{t:.2f}",
                          f"{m['stroke']:.3f}", f"{m['plate_u']:.3f}", f"{m['moved']:.3f}", f"{m['grain_u']:.3f}",
                          "-" if ratio != ratio else f"{ratio:.2f}", f"{m['u10']:.3f}", f"{m['u90']:.3f}",
                          f"{m['entered']:.4f}", f"{m['front']:.3f}", f"{m['top']:.3f}")
