@@ -150,6 +150,28 @@ def test_ordering_verdicts():
     assert math.isnan(vv.twin_floor([result(1, 0.712)]))
 
 
+def test_criterion_check():
+    # issue 59's criterion 6: V1 within 10 % d_eta (13.45 mm of run-up), V2 above V1, V4 below V1;
+    # with --known-band LO HI it passes only while the criterion fails and V1's d_eta is in the band
+    def result(run, z):
+        r = vv.Result(vv.PAPER[run], 0.01, "", "reused")
+        r.status, r.run_up, r.d_eta = "ok", z, vv.d_eta(z)
+        return r
+
+    met = [result(1, 0.705), result(2, 0.720), result(4, 0.690)]            # d_eta 5.2 %, both orderings
+    assert vv.criterion_check(met, 10.0, None)[0]
+    assert not vv.criterion_check(met, 10.0, (40.0, 55.0))[0]                 # met: promote the test
+    low = [result(1, 0.648), result(2, 0.6675), result(4, 0.6523)]          # 12-07: d_eta 47.6 %, V4 above V1
+    assert not vv.criterion_check(low, 10.0, None)[0]
+    passed, message = vv.criterion_check(low, 10.0, (40.0, 55.0))
+    assert passed and "47.6 %" in message
+    assert not vv.criterion_check(low, 10.0, (50.0, 60.0))[0]                 # outside today's band
+    reversed_v4 = [result(1, 0.705), result(2, 0.720), result(4, 0.710)]    # V1 close, V4 above it
+    assert not vv.criterion_check(reversed_v4, 10.0, None)[0]
+    passed, message = vv.criterion_check(low[:2], 10.0, None)
+    assert not passed and "V4" in message
+
+
 def test_set_reaches_every_run(tmp_path):
     # --set KEY=VALUE goes to every run after the run's own overrides, is recorded in the run's
     # stamp (so --reuse tells the runs apart) and named in the table's header; a malformed one is

@@ -754,9 +754,16 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
 {
     for (size_t i = b0; i < b1; i++) {
         double f[DIM] = {0.0};
-        momentum_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, f,
-                       cached ? X->fk + X->fk_off[i] : NULL, implicit ? X->visc_w + X->fk_off[i] : NULL, wendland,
-                       cached, implicit, stress, friction, grains);
+        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        const double *fk = cached ? X->fk + X->fk_off[i] : NULL;
+        double *wl = implicit ? X->visc_w + X->fk_off[i] : NULL;
+        /* The bed friction's sums of a pair vanish unless i is a grain whose shear walls bound or a
+         * wall particle that bounds one (to_i = to_j = 0 in momentum_range): the other particles,
+         * the water's most, walk their pairs without them, to the same forces bit for bit. */
+        if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0))
+            momentum_range(X, P, i, rng, NEIGHBOURS_RANGES, f, fk, wl, wendland, cached, implicit, stress, 1, grains);
+        else
+            momentum_range(X, P, i, rng, NEIGHBOURS_RANGES, f, fk, wl, wendland, cached, implicit, stress, 0, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
