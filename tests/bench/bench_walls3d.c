@@ -60,6 +60,15 @@ static void time_within(const char *what, const struct surface *s, const double 
     printf("%-46s %9.0f ns per query (%ld within %g m)\n", what, 1e9 * (t1 - t0) / (double)n, near, reach);
 }
 
+static void time_may_be_within(const char *what, const struct surface *s, const double *p, size_t n, double reach)
+{
+    long near = 0;
+    const double t0 = now();
+    for (size_t k = 0; k < n; k++) near += surface_may_be_within(s, p + 3 * k, reach);
+    const double t1 = now();
+    printf("%-46s %9.0f ns per query (%ld flagged within %g m)\n", what, 1e9 * (t1 - t0) / (double)n, near, reach);
+}
+
 static void time_crossing(const char *what, const struct surface *s, const double *p, size_t n, double step)
 {
     long hits = 0;
@@ -101,6 +110,7 @@ int main(void)
         time_distance("tank, 10 triangles: distance near the bottom", &s, near, n);
         time_distance("tank: distance anywhere inside", &s, all, n);
         time_within("tank: within 0.15 m? (anywhere inside)", &s, all, n, 0.15);
+        time_may_be_within("tank: may be within 0.15 m? (anywhere inside)", &s, all, n, 0.15);
         time_crossing("tank: crossing of a step near the bottom", &s, near, n, 0.002);
         free(near);
         free(all);
@@ -130,6 +140,8 @@ int main(void)
         time_distance("terrain: distance 0.5 to 2 m above it", &s, high, n / 100);
         time_within("terrain: within 0.15 m? (near it)", &s, near, n, 0.15);
         time_within("terrain: within 0.15 m? (0.5 to 2 m above)", &s, high, n / 10, 0.15);
+        time_may_be_within("terrain: may be within 0.15 m? (near it)", &s, near, n, 0.15);
+        time_may_be_within("terrain: may be within 0.15 m? (0.5 to 2 m above)", &s, high, n / 10, 0.15);
         time_crossing("terrain: crossing of a step near it", &s, near, n, 0.002);
         time_brute("terrain: brute-force distance (mesh_distance)", &copy, near, 200);
         free(near);

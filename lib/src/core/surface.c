@@ -20,6 +20,9 @@ void surface_free(struct surface *s)
     free(s->cell_start);
     free(s->cell_triangle);
     free(s->empty_rings);
+    free(s->triangle_lo);
+    free(s->triangle_hi);
+    free(s->plane_offset);
     memset(s, 0, sizeof *s);
 }
 
@@ -228,12 +231,19 @@ mixsph_status surface_build(struct surface *s, struct mesh *m, char *err, size_t
     s->edge_normal = calloc(3 * nt, sizeof *s->edge_normal);
     s->edge_boundary = calloc(3 * nt, 1);
     s->vertex_boundary = calloc(nv, 1);
-    if (!s->vertex_normal || !s->edge_normal || !s->edge_boundary || !s->vertex_boundary || build_edges(s) != 0 ||
-        build_index(s) != 0 || build_empty_rings(s) != 0) {
+    s->triangle_lo = malloc(nt * sizeof *s->triangle_lo);
+    s->triangle_hi = malloc(nt * sizeof *s->triangle_hi);
+    s->plane_offset = malloc(nt * sizeof *s->plane_offset);
+    if (!s->vertex_normal || !s->edge_normal || !s->edge_boundary || !s->vertex_boundary || !s->triangle_lo ||
+        !s->triangle_hi || !s->plane_offset || build_edges(s) != 0 || build_index(s) != 0 || build_empty_rings(s) != 0) {
         surface_free(s);
         return status_set(err, err_len, MIXSPH_ERR_NOMEM, "out of memory (a surface of %zu triangles)", nt);
     }
     build_vertex_normals(s);
+    for (size_t t = 0; t < nt; t++) {
+        triangle_box(&s->mesh, t, s->triangle_lo[t], s->triangle_hi[t]);
+        s->plane_offset[t] = vec3_dot(s->mesh.normal[t], s->mesh.vertex[s->mesh.triangle[t][0]]);
+    }
     return MIXSPH_OK;
 }
 
@@ -367,6 +377,40 @@ double surface_signed_distance_within(const struct surface *s, const double p[3]
 double surface_signed_distance(const struct surface *s, const double p[3], struct surface_point *at)
 {
     return surface_signed_distance_within(s, p, INFINITY, at);
+}
+
+int surface_may_be_within(const struct surface *s, const double p[3], double reach)
+{
+    if (s->mesh.n_triangles == 0) return 0;
+    /* a triangle within reach of p has its box within reach: that box meets the cube p -+ reach
+     * inside the grid, so the triangle is listed in a bucket of the cube's range (clamped) */
+    size_t a[3], b[3];
+    for (int d = 0; d < 3; d++) {
+        const double grid_hi = s->lo[d] + (double)s->n[d] * s->cell;
+        if (isnan(p[d])) return 1;
+        if (p[d] + reach < s->lo[d] || p[d] - reach > grid_hi) return 0;
+        a[d] = surface_cell_of(s, d, p[d] - reach);
+        b[d] = surface_cell_of(s, d, p[d] + reach);
+    }
+    const double reach2 = reach * reach;
+    for (size_t k = a[2]; k <= b[2]; k++)
+        for (size_t j = a[1]; j <= b[1]; j++)
+            for (size_t i = a[0]; i <= b[0]; i++) {
+                const size_t cell = cell_index(s, i, j, k);
+                for (size_t q = s->cell_start[cell]; q < s->cell_start[cell + 1]; q++) {
+                    const size_t t = s->cell_triangle[q];
+                    const double *lo = s->triangle_lo[t], *hi = s->triangle_hi[t];
+                    double gap2 = 0.0;
+                    for (int d = 0; d < 3; d++) {
+                        const double g = p[d] < lo[d] ? lo[d] - p[d] : p[d] > hi[d] ? p[d] - hi[d] : 0.0;
+                        gap2 += g * g;
+                    }
+                    if (gap2 > reach2) continue;
+                    if (fabs(vec3_dot(s->mesh.normal[t], p) - s->plane_offset[t]) > reach) continue;
+                    return 1;
+                }
+            }
+    return 0;
 }
 
 int surface_first_crossing(const struct surface *s, const double a[3], const double b[3], double *t_hit, double n[3])

@@ -42,6 +42,9 @@ struct surface {
     size_t *cell_start;             /* bucket c lists cell_triangle[cell_start[c] .. cell_start[c + 1]) */
     size_t *cell_triangle;
     uint16_t *empty_rings;          /* per bucket: the shells of buckets around it holding no triangle */
+    double (*triangle_lo)[3];       /* per triangle: its box's low corner [m] */
+    double (*triangle_hi)[3];       /* and high corner [m] */
+    double *plane_offset;           /* per triangle: n . x of its plane [m] */
 };
 
 /* The point of a surface nearest to a query point, and what the surface is there. */
@@ -66,6 +69,14 @@ double surface_signed_distance(const struct surface *s, const double p[3], struc
  *  that close. Cheap for a far point, whose exact distance can take many shells of buckets. */
 double surface_signed_distance_within(const struct surface *s, const double p[3], double max_distance,
                                       struct surface_point *at);
+
+/** May a point of the surface lie within `reach` of p? 0 only when none does; 1 when some
+ *  triangle's box and plane both do (a superset of the exact answer: a triangle's box and plane
+ *  are never farther than the triangle, and a bounding box is exact for a face of an axis-aligned
+ *  box). For a filter whose false positives cost only time, such as the crossing guard's near-wall
+ *  flag: a few bounds per triangle of the buckets within reach instead of the nearest triangle's
+ *  search (docs/performance.md, "The queries of a 3D wall"). A NaN coordinate counts as near. */
+int surface_may_be_within(const struct surface *s, const double p[3], double reach);
 
 /** Does the segment a -> b cross the surface from its front to its back (within [a, b], a
  *  crossing through an edge counted)? Then *t receives the fraction of a -> b at the first such

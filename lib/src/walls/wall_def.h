@@ -46,6 +46,9 @@ struct wall {
     struct surface surface;   /* 3D: the wall's triangles, normals toward the fluid (wall_surface_build) */
     int motion;               /* index into the case's motions, -1 for a fixed wall */
     int slip;                 /* enum wall_slip */
+    int symmetry;             /* 3D: a plane of symmetry (the free-slip side walls of an extruded
+                               * polyline): its particles carry the fluid's velocity mirrored
+                               * across it in every pair term (walls.c, walls_extrapolate_fluid) */
     double friction_deg;      /* friction angle delta on grains with a stress [deg]; NaN: the grains' phi */
 };
 

@@ -80,6 +80,7 @@ mixsph_status wall_side_walls(const struct wall *flume, struct wall *sides, char
                            .y_max = NAN,
                            .motion = -1,
                            .slip = flume->side_walls,
+                           .symmetry = flume->side_walls == WALL_FREE_SLIP,
                            .friction_deg = flume->friction_deg};
     const size_t len = strlen(flume->name); /* checked above: the name and "_sides" fit */
     memcpy(sides->name, flume->name, len);

@@ -87,7 +87,7 @@ int walls_near(const struct walls *W, size_t w, const double pos[DIM], double re
 {
     const double *o = W->state[w].o;
     const double p[3] = {pos[0] - o[0], pos[1] - o[1], pos[2] - o[2]};
-    return !(fabs(surface_signed_distance_within(&W->def[w].surface, p, reach, NULL)) > reach);
+    return surface_may_be_within(&W->def[w].surface, p, reach);
 }
 #endif
 
@@ -596,6 +596,24 @@ static inline void mirror_normal_velocity(const double n[DIM], const double v_wa
     for (int d = 0; d < DIM; d++) v[d] -= 2.0 * vn * n[d];
 }
 
+#if DIM == 3
+/* The unit normal toward the fluid of the face of box wall wl (a plane of symmetry, fluid inside)
+ * behind which wall particle i lies (the faces it is behind, summed and normalised at a corner). */
+static void symmetry_normal(const struct wall *wl, const struct particles *P, size_t i, double n[DIM])
+{
+    double len2 = 0.0;
+    for (int d = 0; d < DIM; d++) {
+        const unsigned lo_face = MESH_BOX_XMIN << (2 * d), hi_face = MESH_BOX_XMAX << (2 * d);
+        n[d] = (wl->box_faces & lo_face) && P->pos[d][i] < wl->box_min[d]   ? 1.0
+               : (wl->box_faces & hi_face) && P->pos[d][i] > wl->box_max[d] ? -1.0
+                                                                            : 0.0;
+        len2 += n[d] * n[d];
+    }
+    const double inv = len2 > 0.0 ? 1.0 / sqrt(len2) : 0.0;
+    for (int d = 0; d < DIM; d++) n[d] *= inv;
+}
+#endif
+
 /* The arguments of a parallel loop of this file (core/team.h). */
 /* The parallel loops of this file (core/team.h), each with its own arguments. */
 struct extrapolate_loop { /* the fluid's state onto the wall particles */
@@ -676,6 +694,18 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
             P->rho[i] = rho_alone;
             for (int d = 0; d < DIM; d++) uv[d] = ws->v[d];
         }
+#if DIM == 3
+        /* a plane of symmetry: the mirror image of the fluid's velocity (its normal part mirrored
+         * above when a solid's stress needs wall_n), in the viscous and every other pair term */
+        if (W->def[w].symmetry) {
+            if (sw > 0.0 && !P->wall_n[0]) {
+                double n[DIM];
+                symmetry_normal(&W->def[w], P, i, n);
+                mirror_normal_velocity(n, ws->v, uv);
+            }
+            for (int d = 0; d < DIM; d++) P->vel[d][i] = uv[d];
+        }
+#endif
         for (int d = 0; d < DIM; d++) P->uv[d][i] = uv[d];
         P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
         P->inv_rho[i] = 1.0 / P->rho[i];

@@ -77,8 +77,9 @@ long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *in
  *  closest point is an end of the polyline (3D: on an open edge of the surface). */
 double walls_distance(const struct walls *W, size_t w, const double pos[DIM], int *at_end);
 
-/** Is pos within `reach` of wall w where it is now (either side)? The crossing guard's filter:
- *  in 3D it stops searching beyond reach, where the exact distance can take long. */
+/** May pos be within `reach` of wall w where it is now (either side)? 0 only when it is not: the
+ *  crossing guard's filter, whose false positives cost only time. 2D: the exact distance; 3D: a
+ *  bound per triangle of the buckets within reach (surface_may_be_within), no nearest-point search. */
 int walls_near(const struct walls *W, size_t w, const double pos[DIM], double reach);
 
 /** The unit normal n of wall w toward its fluid at the point of the wall nearest to pos. */
