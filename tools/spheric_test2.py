@@ -63,6 +63,7 @@ DRAIN_H = 0.5 * DEPTH  # m: H4's "arrival" is the reservoir falling below half i
 PEAK_ONSET = 1000.0  # Pa: a pressure sensor counts as wet
 PEAK_WINDOW = 0.3    # s after the onset in which the first impact peak is sought
 GRID = 0.01          # s: the experiment file's regular grid
+SLOT_TOL = 0.5e-3    # s: a row within half the 1 kHz sampling period of a grid time is its row
 QUASI_STATIC = (1.0, 6.0)  # s: the pressures' comparison after the first impact
 
 # --check: (metric, gauge, tolerance, why). A metric beyond its tolerance fails the check.
@@ -142,12 +143,26 @@ def read_experiment(path):
     return out
 
 
+def grid_rows(t_exp, grid=GRID, t_end=None):
+    """{k: index of the row nearest to k grid} for every multiple k grid (0 <= k grid <= t_end,
+    default the last time) that has a row within SLOT_TOL of it: the experiment's regular grid,
+    the impact window's extra rows left out."""
+    t_end = t_exp[-1] if t_end is None else t_end
+    slots = {}
+    for i, ti in enumerate(t_exp):
+        k = int(round(ti / grid))
+        off = abs(ti - k * grid)
+        if off <= SLOT_TOL and k * grid <= t_end + SLOT_TOL and (k not in slots or off < abs(t_exp[slots[k]] - k * grid)):
+            slots[k] = i
+    return slots
+
+
 def data_findings(exp, grid=GRID, t_end=T_END):
     """What is wrong or notable in the measured series, as (ok, message) pairs: time strictly
-    increasing; every multiple of `grid` from 0 to t_end present (to 1e-6 s); H4 starting within
-    0.02 m of DEPTH; heights in [-0.05, 1] m (the tank is 1 m deep); pressures in [-5, 100] kPa
-    (a negative reading is the sensors' drift or a cavity; beyond 100 kPa is no impact of a 0.55 m
-    column at 4-5 m/s, rho u^2 = 25 kPa)."""
+    increasing; a row within SLOT_TOL of every multiple of `grid` from 0 to t_end; H4 starting
+    within 0.02 m of DEPTH; heights in [-0.05, 1] m (the tank is 1 m deep); pressures in
+    [-5, 100] kPa (a negative reading is the sensors' offset or a cavity; beyond 100 kPa is no
+    impact of a 0.55 m column at 4-5 m/s, rho u^2 = 25 kPa)."""
     t = exp["t"]
     found = []
     dt = np.diff(t)
@@ -155,19 +170,22 @@ def data_findings(exp, grid=GRID, t_end=T_END):
     found.append((bad.size == 0, "time strictly increasing" if bad.size == 0 else
                   f"time not increasing at {bad.size} rows, the first at t = {t[bad[0]]:.4f} -> {t[bad[0] + 1]:.4f} s"))
     n = int(round(t_end / grid))
-    on_grid = np.round(t / grid)
-    near = np.abs(t - on_grid * grid) < 1e-6
-    have = set(on_grid[near].astype(int).tolist())
-    missing = [k for k in range(n + 1) if k not in have]
+    slots = grid_rows(t, grid)
+    missing = [k for k in range(n + 1) if k not in slots]
     if missing:
         show = ", ".join(f"{k * grid:.2f}" for k in missing[:10]) + (" ..." if len(missing) > 10 else "")
         found.append((False, f"the {grid * 1e3:.0f} ms grid 0-{t_end:g} s misses {len(missing)} of {n + 1} times: {show}"))
     else:
-        found.append((True, f"the {grid * 1e3:.0f} ms grid 0-{t_end:g} s complete ({n + 1} times)"))
-    extra = t[~near]
+        worst = max(abs(t[i] - k * grid) for k, i in slots.items() if k <= n)
+        found.append((True, f"the {grid * 1e3:.0f} ms grid 0-{t_end:g} s complete ({n + 1} times, each row within "
+                            f"{worst * 1e3:.2f} ms of its time)"))
+    beyond = [k for k in slots if k > n]
+    if beyond:
+        found.append((True, f"{len(beyond)} grid times beyond {t_end:g} s, to {t[-1]:.3f} s"))
+    extra = np.setdiff1d(np.arange(t.size), list(slots.values()))
     if extra.size:
-        found.append((True, f"{extra.size} rows off the grid, from {extra.min():.3f} to {extra.max():.3f} s "
-                            f"(median step {np.median(np.diff(extra)) * 1e3:.2f} ms)"))
+        found.append((True, f"{extra.size} rows off the grid, from {t[extra].min():.3f} to {t[extra].max():.3f} s "
+                            f"(median step {np.median(np.diff(t[extra])) * 1e3:.2f} ms)"))
     if "H4" in exp:
         h40 = float(exp["H4"][0])
         found.append((abs(h40 - DEPTH) <= 0.02, f"H4 at t = {t[0]:g} s: {h40:.4f} m (column depth {DEPTH} m)"))
@@ -183,16 +201,11 @@ def data_findings(exp, grid=GRID, t_end=T_END):
     return found
 
 
-def grid_rows(t_exp, grid=GRID):
-    """Indices of the rows of the experiment's regular grid (the impact window's extra rows out)."""
-    return np.flatnonzero(np.abs(t_exp - np.round(t_exp / grid) * grid) < 1e-6)
-
-
 def rms_difference(t_run, v_run, t_exp, v_exp, t0=0.0, t1=T_END):
     """(rms of v_run - v_exp [units of v], the span compared [s, s]) over the experiment's grid
     rows in [t0, min(t1, the run's last time)], the run interpolated linearly onto them."""
-    k = grid_rows(t_exp)
-    k = k[(t_exp[k] >= t0 - 1e-9) & (t_exp[k] <= min(t1, t_run[-1]) + 1e-9)]
+    k = np.array(sorted(grid_rows(t_exp).values()), dtype=int)
+    k = k[(t_exp[k] >= t0 - SLOT_TOL) & (t_exp[k] <= min(t1, t_run[-1]) + SLOT_TOL)]
     if k.size == 0:
         return math.nan, (t0, t0)
     v = np.interp(t_exp[k], t_run, v_run)
