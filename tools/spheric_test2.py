@@ -54,6 +54,7 @@ from mixsph_tools.readers import ToolError, read_monitors  # noqa: E402
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXP_DEFAULT = os.path.join(ROOT, "data", "spheric_test2", "kleefsman_marin.csv")
 GAUGES = ("H1", "H2", "H3", "H4")
+GAUGE_X = {"H1": 0.496, "H2": 0.992, "H3": 1.488, "H4": 2.638}  # m, the case's gauges (y = 0.5 m)
 PROBES = ("P1", "P2", "P3", "P4")
 T_END = 6.0          # s: the benchmark's span
 DEPTH = 0.55         # m: the column's depth (H4 at t = 0)
@@ -65,6 +66,13 @@ PEAK_WINDOW = 0.3    # s after the onset in which the first impact peak is sough
 GRID = 0.01          # s: the experiment file's regular grid
 SLOT_TOL = 0.5e-3    # s: a row within half the 1 kHz sampling period of a grid time is its row
 QUASI_STATIC = (1.0, 6.0)  # s: the pressures' comparison after the first impact
+
+# The measured file's column at each of the case's gauges. Its H1 and H3 are the gauges at
+# x = 1.488 and 0.496 m, the reverse of the case's labels: the file's H1 is wet at 0.25 s, when no
+# water can have reached x = 0.496 m (1.5 m from the column's face, behind the box: Ritter's front,
+# 2 sqrt(g 0.55) = 4.6 m/s, an upper bound, is at most 1.16 m out), and its H3 last, at 0.94 s;
+# the arrival order of the file's H1, H2, H3 is that of x = 1.488, 0.992, 0.496 m.
+EXP_GAUGE = {"H1": "H3", "H2": "H2", "H3": "H1", "H4": "H4"}
 
 # --check: (metric, gauge, tolerance, why). A metric beyond its tolerance fails the check.
 CHECKS = (
@@ -219,12 +227,13 @@ def compare(mon, dx, exp):
     h = heights(mon, dx)
     out = {}
     for g in GAUGES:
-        if g not in h or g not in exp:
+        e = EXP_GAUGE[g]
+        if g not in h or e not in exp:
             continue
-        rms, span = rms_difference(t, h[g], exp["t"], exp[g])
-        ta_r, ta_e = arrival(t, h[g], g), arrival(exp["t"], exp[g], g)
+        rms, span = rms_difference(t, h[g], exp["t"], exp[e])
+        ta_r, ta_e = arrival(t, h[g], g), arrival(exp["t"], exp[e], g)
         out[g] = {"arrival_run": ta_r, "arrival_exp": ta_e, "arrival_diff": ta_r - ta_e, "rms_h": rms,
-                  "span": span, "max_run": float(np.max(h[g])), "max_exp": float(np.max(exp[g]))}
+                  "span": span, "max_run": float(np.max(h[g])), "max_exp": float(np.max(exp[e]))}
     for p in PROBES:
         if p not in exp:
             continue
@@ -316,9 +325,11 @@ def plot(runs, exp, out):
     fig, axes = plt.subplots(3, 2, figsize=(11, 9), sharex=True)
     panels = list(GAUGES) + ["P1", "P3"]
     for ax, key in zip(axes.flat, panels):
-        if exp is not None and key in exp:
+        col = EXP_GAUGE.get(key, key)
+        if exp is not None and col in exp:
             scale = 1e-3 if key.startswith("P") else 1.0
-            ax.plot(exp["t"], exp[key] * scale, color="k", lw=0.8, label="experiment")
+            ax.plot(exp["t"], exp[col] * scale, color="k", lw=0.8,
+                    label="experiment" + (f" (file's {col})" if col != key else ""))
         for k, (label, mon, dx) in enumerate(runs):
             color = f"C{k}"
             t = mon["t"]
@@ -330,7 +341,7 @@ def plot(runs, exp, out):
                     ax.plot(t, mon[key + "_wall"] / 1e3, color=color, lw=0.9, label=f"{label} face")
                 if key in mon:
                     ax.plot(t, mon[key] / 1e3, color=color, lw=0.7, ls=":", label=f"{label} probe 1.5 h")
-        ax.set_title(key, fontsize=9)
+        ax.set_title(key + (f" (x = {GAUGE_X[key]} m)" if key in GAUGE_X else ""), fontsize=9)
         ax.set_ylabel("height [m]" if key.startswith("H") else "pressure [kPa]")
         if key.startswith("P"):
             ax.set_ylim(-5, 25)

@@ -57,15 +57,15 @@ def test_spheric_heights_and_first_peak():
 
 
 def synthetic_marin(shift=0.0, step=0.01, window=True):
-    """A measured-like series: heights rising linearly from an arrival time (H1-H3 at 0.6, 0.4,
-    0.3 s + shift) to 0.2 m within 0.1 s, the reservoir H4 draining from 0.55 m at 0.2 m/s
+    """A measured-like series: heights rising linearly from an arrival time (the file's H1-H3 at
+    0.3, 0.4, 0.6 s + shift: its H1 is the gauge nearest the column) to 0.2 m within 0.1 s, the reservoir H4 draining from 0.55 m at 0.2 m/s
     (below half its depth at 1.375 s + shift), P1 a 10 kPa spike at 0.45 s + shift on a 2 kPa
     level from 1 s; every `step` s to 6 s plus every ms from 0.38 to 0.60 s (the impact window)."""
     t = np.round(np.arange(0.0, 6.0 + 1e-9, step), 6)
     if window:
         t = np.union1d(t, np.round(np.arange(0.38, 0.60 + 1e-9, 0.001), 6))
     exp = {"t": t}
-    for g, ta in (("H1", 0.6), ("H2", 0.4), ("H3", 0.3)):
+    for g, ta in (("H1", 0.3), ("H2", 0.4), ("H3", 0.6)):
         exp[g] = np.clip((t - ta - shift) / 0.1, 0.0, 1.0) * 0.2
     exp["H4"] = np.clip(0.55 - 0.2 * np.maximum(t - shift, 0.0), 0.1, 0.55)
     exp["P1"] = np.where(np.abs(t - 0.45 - shift) < 0.0005, 10000.0, 0.0) + np.where(t >= 1.0, 2000.0, 0.0)
@@ -86,7 +86,7 @@ def as_run(exp, dx):
     t = np.round(np.arange(0.0, 6.0 + 1e-9, 0.005), 6)
     mon = {"t": t}
     for g in ("H1", "H2", "H3", "H4"):
-        h = np.interp(t, exp["t"], exp[g])
+        h = np.interp(t, exp["t"], exp[spheric_test2.EXP_GAUGE[g]])
         mon[g] = np.where(h > 0.0, h - 0.5 * dx, np.nan)
     for p in ("P1", "P3"):
         mon[p] = np.interp(t, exp["t"], exp[p])
@@ -139,3 +139,16 @@ def test_spheric_comparison_against_a_known_difference(tmp_path):
     assert not res[0][0] and all(ok for ok, _ in res[1:])
     # the rms is over the 10 ms grid only: the impact window's ms rows do not weigh in
     assert len(spheric_test2.grid_rows(exp["t"])) == 601
+
+
+def test_spheric_measured_gauge_order():
+    # the premise of EXP_GAUGE, on the repository's measured file: its H1, H2, H3 are wet in
+    # that order, and its H1 before any water can reach x = 0.496 m (1.496 m from the column's
+    # face at Ritter's front speed 2 sqrt(g 0.55), an upper bound): so its H1 is not the gauge at
+    # x = 0.496 m, and the case's H1 (x = 0.496) reads the file's H3
+    exp = spheric_test2.read_experiment(spheric_test2.EXP_DEFAULT)
+    t = {g: spheric_test2.arrival(exp["t"], exp[g], g) for g in ("H1", "H2", "H3")}
+    assert t["H1"] < t["H2"] < t["H3"], t
+    ritter = 2.0 * np.sqrt(9.81 * 0.55)
+    assert t["H1"] < (1.992 - 0.496) / ritter < t["H3"]
+    assert spheric_test2.EXP_GAUGE["H1"] == "H3" and spheric_test2.EXP_GAUGE["H3"] == "H1"
