@@ -22,8 +22,8 @@ The differences, each computed the same way on the run and on the experiment:
 
 - arrival at H1-H3: the first time the height reaches ARRIVAL_H; H4 (in the reservoir): the first
   time it falls below DRAIN_H, half the column's depth;
-- the first impact at P1 (and P3): the largest pressure within PEAK_WINDOW s after the first time
-  it exceeds PEAK_ONSET, and its time (first_peak);
+- the first impact at each sensor: its onset, the first time it exceeds PEAK_ONSET, and the
+  largest pressure within PEAK_WINDOW s after it, and its time (first_peak);
 - the rms of the height difference run - experiment over the experiment's 10 ms grid (the impact
   window's extra rows left out, so that each time counts alike), from 0 s to the end of the run
   (6 s for a run that reached it); also for the pressures, over 1-6 s (after the impact, the
@@ -247,7 +247,9 @@ def compare(mon, dx, exp):
             rms_all, span = rms_difference(t, v, exp["t"], exp[p])
             qs = (exp["t"] >= QUASI_STATIC[0]) & (exp["t"] <= QUASI_STATIC[1])
             qr = (t >= QUASI_STATIC[0]) & (t <= QUASI_STATIC[1])
-            out[name] = {"peak_run": vp_r, "t_peak_run": tp_r, "peak_exp": vp_e, "t_peak_exp": tp_e,
+            out[name] = {"onset_run": first_time_at_least(t, v, PEAK_ONSET),
+                         "onset_exp": first_time_at_least(exp["t"], exp[p], PEAK_ONSET),
+                         "peak_run": vp_r, "t_peak_run": tp_r, "peak_exp": vp_e, "t_peak_exp": tp_e,
                          "rms_p_qs": rms_qs, "rms_p": rms_all, "span": span,
                          "mean_qs_run": float(np.mean(v[qr])) if qr.any() else math.nan,
                          "mean_qs_exp": float(np.mean(exp[p][qs]))}
@@ -308,13 +310,14 @@ def comparison_lines(label, cmp):
             lines.append(f"| {g} | {c['arrival_run']:.3f} | {c['arrival_exp']:.3f} | {c['arrival_diff']:+.3f} | "
                          f"{c['max_run']:.3f} | {c['max_exp']:.3f} | {c['rms_h']:.3f} | {c['span'][0]:.2f}-{c['span'][1]:.2f} |")
     lines += [f"\n{label}: pressures against the experiment",
-              "| sensor | first peak run [kPa] | at [s] | first peak exp [kPa] | at [s] | mean 1-6 s run [kPa] | "
-              "mean 1-6 s exp [kPa] | rms diff 1-6 s [kPa] | rms diff all [kPa] |",
-              "|---|---|---|---|---|---|---|---|---|"]
+              "| sensor | onset run [s] | onset exp [s] | first peak run [kPa] | at [s] | first peak exp [kPa] | at [s] | "
+              "mean 1-6 s run [kPa] | mean 1-6 s exp [kPa] | rms diff 1-6 s [kPa] | rms diff all [kPa] |",
+              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for name, c in cmp.items():
         if not name.startswith("P"):
             continue
-        lines.append(f"| {name} | {c['peak_run'] / 1e3:.2f} | {c['t_peak_run']:.3f} | {c['peak_exp'] / 1e3:.2f} | "
+        lines.append(f"| {name} | {c['onset_run']:.3f} | {c['onset_exp']:.3f} | {c['peak_run'] / 1e3:.2f} | "
+                     f"{c['t_peak_run']:.3f} | {c['peak_exp'] / 1e3:.2f} | "
                      f"{c['t_peak_exp']:.3f} | {c['mean_qs_run'] / 1e3:.2f} | {c['mean_qs_exp'] / 1e3:.2f} | "
                      f"{c['rms_p_qs'] / 1e3:.2f} | {c['rms_p'] / 1e3:.2f} |")
     return lines
