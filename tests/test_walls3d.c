@@ -134,53 +134,6 @@ static void test_box_tank_particles(void **state)
     surface_free(&wl.surface);
 }
 
-/* A tank whose faces do not lie half a spacing off the lattice: x = 0.025 is a lattice plane and
- * y = 0.49 lies 0.3 dx beyond the plane y = 0.475. The wall takes the sites behind its faces
- * within the layers and those in front of them closer than dx/2, the sites a body may not hold
- * (walls_site_blocked): the bodies' lattice and the wall's meet with no empty layer (before, the
- * planes x = 0.025 and y = 0.475 were neither, and the water moved onto the surface, where the
- * crossing guard lined particles up along the tank's edges: docs/validation/spheric_test2.md).
- * Reference: the box's own signed distance over the lattice. */
-static void test_tank_off_lattice_particles(void **state)
-{
-    (void)state;
-    const double lo[3] = {0.025, 0.0, 0.0}, hi[3] = {1.0, 0.49, 0.6}, dx = 0.05;
-    const int layers = 2;
-    const double depth = layers * dx;
-    struct wall wl = box_wall(lo, hi, MESH_BOX_OPEN_TOP, 0);
-    assert_int_equal(wall_surface_build(&wl, NULL, err, sizeof err), MIXSPH_OK);
-    struct walls W;
-    walls_of(&W, &wl, 1, NULL, layers);
-    struct particles P = {0};
-    assert_int_equal(particles_alloc(&P, 1024), 0);
-    const long n = walls_generate(&W, dx, NULL, &P);
-    long expected = 0, in_front = 0;
-    for (long k = -10; k < 12; k++) /* sites up to z = 0.575: below the open top */
-        for (long j = -10; j < 20; j++)
-            for (long i = -10; i < 30; i++) {
-                const double p[3] = {(i + 0.5) * dx, (j + 0.5) * dx, (k + 0.5) * dx};
-                const double d = -box_signed_distance(p, lo, hi); /* > 0 inside the tank: its fluid side */
-                if (d >= -depth && d < 0.5 * dx) expected++;
-                if (d >= 0.0 && d < 0.5 * dx) in_front++;
-            }
-    long above = 0; /* the layers' sites at z > 0.6 (around the open top's rim): not in the reference */
-    for (size_t i = 0; i < P.n; i++) above += P.pos[2][i] > hi[2];
-    print_message("off-lattice tank: %ld wall particles below the rim (expected %ld, %ld of them in front of the "
-                  "faces)\n", n - above, expected, in_front);
-    assert_int_equal(n - above, expected);
-    assert_true(in_front > 0);
-    /* the sites on the plane x = 0.025 and on y = 0.475 are the wall's */
-    int on_plane = 0, off_face = 0;
-    for (size_t i = 0; i < P.n; i++) {
-        const int mid_z = fabs(P.pos[2][i] - 0.275) < 1e-12;
-        on_plane |= fabs(P.pos[0][i] - 0.025) < 1e-12 && fabs(P.pos[1][i] - 0.225) < 1e-12 && mid_z;
-        off_face |= fabs(P.pos[0][i] - 0.525) < 1e-12 && fabs(P.pos[1][i] - 0.475) < 1e-12 && mid_z;
-    }
-    assert_true(on_plane && off_face);
-    particles_free(&P);
-    surface_free(&wl.surface);
-}
-
 /* A flume: a bed polyline (a slope then a flat bottom) extruded across y in [0, 0.4], with
  * free-slip side walls. Across the width the bed's particles are, in every row, the 2D sites
  * within the layers behind the polyline or within dx/2 in front of it (by geometry.h's signed distance, which takes the side
@@ -614,7 +567,6 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_box_tank_particles),
-        cmocka_unit_test(test_tank_off_lattice_particles),
         cmocka_unit_test(test_flume_particles),
         cmocka_unit_test(test_box_signed_distance),
         cmocka_unit_test(test_tetra_stl),
