@@ -20,7 +20,9 @@
 
 #include <cmocka.h>
 
+#include "case.h"
 #include "dim.h"
+#include "edit_text.h"
 #include "mesh.h"
 #include "mixsph.h"
 #include "stl.h"
@@ -321,6 +323,51 @@ static void test_monitors(void **state)
     }
 }
 
+static double output_of(const mixsph_sim *s, const char *name)
+{
+    const long k = mixsph_sim_output_find(s, name);
+    assert_true(k >= 0);
+    return mixsph_sim_output_value(s, (size_t)k);
+}
+
+/* In 3D (cases/hydrostatic_tank_3d.json: water H = 0.24 m deep at rest in a 0.2 x 0.12 m box
+ * tank, dx = 0.02): a sensor on the tank's wall x = 0.2 at (y, z) = (0.06, 0.1) read 1.5 h into
+ * the water, and the wall_pressure of the wall's first layer around it (the sites x = 0.21,
+ * y = 0.05 and 0.07, z = 0.09). References: hydrostatics. The probe at t = 0 reads rho0 g
+ * (H - 0.1) within test_probe_initial_field's tolerance 0.005 rho0 g dx (the point lies on the
+ * lattice's symmetry planes in y and z, and the pressure varies along z only). The wall's
+ * pressure after one step is the extrapolation p_w = sum_j (p_j + rho_j g (z_j - z_w)) W_wj /
+ * sum_j W_wj of the hydrostatic water (docs/model.md [WP]), rho0 g (H - z_w) but for the water's
+ * compression rho_j / rho0 - 1 = p_j / K, under 0.4 % here: tolerance 1 % of it. */
+static void test_probe_on_a_3d_wall(void **state)
+{
+    (void)state;
+    char err[512], *text = NULL;
+    if (case_read_file(MIXSPH_SOURCE_DIR "/cases/hydrostatic_tank_3d.json", &text, err, sizeof err) != MIXSPH_OK)
+        fail_msg("%s", err);
+    char *json = edit_text(text, "\"monitors\": {\n",
+                           "\"monitors\": {\n"
+                           "    \"side\": { \"type\": \"pressure_probe\", \"wall\": \"tank\", \"x\": 0.2, \"y\": 0.06, \"z\": 0.1 },\n"
+                           "    \"side_wall\": { \"type\": \"wall_pressure\", \"wall\": \"tank\", \"x_min\": 0.19, \"x_max\": 0.23,"
+                           " \"y_min\": 0.04, \"y_max\": 0.08, \"z_min\": 0.08, \"z_max\": 0.1 },\n");
+    free(text);
+    mixsph_sim *s = NULL;
+    if (mixsph_sim_create_from_text(json, "tank3d_probes.json", NULL, 0, &s, err, sizeof err) != MIXSPH_OK)
+        fail_msg("%s", err);
+    free(json);
+    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
+    const double H = 0.24, dx = 0.02;
+    const double p_probe = output_of(s, "side"), p_probe_ref = 1000.0 * G * (H - 0.1);
+    print_message("3D: the wall sensor reads %.3f Pa at t = 0, rho0 g (H - z) = %.3f Pa\n", p_probe, p_probe_ref);
+    assert_true(fabs(p_probe - p_probe_ref) <= 0.005 * 1000.0 * G * dx);
+    assert_int_equal(mixsph_sim_step(s), MIXSPH_OK);
+    const double p_wall = output_of(s, "side_wall"), p_wall_ref = 1000.0 * G * (H - 0.09);
+    print_message("3D: the wall's first layer reads %.3f Pa after a step, rho0 g (H - z_w) = %.3f Pa\n", p_wall,
+                  p_wall_ref);
+    assert_true(fabs(p_wall - p_wall_ref) <= 0.01 * p_wall_ref);
+    mixsph_sim_destroy(s);
+}
+
 /* Bad 3D input, refused with the key and why. */
 static void test_refused_inputs(void **state)
 {
@@ -397,6 +444,7 @@ int main(void)
         cmocka_unit_test(test_elastic_plastic_falls_freely),
         cmocka_unit_test(test_paper_law_holds_grains),
         cmocka_unit_test(test_monitors),
+        cmocka_unit_test(test_probe_on_a_3d_wall),
         cmocka_unit_test(test_refused_inputs),
         cmocka_unit_test(test_restart_is_bit_identical),
     };

@@ -129,8 +129,10 @@ static void run_tank(const struct tank *T)
         const double p_probe = mixsph_sim_output_value(s, (size_t)probe), p_probe_ref = RHO0 * G * (zs - 1.5 * DX);
         const double e_probe = p_probe / p_probe_ref - 1.0;
         worst_probe = fmax(worst_probe, fabs(e_probe));
-        if (T->beach) { /* known failure: today's band (above) */
-            assert_true(e_probe >= -0.08 && e_probe <= -0.01);
+        if (T->beach) { /* known failure: today's band. Since its wall takes the sites in front of
+                         * its slope (walls.c, 2026-12-07) it reads +1.00 to +1.03 % at 0.25-0.50 s, just
+                         * past the 1 % criterion (-8 % to -1 % before) */
+            assert_true(e_probe >= 0.0 && e_probe <= 0.02);
         } else if (k == 5) { /* reference: hydrostatics at the probe; tolerance 1 % (issue 57) */
             assert_true(fabs(e_probe) <= 0.01);
         }

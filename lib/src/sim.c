@@ -99,7 +99,7 @@ static int site_blocked(const mixsph_sim *s, const double pos[DIM])
     for (size_t w = 0; w < s->cfg.n_walls; w++) {
         int at_end = 0;
         const double d = walls_distance(&s->phys.walls, w, pos, &at_end);
-        if (!at_end && d < 0.5 * s->phys.dx * (1.0 - 1e-9)) return 1;
+        if (walls_site_blocked(d, at_end, s->phys.dx)) return 1;
     }
     return 0;
 }

@@ -636,9 +636,9 @@ static mixsph_status read_profile_times(const struct case_reader *r, const cJSON
     return MIXSPH_OK;
 }
 
-/* What a monitor takes in the case's dimension: the y keys in 3D only; in 3D, a pressure probe at a
- * point (x, y, z) in the flow, and no profile or wall_pressure (2D measures: x bins of a section,
- * the pressure along a wall's polyline). */
+/* What a monitor takes in the case's dimension: the y keys in 3D only; in 3D, a pressure probe's
+ * point is (x, y, z) (in the flow, or a sensor on a wall), a wall_pressure's region a box, and no
+ * profile (x bins of a 2D section). */
 static mixsph_status read_monitor_dimension(const struct case_reader *r, const cJSON *it, const char *path,
                                             const struct case_def *c, const struct monitor_def *md)
 {
@@ -648,16 +648,11 @@ static mixsph_status read_monitor_dimension(const struct case_reader *r, const c
                                 r->origin, path);
         return MIXSPH_OK;
     }
-    if (md->kind == MONITOR_PROFILE || md->kind == MONITOR_WALL_PRESSURE)
-        return FAIL(r, "%s: %s: a %s monitor is 2D only (in 3D: max_elevation over a region with x and y ranges, "
-                       "pressure_probe at a point, kinetic_energy, front, wall_work)", r->origin, path,
-                    md->kind == MONITOR_PROFILE ? "profile" : "wall_pressure");
-    if (md->kind == MONITOR_PRESSURE_PROBE) {
-        if (item(it, "wall"))
-            return FAIL(r, "%s: %s.wall: a probe on a wall's sensor is 2D only; in 3D give a point in the flow "
-                           "(x, y, z)", r->origin, path);
-        if (!item(it, "y")) return FAIL(r, "%s: %s.y: missing (a 3D probe's point is x, y, z)", r->origin, path);
-    }
+    if (md->kind == MONITOR_PROFILE)
+        return FAIL(r, "%s: %s: a profile monitor is 2D only (in 3D: max_elevation over a region with x and y "
+                       "ranges, pressure_probe at a point, wall_pressure, kinetic_energy, front, wall_work)", r->origin, path);
+    if (md->kind == MONITOR_PRESSURE_PROBE && !item(it, "y"))
+        return FAIL(r, "%s: %s.y: missing (a 3D probe's point is x, y, z)", r->origin, path);
     if (md->kind == MONITOR_WAVE_GAUGE && !item(it, "y"))
         return FAIL(r, "%s: %s.y: missing (a 3D wave gauge's station is x, y)", r->origin, path);
     if (!(md->y_max > md->y_min)) return FAIL(r, "%s: %s: expected y_min < y_max", r->origin, path);

@@ -35,9 +35,8 @@
  * folder is set.
  * A monitor's region, point and bins are case input in x and z (and y in 3D): compared with
  * components 0 (x), DIM_UP (z) and, in 3D, 1 (y) of the particles' positions. In 3D a region is a
- * box (y_min..y_max, every y by default) and a probe's point is (x, y, z) in the flow; profile and
- * wall_pressure (x bins of a section, the pressure along a wall's polyline) are 2D only, which the
- * case reader says (io/case.c). */
+ * box (y_min..y_max, every y by default) and a probe's point is (x, y, z); a profile (x bins of a
+ * section) is 2D only, which the case reader says (io/case.c). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>

@@ -307,15 +307,28 @@ static long walls_generate_lattice(const struct walls *W, double dx, const mixsp
 }
 #else /* DIM == 3: the lattice sites behind each wall's surface */
 
-/* Whether pos lies behind a fixed wall before w, within the layers' depth: among fixed walls a
- * site is filled once. At t = 0 a wall's frame is the case's. */
-static int behind_earlier_fixed_wall(const struct walls *W, size_t w, const double pos[3], double depth)
+/* Whether the lattice site pos, at signed distance d from a wall's surface whose nearest point is
+ * `at`, is one of that wall's particles: behind the surface within the layers' depth, or in
+ * front of it where the wall blocks the bodies' sites (walls_site_blocked). Without the second
+ * part a surface lying up to dx/2 in front of a lattice plane left an empty layer between the
+ * wall's particles and the water's (a whole one where the surface is a lattice plane): the
+ * water moved into it, onto the surface, where the crossing guard put particles back every step
+ * and lined them up along the edges, and they merged there (docs/validation/spheric_test2.md). */
+static int wall_site(double d, const struct surface_point *at, double depth, double dx)
+{
+    return d >= -depth && (d < 0.0 || walls_site_blocked(d, at->at_boundary, dx));
+}
+
+/* Whether pos is a site of a fixed wall before w: among fixed walls a site is filled once. At
+ * t = 0 a wall's frame is the case's. */
+static int behind_earlier_fixed_wall(const struct walls *W, size_t w, const double pos[3], double depth, double dx)
 {
     if (W->def[w].motion >= 0) return 0;
     for (size_t v = 0; v < w; v++) {
         if (W->def[v].motion >= 0) continue;
-        const double d = surface_signed_distance(&W->def[v].surface, pos, NULL);
-        if (d < 0.0 && d >= -depth) return 1;
+        struct surface_point at;
+        const double d = surface_signed_distance(&W->def[v].surface, pos, &at);
+        if (wall_site(d, &at, depth, dx)) return 1;
     }
     return 0;
 }
@@ -363,7 +376,8 @@ static void sites_in(double b0, double b1, double off, double dx, long *first, l
 }
 
 /* Every lattice site (i + 1/2) dx, (j + 1/2) dx, z_off + (k + 1/2) dx within the layers' depth
- * behind a wall's surface (-depth <= d < 0, d the signed distance), bucket by bucket of its
+ * behind a wall's surface (-depth <= d < 0, d the signed distance) or blocked for the bodies in
+ * front of it (wall_site), bucket by bucket of its
  * grid near the surface. Beyond an open edge the rule keeps the sites behind the edge's face
  * within depth of the edge (a quarter cylinder), so two surfaces meeting at an edge (a flume's
  * bed and its side walls) leave no gap between their layers. */
@@ -398,8 +412,9 @@ static long walls_generate_lattice(const struct walls *W, double dx, const mixsp
                         for (long j = first[1]; j < end[1]; j++)
                             for (long i = first[0]; i < end[0]; i++) {
                                 const double pos[3] = {(i + 0.5) * dx, (j + 0.5) * dx, z_off + (k + 0.5) * dx};
-                                const double d = surface_signed_distance(s, pos, NULL);
-                                if (!(d < 0.0) || d < -depth || behind_earlier_fixed_wall(W, w, pos, depth)) continue;
+                                struct surface_point at;
+                                const double d = surface_signed_distance(s, pos, &at);
+                                if (!wall_site(d, &at, depth, dx) || behind_earlier_fixed_wall(W, w, pos, depth, dx)) continue;
                                 const size_t p = particles_push(P, pos, 1000.0, 0.0, (uint8_t)w, MIXSPH_STATE_WALL);
                                 if (p == (size_t)-1) {
                                     free(near);

@@ -69,9 +69,20 @@ void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const
  *  they start with their wall's velocity. Polls `interrupt` (may be NULL) at every lattice row,
  *  or every segment when aligned. Returns the number added, -1 when out of memory,
  *  WALLS_INTERRUPTED when the host asked to stop, WALLS_NOT_IN_3D for the aligned placement in 3D. In 3D a wall's particles are the
- *  lattice sites within the layers' depth behind its surface (and behind its open edges). */
+ *  lattice sites within the layers' depth behind its surface (and behind its open edges) and those
+ *  in front of it that it blocks for the bodies (walls_site_blocked). */
 long walls_generate(const struct walls *W, double dx, const mixsph_interrupt *interrupt,
                     struct particles *P);
+
+/** Whether a lattice site at signed distance d [m] from a wall's surface (d < 0 behind it; at_end:
+ *  its nearest point on an open edge) is too close to the wall to hold a body's particle: within
+ *  dx/2 in front of the surface, or behind it. In 3D the wall's own particles take the sites it
+ *  blocks within its layers' depth (walls_generate), so that the bodies' lattice and the wall's
+ *  meet with no empty layer between them (docs/model.md section 8). */
+static inline int walls_site_blocked(double d, int at_end, double dx)
+{
+    return !at_end && d < 0.5 * dx * (1.0 - 1e-9);
+}
 
 /** Signed distance of pos to wall w at its current position (< 0 behind it) [m], and whether the
  *  closest point is an end of the polyline (3D: on an open edge of the surface). */
