@@ -182,8 +182,10 @@ static void test_parse_errors(void **state)
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0, "
                  "\"saturated\": true, \"pore_fluid\": \"water\", \"mu_thr\": 320e3 }",
                  "media.sand.pore_fluid");
-    /* no threshold viscosity at all; both K and c; a key of fluids only */
-    expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 35.0 }",
+    /* the paper's law named without a threshold viscosity (a medium naming no law and giving
+     * none runs the elastic-plastic law: test_case); both K and c; a key of fluids only */
+    expect_error("\"sand\": { \"type\": \"granular\", \"law\": \"paper\", \"rho\": 2650.0, \"K\": 4.24e6, "
+                 "\"porosity\": 0.35, \"phi\": 35.0 }",
                  "mu_thr");
     expect_error("\"sand\": { \"type\": \"granular\", \"rho\": 2650.0, \"K\": 4.24e6, \"c\": 40.0, \"porosity\": 0.35, "
                  "\"phi\": 35.0, \"mu_thr\": 320e3 }",
