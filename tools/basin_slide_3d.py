@@ -174,7 +174,7 @@ def run_case(run, mixsph, threads):
     with open(log, "w") as f:
         rc = subprocess.run(cmd, stdout=f, stderr=subprocess.STDOUT).returncode
     if rc != 0:
-        raise ToolError(f"{' '.join(cmd)} failed ({rc}):\n{tail(log)}", 1)
+        raise ToolError(f"{' '.join(cmd)} failed ({rc}); the end of {log}:\n" + "\n".join(tail(log)), 1)
 
 
 def run_case_json(run):
