@@ -29,7 +29,7 @@ wave height of two empirical 3D relations, evaluated at each gauge (r, gamma the
   Heller, Hager & Minor (2009, VAW Mitteilung 211, the 3D propagation equation)
       H / h = (3/2) P^(4/5) cos^2(2 gamma / 3) (r / h)^(-2/3),
       P = F S^(1/2) M^(1/4) cos(6 alpha / 7)^(1/2) (tools/impulse_waves.py's impulse_product);
-  Huber & Hager (1997, J. Hydraul. Res. 35(4))
+  Huber & Hager (1997, "Forecasting impulse waves in reservoirs", 19th ICOLD Congress, C31)
       H / h = 0.88 sin(alpha) cos^2(2 gamma / 3) (rho_s / rho_w)^(1/4) (V / (b h^2))^(1/2) (r / h)^(-2/3).
 Both are as recalled (the sources were not readable here; the first matches a public code's
 transcription): docs/validation/basin_slide_3d.md says so beside the numbers.
