@@ -325,13 +325,13 @@ static double single_grain(double x, double z, double dx, double rho_s, const ch
 
 #define SATURATED ", \"saturated\": true, \"pore_fluid\": \"water\""
 
-/* Ergun's terminal slip [m/s] of a parcel of grains of mixture density rho_mix in still water,
- * (rho_mix - rho_w) g = beta(u) u with beta of docs/model.md [GW] (n = POR, d = 2 mm, mu_w = 1e-3 Pa s). */
-static double ergun_terminal_slip(double rho_mix)
+/* Ergun's terminal slip [m/s] of a parcel of grains in still water whose submerged weight per unit
+ * volume is `load` [N/m3]: load = beta(u) u with beta of docs/model.md [GW] (n = POR, d = 2 mm,
+ * mu_w = 1e-3 Pa s). */
+static double ergun_terminal_slip(double load)
 {
     const double d = 0.002, mu = 1.0e-3;
     const double a = 150.0 * (1.0 - POR) * (1.0 - POR) * mu / (POR * d * d), b = 1.75 * (1.0 - POR) * RHO_W / d;
-    const double load = (rho_mix - RHO_W) * G_ACC;
     return (-a + sqrt(a * a + 4.0 * b * load)) / (2.0 * b);
 }
 
@@ -358,11 +358,12 @@ static void test_grains_in_water_short(void **state)
     double vz = NAN;
     const struct {
         const char *what, *extra;
-        double rho_mix;
-    } sinking[] = {{"saturated", GRAINS_IN_WATER SATURATED, POR * RHO_W + (1.0 - POR) * RHO_S},
-                   {"dry", GRAINS_IN_WATER, (1.0 - POR) * RHO_S}};
+        double rho_mix, load;
+    } sinking[] = {{"saturated", GRAINS_IN_WATER SATURATED, POR * RHO_W + (1.0 - POR) * RHO_S,
+                    (POR * RHO_W + (1.0 - POR) * RHO_S - RHO_W) * G_ACC},
+                   {"dry", GRAINS_IN_WATER, (1.0 - POR) * RHO_S, (1.0 - POR) * (RHO_S - RHO_W) * G_ACC}};
     for (int k = 0; k < 2; k++) {
-        const double u_t = ergun_terminal_slip(sinking[k].rho_mix);
+        const double u_t = ergun_terminal_slip(sinking[k].load);
         const double descent = z_top - single_grain(x, z_top, dx, RHO_S, sinking[k].extra, t, &vz);
         print_message("%s grain (%.0f kg/m3) from the top row: down %.4f m after %.1f s (%.2f u_t t, u_t = %.4f m/s)\n",
                       sinking[k].what, sinking[k].rho_mix, descent, t, descent / (u_t * t), u_t);

@@ -93,7 +93,9 @@ enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_
 
 /* The per-particle arrays of the grains in water (docs/model.md [GW]; params.grains_in_water): each
  * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, a
- * grain's Ergun factors (granular.h) and its parcel's volume m / rho0. */
+ * grain's Ergun factors (granular.h), its parcel's volume m / rho0 and the fraction of that volume
+ * its solids take from the water (1 - n dry, 1 saturated: the parcel then carries its pore water;
+ * 1 for every other particle). */
 enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_VOLUME, GW_SOLID, GW_ARRAYS };
 #define GRAIN_ROLE_FLUID (-1.0) /* a particle of a LAW_FLUID medium */
 #define GRAIN_ROLE_GRAIN 1.0    /* a particle of a LAW_GRAINS_IN_WATER medium; 0: any other (walls) */
@@ -150,7 +152,6 @@ struct pair_ctx {
     double *group_w;           /* and its sums, 5 per group */
     double *gw[GW_ARRAYS];     /* the grains in water (struct forces), or NULL: none */
     double p_background;       /* the water's pressure at a free surface [Pa] (the grains in water) */
-    int gw_design;             /* EXPERIMENT (sinkdx): 0 base, 1 continuity (1-n), 2 + pressure volume, 3 + difference form */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -185,8 +186,6 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->group_w = NULL;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = NULL;
     X->p_background = fp->p_background;
-    const char *design = getenv("MIXSPH_GW_DESIGN");
-    X->gw_design = design ? atoi(design) : 0;
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -229,7 +228,8 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * difference. psi_ji = -psi_ij, so sum_i V_i e_i = 0: the diffusion moves density between
  * particles and creates none. With `grains` (docs/model.md [GW]) a grain in water takes no
  * density rate from its fluid neighbours: water flowing past or through a parcel of grains does
- * not pack them (the fluid's rate keeps the grains: they take room from it). */
+ * not pack them; the fluid's rate counts a grain by the volume its solids take from the water
+ * (GW_SOLID): the rest of the parcel is pore space the water flows through. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                     const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
@@ -473,7 +473,8 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
  * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
  * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). With `grains` a pair of a
  * grain in water and a fluid particle is that of docs/model.md [GW]: the grain's pressure in it is
- * the water's interpolated at the grain (water_pressure_range), it carries no deviatoric stress,
+ * the water's interpolated at the grain (water_pressure_range) acting on the volume of the
+ * parcel's solids (GW_SOLID times m / rho0), it carries no deviatoric stress,
  * and Ergun's drag c_ij (u_i - u_j), c_ij = beta V_i V_j W_ij, beta the grain's (granular.h) with
  * the fluid particle's mu and rho and the pair's slip |u_i - u_j|, acts between them (in the
  * implicit couplings w_ij with `implicit`). Every term stays a pair force, added to i and
@@ -524,7 +525,6 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double vol0_i = grains ? vol0[i] : 0.0;
     const double *restrict solid = grains ? X->gw[GW_SOLID] : NULL;
     const double solid_i = grains ? solid[i] : 1.0;
-    const int design = X->gw_design;
     const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
 #if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
@@ -565,11 +565,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 pi_pair = gi > 0.0 ? p_water_i : pi;
                 pj_pair = gj > 0.0 ? p_water[j] : p[j];
                 vv_pair = gi > 0.0 ? vol0_i * vol[j] : gj > 0.0 ? voli * vol0[j] : vv;
-                vv_press = design >= 2 ? vv_pair * (gi > 0.0 ? solid_i : gj > 0.0 ? solid[j] : 1.0) : vv_pair;
-                if (design == 3) { /* difference form: the grain takes -V grad p, no contact push */
-                    pi_pair = gi > 0.0 ? -p_water_i : gj > 0.0 ? pi : pi_pair;
-                    pj_pair = gj > 0.0 ? -p_water[j] : gi > 0.0 ? p[j] : pj_pair;
-                }
+                /* the pressure acts on the volume the parcel's solids take from the water */
+                vv_press = vv_pair * (gi > 0.0 ? solid_i : gj > 0.0 ? solid[j] : 1.0);
             }
             double fr = -vv_press * (pi_pair + pj_pair);
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
@@ -1111,8 +1108,6 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
     const struct particles *P = S->P;
     double *role = F->gw[GW_ROLE], *dv = F->gw[GW_DRAG_VISCOUS], *dr = F->gw[GW_DRAG_INERTIAL];
     double *vol0 = F->gw[GW_VOLUME], *solid = F->gw[GW_SOLID];
-    const char *design = getenv("MIXSPH_GW_DESIGN");
-    const int weighted = design && atoi(design) >= 1;
     for (size_t i = 0; i < n; i++) {
         const struct medium *m = &S->media[P->medium[i]];
         const int wall = P->state[i] == MIXSPH_STATE_WALL;
@@ -1121,7 +1116,7 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
         dv[i] = grain ? m->granular.drag_viscous : 0.0;
         dr[i] = grain ? m->granular.drag_inertial : 0.0;
         vol0[i] = grain ? P->m[i] / m->rho0 : 0.0;
-        solid[i] = grain && weighted && !m->granular.saturated ? 1.0 - m->granular.porosity : 1.0;
+        solid[i] = grain && !m->granular.saturated ? 1.0 - m->granular.porosity : 1.0;
     }
     for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = vol0[i] = 0.0, solid[i] = 1.0;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = F->gw[q];
