@@ -338,13 +338,15 @@ static double ergun_terminal_slip(double load)
 /* (e) Grains in water (water_coupling "grains", docs/model.md [GW]), one grain particle of the
  * gravel (d = 2 mm) in the tank at dx = 0.02 (0.5 s; the four runs about 5 s on one thread):
  * - released in the water's top row it sinks, saturated (mixture density 1990 kg/m3, twice the
- *   water's) and dry (1590 kg/m3). Reference: Ergun's terminal slip u_t of the parcel
- *   (ergun_terminal_slip: 0.108 and 0.078 m/s); its descent after t = 0.5 s within
+ *   water's) and dry (1590 kg/m3). Reference: Ergun's terminal slip u_t of the parcel under its
+ *   buoyant weight (1 - n)(rho_s - rho_w) g, the same for both ([GW-S]: the water counts a dry
+ *   parcel by its solids' volume; ergun_terminal_slip: 0.108 m/s); its descent after t = 0.5 s within
  *   [0.4, 1.5] u_t t: the lower factor for the start from rest and the water's numerical viscosity
  *   (its artificial viscosity, as the flow around one particle sees it: docs/validation/
  *   slide_flume.md, "Why single grains ride the surface"), the upper for the kernel's share of
  *   the water around a lone grain, 0.73 of a full support (the drag is beta times it, u up to
- *   1.3 u_t). Measured 12-07: 0.0459 m (0.85 u_t t) saturated, 0.0240 m (0.62 u_t t) dry. The
+ *   1.3 u_t). Measured 12-07: 0.0459 m (0.85 u_t t) saturated, 0.0550 m (1.02 u_t t) dry (0.0240 m
+ *   before [GW-S], when the dry parcel's buoyancy was its whole volume's and u_t 0.078 m/s). The
  *   water_coupling "mixture" grain in the same place goes down 0.011 m (saturated; 0.2 u_t t) and
  *   lies on the water (test (d), the known failure, at dx = 0.01).
  * - saturated, on the floor (the bottom row), it stays: within 0.1 dx over 0.5 s (the bed holds
