@@ -290,8 +290,9 @@ static void test_surface_grain_sinks(void **state)
 
 /* One grain particle at the lattice site of spacing dx centred at (x, z), its grains of density
  * rho_s, released at rest: its height [m] and vertical velocity [m/s] after t_end (printed every
- * 0.1 s). */
-static double single_grain(double x, double z, double dx, double rho_s, const char *extra, double t_end, double *vz)
+ * 0.1 s; z_at, unless NULL, receives the height at t = 0.1 k, k = 1 .. t_end / 0.1). */
+static double single_grain_heights(double x, double z, double dx, double rho_s, const char *extra, double t_end,
+                                   double *vz, double *z_at)
 {
     const mixsph_override ov[] = {{"numerics.dx", dx}, {"media.gravel.rho", rho_s}};
     mixsph_sim *s = NULL;
@@ -317,10 +318,16 @@ static double single_grain(double x, double z, double dx, double rho_s, const ch
                 grains++;
             }
         print_message("    t = %.1f s: z = %.4f m, vz = %.4f m/s\n", mixsph_sim_time(s), zg, *vz);
+        if (z_at) z_at[k - 1] = zg;
     }
     assert_int_equal(grains, 1);
     mixsph_sim_destroy(s);
     return zg;
+}
+
+static double single_grain(double x, double z, double dx, double rho_s, const char *extra, double t_end, double *vz)
+{
+    return single_grain_heights(x, z, dx, rho_s, extra, t_end, vz, NULL);
 }
 
 #define SATURATED ", \"saturated\": true, \"pore_fluid\": \"water\""
@@ -383,6 +390,34 @@ static void test_grains_in_water_short(void **state)
     assert_true(fabs(z_neutral - z_mid) <= 0.05 * dx);
 }
 
+/* (f) A dry grain sinks as fast at every spacing (issue 59 criterion 5 at dx and dx/2 asks it of the
+ * grains a splash leaves in the water column; docs/validation/grains_settle.md, "Designs for grains
+ * that sink at every spacing"): one grain particle of the dry gravel (d = 2 mm) released at rest
+ * at mid-depth, centred at (0.2 + dx/2, 0.2 + dx/2), at dx = 0.02, 0.01 and 0.005; its mean speed
+ * over 0.1-0.4 s. Reference: Ergun's terminal slip u_t = 0.108 m/s of test (e), which does not
+ * depend on dx; the criterion: the speed at dx = 0.005 at least 0.9 of that at dx = 0.02. NOT MET
+ * (12-07): with [GW-S] 0.110 / 0.087 / 0.057 m/s (1.03 / 0.81 / 0.53 u_t), the ratio 0.518 (the
+ * water still flows around a body one particle across, against its artificial viscosity, which is
+ * proportional to dx; with d = 4 mm 0.51, and 0.10 before [GW-S]); a known failure with today's
+ * band 0.45-0.60. Validation suite (45 s on one thread). */
+static void test_grain_sinks_at_every_spacing(void **state)
+{
+    (void)state;
+    const double dxs[] = {0.02, 0.01, 0.005};
+    double speed[3];
+    for (int k = 0; k < 3; k++) {
+        const double dx = dxs[k], c = 0.2 + 0.5 * dx;
+        double vz, z_at[4];
+        single_grain_heights(c, c, dx, RHO_S, GRAINS_IN_WATER, 0.4, &vz, z_at);
+        speed[k] = (z_at[0] - z_at[3]) / 0.3;
+        print_message("dx = %.3f: the dry grain sinks at %.4f m/s over 0.1-0.4 s (%.2f u_t)\n", dx, speed[k],
+                      speed[k] / ergun_terminal_slip((1.0 - POR) * (RHO_S - RHO_W) * G_ACC));
+    }
+    const double ratio = speed[2] / speed[0];
+    known_failure_check("a dry grain's sinking speed at dx = 0.005 over that at dx = 0.02", ratio >= 0.9, ratio, 0.45,
+                        0.60);
+}
+
 /* `test_settling` runs the tests the model meets; `test_settling known_failure surface_grain` the
  * criterion it does not meet yet (a test of its own in CTest). */
 int main(int argc, char **argv)
@@ -397,7 +432,8 @@ int main(int argc, char **argv)
     }
     if (argc > 1 && strcmp(argv[1], "validation") == 0) {
         /* the long version (CTest test_settling_validation, label validation: ./tools/do validate) */
-        const struct CMUnitTest long_tests[] = {cmocka_unit_test(test_block_sinks)};
+        const struct CMUnitTest long_tests[] = {cmocka_unit_test(test_block_sinks),
+                                                cmocka_unit_test(test_grain_sinks_at_every_spacing)};
         return cmocka_run_group_tests(long_tests, NULL, NULL);
     }
     const struct CMUnitTest tests[] = {
