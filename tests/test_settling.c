@@ -353,7 +353,10 @@ static double ergun_terminal_slip(double load)
  *   slide_flume.md, "Why single grains ride the surface"), the upper for the kernel's share of
  *   the water around a lone grain, 0.73 of a full support (the drag is beta times it, u up to
  *   1.3 u_t). Measured 12-07: 0.0459 m (0.85 u_t t) saturated, 0.0550 m (1.02 u_t t) dry (0.0240 m
- *   before [GW-S], when the dry parcel's buoyancy was its whole volume's and u_t 0.078 m/s). The
+ *   before [GW-S], when the dry parcel's buoyancy was its whole volume's and u_t 0.078 m/s). The dry
+ *   grain goes down at least as far as the saturated one: the same buoyant weight and drag, less
+ *   inertia (its mass lacks the pore water's), and it takes from the water only its solids'
+ *   volume (this fails without [GW-S]: 0.0240 against 0.0459 m). The
  *   water_coupling "mixture" grain in the same place goes down 0.011 m (saturated; 0.2 u_t t) and
  *   lies on the water (test (d), the known failure, at dx = 0.01).
  * - saturated, on the floor (the bottom row), it stays: within 0.1 dx over 0.5 s (the bed holds
@@ -371,15 +374,18 @@ static void test_grains_in_water_short(void **state)
     } sinking[] = {{"saturated", GRAINS_IN_WATER SATURATED, POR * RHO_W + (1.0 - POR) * RHO_S,
                     (POR * RHO_W + (1.0 - POR) * RHO_S - RHO_W) * G_ACC},
                    {"dry", GRAINS_IN_WATER, (1.0 - POR) * RHO_S, (1.0 - POR) * (RHO_S - RHO_W) * G_ACC}};
+    double descent_of[2];
     for (int k = 0; k < 2; k++) {
         const double u_t = ergun_terminal_slip(sinking[k].load);
         const double descent = z_top - single_grain(x, z_top, dx, RHO_S, sinking[k].extra, t, &vz);
+        descent_of[k] = descent;
         print_message("%s grain (%.0f kg/m3) from the top row: down %.4f m after %.1f s (%.2f u_t t, u_t = %.4f m/s)\n",
                       sinking[k].what, sinking[k].rho_mix, descent, t, descent / (u_t * t), u_t);
         assert_true(descent >= 0.4 * u_t * t);
         assert_true(descent <= 1.5 * u_t * t);
         assert_true(vz < 0.0);
     }
+    assert_true(descent_of[1] >= descent_of[0]); /* the dry parcel: the same buoyant weight, less inertia */
     const double z_bed = 0.5 * dx;
     const double z_rest = single_grain(x, z_bed, dx, RHO_S, GRAINS_IN_WATER SATURATED, t, &vz);
     print_message("saturated grain on the floor: moved %.5f m in %.1f s\n", z_rest - z_bed, t);
