@@ -93,8 +93,10 @@ enum { WALL_F = 0, WALL_N = DIM, WALL_Q_GIVEN = 2 * DIM, WALL_QMU_GIVEN, WALL_Q_
 
 /* The per-particle arrays of the grains in water (docs/model.md [GW]; params.grains_in_water): each
  * particle's role (GRAIN_ROLE_*), the water's pressure interpolated at a grain and its two sums, a
- * grain's Ergun factors (granular.h) and its parcel's volume m / rho0. */
-enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_VOLUME, GW_ARRAYS };
+ * grain's Ergun factors (granular.h), its parcel's volume m / rho0 and the fraction of that volume
+ * its solids take from the water (1 - n dry, 1 saturated: the parcel then carries its pore water;
+ * 1 for every other particle). */
+enum { GW_ROLE = 0, GW_PRESSURE, GW_SUM, GW_WEIGHT, GW_DRAG_VISCOUS, GW_DRAG_INERTIAL, GW_VOLUME, GW_SOLID, GW_ARRAYS };
 #define GRAIN_ROLE_FLUID (-1.0) /* a particle of a LAW_FLUID medium */
 #define GRAIN_ROLE_GRAIN 1.0    /* a particle of a LAW_GRAINS_IN_WATER medium; 0: any other (walls) */
 
@@ -226,7 +228,8 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * difference. psi_ji = -psi_ij, so sum_i V_i e_i = 0: the diffusion moves density between
  * particles and creates none. With `grains` (docs/model.md [GW]) a grain in water takes no
  * density rate from its fluid neighbours: water flowing past or through a parcel of grains does
- * not pack them (the fluid's rate keeps the grains: they take room from it). */
+ * not pack them; the fluid's rate counts a grain by the volume its solids take from the water
+ * (GW_SOLID): the rest of the parcel is pore space the water flows through. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                     const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
@@ -247,6 +250,8 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
     const double fluid_i = ti >= 0.0 ? 1.0 : 0.0;
     const double *restrict role = grains ? X->gw[GW_ROLE] : NULL;
     const double role_i = grains ? role[i] : 0.0;
+    const double *restrict solid = grains ? X->gw[GW_SOLID] : NULL;
+    const double solid_i = grains ? solid[i] : 1.0;
     double acc[FORCES_CHUNK] = {0}, cnt[FORCES_CHUNK] = {0}, dif[FORCES_CHUNK] = {0};
     FORCES_FOR_EACH_CHUNK(rng, nr, jb, m) {
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK], ej[FORCES_CHUNK];
@@ -269,8 +274,8 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             if (grains) { /* a grain's side of a grain-fluid pair drops out */
                 const double keep_i = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
                 const double keep_j = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
-                acc[k] += keep_i * vol[j] * uf;
-                dj[k] = keep_j * voli * uf;
+                acc[k] += keep_i * (role_i == GRAIN_ROLE_FLUID ? solid[j] : 1.0) * vol[j] * uf;
+                dj[k] = keep_j * (role[j] == GRAIN_ROLE_FLUID ? solid_i : 1.0) * voli * uf;
             } else {
                 acc[k] += vol[j] * uf;
                 dj[k] = voli * uf;
@@ -468,7 +473,8 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
  * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
  * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). With `grains` a pair of a
  * grain in water and a fluid particle is that of docs/model.md [GW]: the grain's pressure in it is
- * the water's interpolated at the grain (water_pressure_range), it carries no deviatoric stress,
+ * the water's interpolated at the grain (water_pressure_range) acting on the volume of the
+ * parcel's solids (GW_SOLID times m / rho0), it carries no deviatoric stress,
  * and Ergun's drag c_ij (u_i - u_j), c_ij = beta V_i V_j W_ij, beta the grain's (granular.h) with
  * the fluid particle's mu and rho and the pair's slip |u_i - u_j|, acts between them (in the
  * implicit couplings w_ij with `implicit`). Every term stays a pair force, added to i and
@@ -517,6 +523,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict vol0 = grains ? X->gw[GW_VOLUME] : NULL;
     const double role_i = grains ? role[i] : 0.0, p_water_i = grains ? p_water[i] : 0.0;
     const double vol0_i = grains ? vol0[i] : 0.0;
+    const double *restrict solid = grains ? X->gw[GW_SOLID] : NULL;
+    const double solid_i = grains ? solid[i] : 1.0;
     const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
 #if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
@@ -550,15 +558,17 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             const double inv_r2e = inv_d * mus;
             const double vv = voli * vol[j] * (1.0 - walli * wallj); /* wall-wall pairs vanish */
             /* pressure; a grain in water takes the water's (gi: i is the grain, gj: j is) */
-            double gi = 0.0, gj = 0.0, pi_pair = pi, pj_pair = p[j], vv_pair = vv;
+            double gi = 0.0, gj = 0.0, pi_pair = pi, pj_pair = p[j], vv_pair = vv, vv_press = vv;
             if (grains) { /* and the grain's parcel volume m / rho0, however loose its packing */
                 gi = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
                 gj = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 1.0 : 0.0;
                 pi_pair = gi > 0.0 ? p_water_i : pi;
                 pj_pair = gj > 0.0 ? p_water[j] : p[j];
                 vv_pair = gi > 0.0 ? vol0_i * vol[j] : gj > 0.0 ? voli * vol0[j] : vv;
+                /* the pressure acts on the volume the parcel's solids take from the water */
+                vv_press = vv_pair * (gi > 0.0 ? solid_i : gj > 0.0 ? solid[j] : 1.0);
             }
-            double fr = -vv_pair * (pi_pair + pj_pair);
+            double fr = -vv_press * (pi_pair + pj_pair);
             /* artificial viscosity: approaching pairs (all pairs with av_separating) of one
              * medium (any two media with av_mixed), or of a particle and a wall (with av_wall);
              * avc is 0 for a medium without it */
@@ -1097,7 +1107,7 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
 {
     const struct particles *P = S->P;
     double *role = F->gw[GW_ROLE], *dv = F->gw[GW_DRAG_VISCOUS], *dr = F->gw[GW_DRAG_INERTIAL];
-    double *vol0 = F->gw[GW_VOLUME];
+    double *vol0 = F->gw[GW_VOLUME], *solid = F->gw[GW_SOLID];
     for (size_t i = 0; i < n; i++) {
         const struct medium *m = &S->media[P->medium[i]];
         const int wall = P->state[i] == MIXSPH_STATE_WALL;
@@ -1106,8 +1116,9 @@ static void grains_in_water_roles(struct forces *F, const struct pair_system *S,
         dv[i] = grain ? m->granular.drag_viscous : 0.0;
         dr[i] = grain ? m->granular.drag_inertial : 0.0;
         vol0[i] = grain ? P->m[i] / m->rho0 : 0.0;
+        solid[i] = grain && !m->granular.saturated ? 1.0 - m->granular.porosity : 1.0;
     }
-    for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = vol0[i] = 0.0;
+    for (size_t i = n; i < n + FORCES_CHUNK; i++) role[i] = dv[i] = dr[i] = vol0[i] = 0.0, solid[i] = 1.0;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = F->gw[q];
 }
 
