@@ -629,7 +629,7 @@ mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj
             return MIXSPH_OK;
         }
         for (const cJSON *e = it->child; e; e = e->next) { /* each name's number in the range; case.c the names */
-            char ep[256];
+            char ep[512]; /* kp, a dot and the name */
             key_path(ep, sizeof ep, kp, e->string);
             if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
                 return FAIL(r, "%s: %s: expected a number", r->origin, ep);
