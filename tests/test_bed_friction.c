@@ -140,14 +140,15 @@ static void test_short_block_paper(void **state)
 }
 
 /* Two blocks of dry sand (phi 35, elastic-plastic) on one 45-degree ramp whose friction names each
- * medium (walls.ramp.friction = {"lower": 20, "upper": 30}): the lower block, s 0.8 to 1.2 along the
- * ramp, of medium "lower", the upper one, s 0 to 0.4, of medium "upper" (it slides slower, so the
- * two part); both 0.2 m thick, as cases/coulomb_block.json's block. */
+ * medium (walls.ramp.friction = {"lower": 20, "upper": 30}): the lower block, s 0.6 to 0.9 along the
+ * ramp, of medium "lower", the upper one, s 0 to 0.3, of medium "upper" (it slides slower, so the
+ * two part); both 0.1 m thick, on a ramp from s = -0.15 to 2.4 (cases/coulomb_block.json's block and
+ * ramp shortened, for the test's time). */
 static char *two_block_case(double dx, double t_end)
 {
     const double c = cos(45.0 * GEOM_PI / 180.0), sn = sin(45.0 * GEOM_PI / 180.0);
     double x[2][4], z[2][4];
-    const double s0[2] = {0.8, 0.0}, corner_s[4] = {0.0, 0.4, 0.4, 0.0}, corner_d[4] = {0.0, 0.0, 0.2, 0.2};
+    const double s0[2] = {0.6, 0.0}, corner_s[4] = {0.0, 0.3, 0.3, 0.0}, corner_d[4] = {0.0, 0.0, 0.1, 0.1};
     for (int b = 0; b < 2; b++)
         for (int k = 0; k < 4; k++) {
             const double s = s0[b] + corner_s[k], d = corner_d[k];
@@ -168,11 +169,11 @@ static char *two_block_case(double dx, double t_end)
              "    \"upper_block\": { \"medium\": \"upper\", \"polygon\": [[%.9f, %.9f], [%.9f, %.9f], [%.9f, %.9f], [%.9f, %.9f]] } },\n"
              "  \"walls\": { \"ramp\": { \"polyline\": [[%.9f, %.9f], [%.9f, %.9f]], \"fluid_side\": \"left\",\n"
              "             \"slip\": \"no-slip\", \"friction\": { \"lower\": 20, \"upper\": 30 } } },\n"
-             "  \"domain\": { \"x_min\": -0.3, \"x_max\": 3.0, \"z_min\": -2.6, \"z_max\": 0.45 },\n"
+             "  \"domain\": { \"x_min\": -0.3, \"x_max\": 2.0, \"z_min\": -1.9, \"z_max\": 0.45 },\n"
              "  \"output\": { \"monitor_interval\": 0.01 } }\n",
              dx, t_end, medium, medium, x[0][0], z[0][0], x[0][1], z[0][1], x[0][2], z[0][2], x[0][3], z[0][3],
-             x[1][0], z[1][0], x[1][1], z[1][1], x[1][2], z[1][2], x[1][3], z[1][3], -0.15 * c, 0.15 * sn, 3.5 * c,
-             -3.5 * sn);
+             x[1][0], z[1][0], x[1][1], z[1][1], x[1][2], z[1][2], x[1][3], z[1][3], -0.15 * c, 0.15 * sn, 2.4 * c,
+             -2.4 * sn);
     return text;
 }
 
