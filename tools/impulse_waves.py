@@ -92,12 +92,12 @@ def scenario_case(base, speed, thickness, depth, t_end):
     return c
 
 
-def impulse_product(v_s, s, m, h):
-    """P of Heller & Hager (2010), per unit width."""
+def impulse_product(v_s, s, m, h, alpha=ALPHA):
+    """P of Heller & Hager (2010): m the slide's mass per unit width, alpha its slope [deg]."""
     F = v_s / math.sqrt(G * h)
     S = s / h
     M = m / (RHO_W * h * h)
-    return F * math.sqrt(S) * M ** 0.25 * math.sqrt(math.cos(math.radians(6.0 * ALPHA / 7.0)))
+    return F * math.sqrt(S) * M ** 0.25 * math.sqrt(math.cos(math.radians(6.0 * alpha / 7.0)))
 
 
 def run_one(a, name, dx):
