@@ -47,6 +47,7 @@ static const char *type_text(const struct case_key *k)
     case CASE_NUMBERS: return "array of numbers";
     case CASE_POINTS: return "array of [x, z]";
     case CASE_OBJECT: return "object";
+    case CASE_NUMBER_BY_NAME: return "number, or object of numbers by name";
     }
     return "";
 }

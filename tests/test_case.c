@@ -995,6 +995,55 @@ static void test_wall_forms_in_2d(void **state)
                       ORIGIN ": walls.tank.open_faces: a polyline wall does not take this key (only box)");
 }
 
+/* A wall's friction per medium (walls.<name>.friction as an object, docs/cases.md): the media it
+ * names take theirs, the others the default (NaN: the grains' own phi); the number form gives every
+ * medium its value. Refused with the key and why: a name that is no medium, a medium that takes no
+ * bed friction (a fluid), a value out of range or not a number, neither a number nor an object. */
+static void test_wall_friction_per_medium(void **state)
+{
+    (void)state;
+    struct case_def c;
+    char err[512] = "";
+    const char *tank_end = "\"fluid_side\": \"left\" },";
+    char *sand = with_sand("");
+    char *j = edit_text(sand, tank_end, "\"fluid_side\": \"left\", \"friction\": { \"sand\": 25 } },");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(isnan(c.walls[0].friction_deg));
+    assert_true(isnan(c.walls[0].friction_of_medium_deg[0]) && c.walls[0].friction_of_medium_deg[1] == 25.0);
+    assert_true(isnan(c.walls[1].friction_of_medium_deg[1])); /* the paddle names none */
+    case_free(&c);
+    const mixsph_override named = {"walls.tank.friction.sand", 28.0};
+    assert_int_equal(case_parse(j, ORIGIN, &named, 1, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.walls[0].friction_of_medium_deg[1] == 28.0);
+    case_free(&c);
+    free(j);
+    j = edit_text(sand, tank_end, "\"fluid_side\": \"left\", \"friction\": 30 },");
+    assert_int_equal(case_parse(j, ORIGIN, NULL, 0, &c, err, sizeof err), MIXSPH_OK);
+    assert_true(c.walls[0].friction_deg == 30.0 && c.walls[0].friction_of_medium_deg[0] == 30.0 &&
+                c.walls[0].friction_of_medium_deg[1] == 30.0);
+    case_free(&c);
+    free(j);
+    static const struct {
+        const char *value, *message;
+    } refused[] = {
+        {"{ \"gravel\": 25 }", ORIGIN ": walls.tank.friction.gravel: 'gravel' is not one of the media"},
+        {"{ \"water\": 25 }", ORIGIN ": walls.tank.friction.water: medium water (type fluid) takes no bed friction"},
+        {"{ \"sand\": 95 }", ORIGIN ": walls.tank.friction.sand: 95 is out of range (expected 0 <= x <= 90)"},
+        {"{ \"sand\": \"steep\" }", ORIGIN ": walls.tank.friction.sand: expected a number"},
+        {"[25]", ORIGIN ": walls.tank.friction: expected a number, or an object of numbers by name"},
+        {"-1", ORIGIN ": walls.tank.friction: -1 is out of range (expected 0 <= x <= 90)"},
+    };
+    for (size_t k = 0; k < sizeof refused / sizeof refused[0]; k++) {
+        char with[160];
+        snprintf(with, sizeof with, "\"fluid_side\": \"left\", \"friction\": %s },", refused[k].value);
+        j = edit_text(sand, tank_end, with);
+        const int ok = error_matches(j, NULL, 0, MIXSPH_ERR_CASE, refused[k].message, (const char *)NULL);
+        free(j);
+        assert_true(ok);
+    }
+    free(sand);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -1022,6 +1071,7 @@ int main(void)
         cmocka_unit_test(test_d50_refused),
         cmocka_unit_test(test_granular_law_by_number),
         cmocka_unit_test(test_granular_law_unnamed),
+        cmocka_unit_test(test_wall_friction_per_medium),
         cmocka_unit_test(test_table_rows),
         cmocka_unit_test(test_numerics_reach_the_step),
         cmocka_unit_test(test_parameters),

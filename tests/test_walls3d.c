@@ -151,9 +151,11 @@ static void test_flume_particles(void **state)
                            .friction_deg = NAN}};
     snprintf(def[0].name, sizeof def[0].name, "bed");
     assert_int_equal(wall_surface_build(&def[0], NULL, err, sizeof err), MIXSPH_OK);
+    def[0].friction_of_medium_deg[1] = 25.0; /* the flume's friction per medium: its side walls' too */
     assert_int_equal(wall_side_walls(&def[0], &def[1], err, sizeof err), MIXSPH_OK);
     assert_string_equal(def[1].name, "bed_sides");
     assert_int_equal(def[1].slip, WALL_FREE_SLIP);
+    assert_true(isnan(def[1].friction_deg) && def[1].friction_of_medium_deg[1] == 25.0);
     struct walls W;
     walls_of(&W, def, 2, NULL, layers);
     struct particles P = {0};

@@ -4,6 +4,7 @@ and come to rest near its friction angle.
 
     python tools/granular_heap.py [--phi 32] [--dx 0.01] [--refine] [--t-end 3] [--threads 2]
         [--mixsph build/mixsph] [--out out/granular_heap] [--reuse] [--check] [--doc FILE]
+        [--diagnose [--floor-friction DEG]]
     mixsph-validate heap ...      (the same, installed by ./tools/do setup)
 
 The case (cases/granular_heap.json, the elastic-plastic law with its wall friction delta = phi,
@@ -17,6 +18,14 @@ dx wide and a least-squares line through the tops between 20 % and 80 % of the h
 each side of its highest column, the mean of the two sides (the measure of test_elastic_plastic's
 repose test); the share of grains faster than 1 mm/s at t_end. --refine runs each heap at dx and
 dx / 2 and gives the change.
+
+--diagnose runs the steep heap only (at dx, and dx / 2 with --refine) and tells what sets its
+final angle: per snapshot time the flank angle by the measure above and by variants of it (columns
+2 dx wide; the tops between 10-90 %, 30-70 %, 20-50 % and 50-80 % of the height), the heap's
+height, the toe's run-out beyond the initial base, the share of grains above 1 mm/s and their mean
+speed, the slip along the floor of the grains of the first row; and the peak kinetic energy per
+unit mass. --floor-friction sets the floor's friction angle delta (default: the grains' phi; 90:
+no Coulomb contact, the law's own no-slip shear). Written: OUT/heap_diagnosis.md.
 
 Written: OUT/granular_heap.md (the table and the command) and, with --doc FILE, the same there.
 Exit status: 0 ok; 1 a run failed (or, with --check, a criterion failed); 2 bad usage.
@@ -63,26 +72,88 @@ def heap_case(base, phi, slope, t_end):
     return c
 
 
-def flank_angle(x, z, dx):
-    """The mean slope [deg] of the two flanks (module docstring), NaN when a side has < 2 columns."""
-    # columns with edges at multiples of dx, so the lattice's sites x = (i + 1/2) dx are at their
-    # centres: columns placed from the leftmost grain had every site on an edge, where a motion of
-    # 0.01 dx moved whole columns of tops across (4 degrees on a heap that had not moved)
-    x0 = (math.floor(x.min() / dx) - 1) * dx
-    b = np.floor((x - x0) / dx).astype(int)
+def column_tops(x, z, width):
+    """(x of the first column's left edge, the top z of every column `width` wide)."""
+    # columns with edges at multiples of the width, so the lattice's sites x = (i + 1/2) dx are at
+    # their centres: columns placed from the leftmost grain had every site on an edge, where a motion
+    # of 0.01 dx moved whole columns of tops across (4 degrees on a heap that had not moved)
+    x0 = (math.floor(x.min() / width) - 1) * width
+    b = np.floor((x - x0) / width).astype(int)
     top = np.full(b.max() + 1, -np.inf)
     np.maximum.at(top, b, z)
+    return x0, top
+
+
+def flank_angle(x, z, dx, lo=0.2, hi=0.8):
+    """The mean slope [deg] of the two flanks (module docstring): columns dx wide, the tops between
+    lo and hi times the height; NaN when a side has < 2 columns."""
+    x0, top = column_tops(x, z, dx)
     apex = int(np.argmax(top))
     H = top[apex]
     angles = []
     for side in (-1, 1):
         k = np.arange(top.size)
-        sel = ((k - apex) * side > 0) & (top > 0.2 * H) & (top < 0.8 * H)
+        sel = ((k - apex) * side > 0) & (top > lo * H) & (top < hi * H)
         if sel.sum() < 2:
             return math.nan
         slope = np.polyfit(x0 + (k[sel] + 0.5) * dx, top[sel], 1)[0]
         angles.append(math.degrees(math.atan(abs(slope))))
     return float(np.mean(angles))
+
+
+# --diagnose: the variants of the flank angle (label, column width in dx, lo, hi)
+ANGLE_VARIANTS = (("20-80 %", 1, 0.2, 0.8), ("2 dx columns", 2, 0.2, 0.8), ("10-90 %", 1, 0.1, 0.9),
+                  ("30-70 %", 1, 0.3, 0.7), ("20-50 %", 1, 0.2, 0.5), ("50-80 %", 1, 0.5, 0.8))
+DIAGNOSE_TIMES = (0.2, 0.4, 0.6, 0.8, 1.0, 1.5, 2.0, 2.5, 3.0, 3.5, 4.0)   # [s]
+
+
+def heap_state(x, z, speed, dx):
+    """What --diagnose reads at one time: the flank angle's variants [deg], the height [m], the toe's
+    distance from the apex column [m], the share of grains above STOP_SPEED and their mean speed [m/s]."""
+    x0, top = column_tops(x, z, dx)
+    apex = int(np.argmax(top))
+    xa = x0 + (apex + 0.5) * dx
+    return {"angles": [flank_angle(x, z, w * dx, lo, hi) for _, w, lo, hi in ANGLE_VARIANTS],
+            "height": float(top[apex]), "toe": float(max(x.max() - xa, xa - x.min())),
+            "moving": float(np.mean(speed > STOP_SPEED)), "mean_speed": float(np.mean(speed))}
+
+
+def diagnose_one(a, dx):
+    """The --diagnose rows of the steep heap at dx (its run made or reused by run_one)."""
+    res = run_one(a, "steep", dx)
+    out = os.path.join(a.out, f"steep_dx{dx:g}")
+    lines = [f"steep heap, dx = {dx:g} m ({res['status']}); floor friction "
+             f"{'phi' if a.floor_friction is None else f'{a.floor_friction:g} deg'}", "",
+             "| t [s] | " + " | ".join(f"angle {v[0]} [deg]" for v in ANGLE_VARIANTS) +
+             " | height [m] | toe beyond the base [m] | grains > 1 mm/s | mean speed [mm/s] | "
+             "first row's slip, mean / max [mm] |", "|" + " --- |" * (len(ANGLE_VARIANTS) + 6)]
+    if res["status"] != "ok":
+        return lines, res
+    snaps = list_snapshots(out)
+    _, c0 = read_snapshot(snaps[0][1])
+    g0 = c0["state"] <= 1
+    order0 = np.argsort(c0["id"][g0])
+    ids0, x0, z0 = c0["id"][g0][order0], c0["x"][g0][order0], c0["z"][g0][order0]
+    first_row = z0 < dx   # the grains on the floor at t = 0
+    for t, ref in snaps:
+        if min(abs(t - w) for w in DIAGNOSE_TIMES) > 0.02:
+            continue
+        _, c = read_snapshot(ref)
+        g = c["state"] <= 1
+        st = heap_state(c["x"][g], c["z"][g], np.hypot(c["vx"][g], c["vz"][g]), dx)
+        o = np.argsort(c["id"][g])
+        slip = "n/a"
+        if np.array_equal(c["id"][g][o], ids0):
+            d = np.abs(c["x"][g][o][first_row] - x0[first_row])
+            slip = f"{1e3 * d.mean():.2f} / {1e3 * d.max():.1f}"
+        lines.append(f"| {t:.1f} | " + " | ".join(f(v, ".1f") for v in st["angles"]) +
+                     f" | {st['height']:.4f} | {st['toe'] - HALF_BASE:.3f} | {100 * st['moving']:.1f} % | "
+                     f"{1e3 * st['mean_speed']:.2f} | {slip} |")
+    mon = np.genfromtxt(os.path.join(out, "monitors.csv"), delimiter=",", names=True)
+    k = int(np.argmax(mon["kinetic_energy"]))
+    lines += ["", f"peak kinetic energy {mon['kinetic_energy'][k]:.4g} J/m at t = {mon['t'][k]:.2f} s: "
+              f"{mon['kinetic_energy'][k] / mon['mass'][k]:.3g} J/kg", ""]
+    return lines, res
 
 
 def run_one(a, kind, dx):
@@ -93,8 +164,11 @@ def run_one(a, kind, dx):
         base = json.load(f)
     case = os.path.join(out, "case.json")
     t_end = STILL_OVER if kind == "stable" else a.t_end
+    c = heap_case(base, a.phi, slope, t_end)
+    if a.floor_friction is not None:
+        c["walls"]["floor"]["friction"] = a.floor_friction
     with open(case, "w") as f:
-        json.dump(heap_case(base, a.phi, slope, t_end), f, indent=1)
+        json.dump(c, f, indent=1)
     res = {"kind": kind, "slope": slope, "dx": dx, "status": "ok", "t_end": t_end}
     if not (a.reuse and os.path.isfile(os.path.join(out, "summary.json"))):
         for name in os.listdir(out):
@@ -156,13 +230,29 @@ def main(argv=None, prog=PROG):
     ap.add_argument("--reuse", action="store_true", help="read finished runs instead of running them again")
     ap.add_argument("--check", action="store_true", help="exit status 1 when a criterion fails")
     ap.add_argument("--doc", help="also write the table (with the command) to this file")
+    ap.add_argument("--diagnose", action="store_true", help="the steep heap's angle over time, by variants of "
+                    "the measure, its toe, speeds and floor slip (module docstring)")
+    ap.add_argument("--floor-friction", type=float, help="the floor's friction angle delta [deg] (default: phi)")
     a = ap.parse_args(argv)
     if not (5 < a.phi < 42 and a.dx > 0 and a.t_end > 0 and a.threads >= 1):
         ap.error("--phi between 5 and 42 degrees, --dx and --t-end positive, --threads at least 1")
     if not os.access(a.mixsph, os.X_OK):
         ap.error(f"{a.mixsph}: no mixsph executable there (build it: ./tools/do build)")
     a.mixsph = os.path.abspath(a.mixsph)
+    if a.floor_friction is not None and not (0.0 <= a.floor_friction <= 90.0 and a.diagnose):
+        ap.error("--floor-friction: with --diagnose, between 0 and 90 degrees")
     spacings = [a.dx, a.dx / 2] if a.refine else [a.dx]
+    if a.diagnose:
+        lines = []
+        for dx in spacings:
+            lines += diagnose_one(a, dx)[0]
+        command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
+        text = "\n".join(lines) + "\n```sh\n" + command + "\n```\n"
+        print(text)
+        os.makedirs(a.out, exist_ok=True)
+        with open(os.path.join(a.out, "heap_diagnosis.md"), "w") as fo:
+            fo.write(text)
+        return
     rows = [run_one(a, kind, dx) for kind in ("stable", "steep") for dx in spacings]
     head = ("| heap | slope [deg] | dx [m] | status | wall [s] | t [s] | largest displacement to 2 s [dx] | "
             "flank angle at 0 [deg] | at t [deg] | vs 2 dx [deg] | grains > 1 mm/s at t | criterion | met |")

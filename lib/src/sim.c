@@ -2,6 +2,7 @@
  * initial state, walls, cell grid), stepping, outputs. Public API of mixsph.h. */
 #include "sim.h"
 
+#include "bed_friction.h"
 #include "body_sites.h"
 #include "budget.h"
 #include "law_registry.h"
@@ -42,36 +43,32 @@ struct site {
     size_t body;     /* the body it belongs to */
 };
 
-/* A wall's friction angle delta from which the bed friction is "none" (docs/model.md [BF]): the
- * law's own no-slip shear, unbounded [deg]. */
-#define WALL_FRICTION_NONE_DEG 90.0
+_Static_assert(WALLS_MAX <= BED_FRICTION_SIDE && CASE_MAX_MEDIA <= BED_FRICTION_SIDE,
+               "the bed friction's table holds every wall and every medium");
 
-/* Whether some grain of the case takes a wall's Coulomb friction (bed_friction.h): a medium whose
- * law bounds the shear of every no-slip wall (LAW_WALL_FRICTION) and a no-slip wall that does not
- * give delta = 90, or a law that takes it where a wall gives its angle (LAW_WALL_FRICTION_GIVEN)
- * and such a wall. */
+/* Whether some grain of the case takes a wall's Coulomb friction (bed_friction.h): a no-slip wall
+ * whose friction on a medium is not "none" and whose law bounds the shear of every no-slip wall
+ * (LAW_WALL_FRICTION) or takes it where the wall gives its angle (LAW_WALL_FRICTION_GIVEN). */
 static int bed_friction_on(const struct case_def *c)
 {
-    unsigned features = 0u;
-    for (size_t k = 0; k < c->n_media; k++) features |= law_get(c->media[k].law)->features;
-    for (size_t w = 0; w < c->n_walls; w++) {
-        const struct wall *wl = &c->walls[w];
-        if (wl->slip != WALL_NO_SLIP || wl->friction_deg >= WALL_FRICTION_NONE_DEG) continue;
-        if ((features & LAW_WALL_FRICTION) || ((features & LAW_WALL_FRICTION_GIVEN) && !isnan(wl->friction_deg)))
-            return 1;
-    }
+    for (size_t w = 0; w < c->n_walls; w++)
+        for (size_t k = 0; k < c->n_media && c->walls[w].slip == WALL_NO_SLIP; k++) {
+            const double mu = bed_friction_coefficient(c->walls[w].friction_of_medium_deg[k]);
+            const unsigned features = law_get(c->media[k].law)->features;
+            if ((mu == BED_FRICTION_OWN && (features & LAW_WALL_FRICTION)) ||
+                (mu >= 0.0 && (features & (LAW_WALL_FRICTION | LAW_WALL_FRICTION_GIVEN))))
+                return 1;
+        }
     return 0;
 }
 
-/* A wall particle's friction coefficient (particles.h wall_friction): tan(delta) of its wall's
- * friction, -1 where the wall takes the grains' phi, -2 where it bounds nothing (delta = 90); 0
- * for a particle that is not a wall's. */
-static double wall_friction_coefficient(const struct wall *w)
+/* The friction coefficient of each (wall, medium) pair (bed_friction.h); 0 where either is none. */
+static void bed_friction_table_fill(const struct case_def *c, struct bed_friction_table *T)
 {
-    if (!w) return 0.0;
-    if (isnan(w->friction_deg)) return -1.0;
-    if (w->friction_deg >= WALL_FRICTION_NONE_DEG) return -2.0;
-    return tan(w->friction_deg * GEOM_PI / 180.0);
+    for (size_t q = 0; q < BED_FRICTION_SIDE * BED_FRICTION_SIDE; q++) T->mu[q] = 0.0;
+    for (size_t w = 0; w < c->n_walls; w++)
+        for (size_t k = 0; k < c->n_media; k++)
+            T->mu[w * BED_FRICTION_SIDE + k] = bed_friction_coefficient(c->walls[w].friction_of_medium_deg[k]);
 }
 
 static int site_cmp(const void *a, const void *b)
@@ -357,9 +354,7 @@ static mixsph_status create_laws(mixsph_sim *s)
         for (size_t i = 0; i < s->phys.P.n; i++) {
             struct particles *P = &s->phys.P;
             const int wall = P->state[i] == MIXSPH_STATE_WALL;
-            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
-            P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
-            P->wall_friction[i] = wall_friction_coefficient(w);
+            P->wall_rough[i] = wall && s->cfg.walls[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
         }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
@@ -390,6 +385,7 @@ static void set_scheme_params(mixsph_sim *s)
 #define NUMERICS_KEY COPY_NUMERICS_KEY
 #include "numerics_keys.def"
 #undef NUMERICS_KEY
+    if (s->scheme.pair.bed_friction) bed_friction_table_fill(c, &s->scheme.pair.bed_mu);
     for (size_t k = 0; k < c->n_media; k++) /* a medium's finish may set it (not its law's features) */
         if (c->media[k].features & LAW_GRAINS_IN_WATER) s->scheme.pair.grains_in_water = 1;
 }

@@ -87,6 +87,22 @@ def test_flank_angle_of_a_lattice_heap():
     assert gh.flank_angle(x, z, dx) == pytest.approx(30.0, abs=1.5)
 
 
+def test_heap_state_of_a_lattice_heap():
+    # the 30-degree lattice heap by every variant of the measure (--diagnose): within 1.5 degrees but
+    # the 2 dx columns (their tops are a staircase of two sites: 2 degrees); its height and toe
+    dx = 0.005
+    pts = [((i + 0.5) * dx, (k + 0.5) * dx) for i in range(-60, 60) for k in range(60)]
+    pts = [(x, z) for x, z in pts if z <= (0.3 - abs(x)) * math.tan(math.radians(30))]
+    x, z = np.array(pts).T
+    speed = np.where(z > 0.1, 2e-3, 0.0)
+    st = gh.heap_state(x, z, speed, dx)
+    for (label, width, _, _), angle in zip(gh.ANGLE_VARIANTS, st["angles"]):
+        assert angle == pytest.approx(30.0, abs=2.0 if width == 2 else 1.5), label
+    assert st["height"] == pytest.approx(z.max())
+    assert st["toe"] == pytest.approx(0.3 - dx / 2, abs=dx)
+    assert st["moving"] == pytest.approx(np.mean(z > 0.1))
+
+
 def test_reproduce_command_drops_where_things_go():
     # --mixsph, --doc and --out (with their values, in either form) do not change the numbers: left out
     import mixsph_tools as mt

@@ -19,7 +19,9 @@ enum case_type {
     CASE_NAME,    /* the name of another entry (a medium, a wall, ...): resolved by case.c */
     CASE_NUMBERS, /* an array of at least lo numbers: stored by case.c */
     CASE_POINTS,  /* an array of at least lo [x, z] points -> struct polyline */
-    CASE_OBJECT   /* an object: a section of its own */
+    CASE_OBJECT,  /* an object: a section of its own */
+    CASE_NUMBER_BY_NAME /* a number in [lo, hi] (-> double), or an object of such numbers keyed by the names of
+                           other entries (a wall's friction per medium): its names resolved by case.c */
 };
 
 enum case_need {

@@ -585,6 +585,27 @@ static mixsph_status build_wall_surface(const struct case_reader *r, const cJSON
     return MIXSPH_OK;
 }
 
+/* The wall's friction angle on each medium (struct wall friction_of_medium_deg): its key `friction`
+ * as a number for every medium, or as an object naming granular media (range checked by the
+ * schema), the others taking the default (NaN: the grains' own phi; the paper law then takes none). */
+static mixsph_status read_wall_friction(const struct case_reader *r, const cJSON *it, const char *path,
+                                        const struct case_def *c, struct wall *wl)
+{
+    for (size_t k = 0; k < WALL_MEDIA_MAX; k++) wl->friction_of_medium_deg[k] = wl->friction_deg;
+    const cJSON *by_name = item(it, "friction");
+    if (!cJSON_IsObject(by_name)) return MIXSPH_OK;
+    for (const cJSON *e = by_name->child; e; e = e->next) {
+        const int k = find_medium(c, e->string);
+        if (k < 0) return FAIL(r, "%s: %s.friction.%s: '%s' is not one of the media", r->origin, path, e->string, e->string);
+        const struct medium *md = &c->media[k];
+        if (!(md->features & (LAW_WALL_FRICTION | LAW_WALL_FRICTION_GIVEN)))
+            return FAIL(r, "%s: %s.friction.%s: medium %s (type %s) takes no bed friction: a wall's friction acts on "
+                           "granular media only", r->origin, path, e->string, md->name, law_get(md->law)->type);
+        wl->friction_of_medium_deg[k] = e->valuedouble;
+    }
+    return MIXSPH_OK;
+}
+
 static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, struct case_def *c)
 {
     for (const cJSON *it = item(root, "walls")->child; it; it = it->next) {
@@ -599,6 +620,7 @@ static mixsph_status read_walls(const struct case_reader *r, const cJSON *root, 
         TRY(case_schema_read(r, it, path, section("walls"), 1u << wl->form, wl));
         if (wl->form == WALL_FORM_POLYLINE && !item(it, "fluid_side"))
             return FAIL(r, "%s: %s.fluid_side: missing (expected a string)", r->origin, path);
+        TRY(read_wall_friction(r, it, path, c, wl));
         const cJSON *file = item(it, wl->form == WALL_FORM_STL ? "stl" : "terrain"); /* its length checked */
         if (file && (wl->form == WALL_FORM_STL || wl->form == WALL_FORM_TERRAIN))
             snprintf(wl->file, sizeof wl->file, "%s", file->valuestring);

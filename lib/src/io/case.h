@@ -12,6 +12,7 @@
 
 #define CASE_NAME_LEN MEDIUM_NAME_LEN /* names of all entries */
 #define CASE_MAX_MEDIA 8
+_Static_assert(CASE_MAX_MEDIA <= WALL_MEDIA_MAX, "a wall's friction per medium holds every medium of a case");
 #define CASE_MAX_BODIES 16
 #define CASE_MAX_WALLS WALLS_MAX
 #define CASE_MAX_MOTIONS 8

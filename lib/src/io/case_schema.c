@@ -179,12 +179,13 @@ static const struct case_key wall_keys[] = {
                 "is above it"},
     {.key = "slip", .type = CASE_CHOICE, DEF(WALL_NO_SLIP), .choices = slips, .numeric_choice = 1,
      .field = CASE_FIELD(wall, slip), .meaning = "the condition on the tangential velocity"},
-    {.key = "friction", .type = CASE_NUMBER, RANGE(0, 0, 90, 0),
+    {.key = "friction", .type = CASE_NUMBER_BY_NAME, RANGE(0, 0, 90, 0),
      .def_text = "elastic_plastic: φ of the grains; paper: 90", .unit = "deg",
      .field = CASE_FIELD(wall, friction_deg),
      .meaning = "bed friction angle δ of a no-slip wall on grains (docs/model.md [BF]): its shear on a sliding grain "
                 "is tan δ times the normal force it exerts, on a grain at rest at most that (0: smooth; 90: none, "
-                "the law's own no-slip shear)"},
+                "the law's own no-slip shear). A number: every granular medium's δ; an object {\"medium\": δ, ...}: "
+                "the δ of each granular medium it names, the default for the others"},
     {.key = "motion", .type = CASE_NAME, .def_text = "fixed", .meaning = "name of one of the motions"},
 };
 
@@ -379,6 +380,7 @@ void case_schema_range_text(const struct case_key *k, int unicode, char *buf, si
     switch (k->type) {
     case CASE_NUMBER:
     case CASE_INTEGER:
+    case CASE_NUMBER_BY_NAME:
         snprintf(buf, len, "%s %s x %s %s", lo, k->lo_open ? "<" : le, k->hi_open ? "<" : le, hi);
         break;
     case CASE_STRING:
@@ -439,6 +441,7 @@ static const char *expected_noun(enum case_type t)
     case CASE_NUMBERS: return "an array of numbers";
     case CASE_POINTS: return "an array of [x, z] points";
     case CASE_OBJECT: return "an object";
+    case CASE_NUMBER_BY_NAME: return "a number, or an object of numbers by name";
     default: return "a string";
     }
 }
@@ -503,7 +506,8 @@ int case_schema_stored_number(const struct case_key *k, const void *base, double
     const void *f = field_of(k, (void *)base);
     if (!f) return -1;
     switch (k->type) {
-    case CASE_NUMBER: *value = *(const double *)f; return 0;
+    case CASE_NUMBER:
+    case CASE_NUMBER_BY_NAME: *value = *(const double *)f; return 0;
     case CASE_INTEGER:
     case CASE_BOOL:
     case CASE_CHOICE: *value = *(const int *)f; return 0;
@@ -553,7 +557,7 @@ mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj
         if (!f) return MIXSPH_OK;
         if (k->type == CASE_STRING && k->def_text) snprintf((char *)f, (size_t)k->hi + 1, "%s", k->def_text);
         if (!k->has_def) return MIXSPH_OK;
-        if (k->type == CASE_NUMBER) *(double *)f = k->def;
+        if (k->type == CASE_NUMBER || k->type == CASE_NUMBER_BY_NAME) *(double *)f = k->def;
         else *(int *)f = (int)k->def; /* integer, Boolean, choice */
         return MIXSPH_OK;
     }
@@ -617,6 +621,20 @@ mixsph_status case_schema_read_key(const struct case_reader *r, const cJSON *obj
     }
     case CASE_OBJECT:
         if (!cJSON_IsObject(it)) return FAIL(r, "%s: %s: expected an object", r->origin, kp);
+        return MIXSPH_OK;
+    case CASE_NUMBER_BY_NAME:
+        if (!cJSON_IsObject(it)) { /* the number form: a number of the key's range */
+            TRY(read_number(r, it, kp, k, &v));
+            if (f) *(double *)f = v;
+            return MIXSPH_OK;
+        }
+        for (const cJSON *e = it->child; e; e = e->next) { /* each name's number in the range; case.c the names */
+            char ep[512]; /* kp, a dot and the name */
+            key_path(ep, sizeof ep, kp, e->string);
+            if (!cJSON_IsNumber(e) || !isfinite(e->valuedouble))
+                return FAIL(r, "%s: %s: expected a number", r->origin, ep);
+            TRY(read_number(r, e, ep, k, &v));
+        }
         return MIXSPH_OK;
     }
     return MIXSPH_OK;

@@ -3,6 +3,18 @@
 
 #include <math.h>
 
+#include "geometry.h" /* GEOM_PI */
+
+/* delta from which the bed friction is "none" (docs/model.md [BF]): the law's own shear, unbounded [deg] */
+#define BED_FRICTION_NONE_DEG 90.0
+
+double bed_friction_coefficient(double delta_deg)
+{
+    if (isnan(delta_deg)) return BED_FRICTION_OWN;
+    if (delta_deg >= BED_FRICTION_NONE_DEG) return BED_FRICTION_NONE;
+    return tan(delta_deg * GEOM_PI / 180.0);
+}
+
 void bed_friction_change(const struct bed_contact *c, double change[DIM])
 {
     for (int d = 0; d < DIM; d++) change[d] = 0.0;

@@ -38,6 +38,23 @@ struct bed_contact {
     double dt;               /* the time step [s]; 0: the stick force holds the other forces only */
 };
 
+/* The friction coefficient of every (wall, medium) pair, as the momentum pass reads it: tan(delta)
+ * >= 0, BED_FRICTION_OWN where the wall takes the grains' own phi, BED_FRICTION_NONE where it
+ * bounds nothing (the law's own no-slip shear). Entry [w * BED_FRICTION_SIDE + k] is wall w's on
+ * medium k; a particle's `medium` byte (a wall particle's: its wall) indexes either side, so the
+ * side holds every wall and every medium of a case (sim.c checks) and is a power of two (an index
+ * masked by BED_FRICTION_SIDE - 1 stays inside whatever byte a padding lane holds). */
+#define BED_FRICTION_SIDE 16
+#define BED_FRICTION_OWN (-1.0)
+#define BED_FRICTION_NONE (-2.0)
+struct bed_friction_table {
+    double mu[BED_FRICTION_SIDE * BED_FRICTION_SIDE];
+};
+
+/** The coefficient of a friction angle delta [deg]: tan(delta); NaN (not given) BED_FRICTION_OWN;
+ *  90 or more BED_FRICTION_NONE. */
+double bed_friction_coefficient(double delta_deg);
+
 /** The change of grain i's force that its bed friction makes (added to its pair force). */
 void bed_friction_change(const struct bed_contact *c, double change[DIM]);
 

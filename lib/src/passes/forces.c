@@ -136,6 +136,7 @@ struct pair_ctx {
     const double *bed_given, *bed_own; /* with bed_friction, per particle: 1 where the walls that give
                                         * their friction angle (bed_given) or take its own medium's
                                         * (bed_own) bound its shear, else 0 */
+    const double *bed_mu; /* with bed_friction: each (wall, medium) pair's coefficient (bed_friction.h) */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -169,6 +170,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->bed_friction = fp->bed_friction;
     for (int q = 0; q < WALL_SUMS; q++) X->wall_sum[q] = NULL;
     X->bed_given = X->bed_own = NULL;
+    X->bed_mu = fp->bed_mu.mu;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -509,12 +511,15 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict p = P->p, *restrict vol = P->vol;
     const double *restrict m = P->m, *restrict mu = P->mu, *restrict tag = P->tag;
     const double *restrict avc = P->avc;
-    const double *restrict wall_rough = P->wall_rough, *restrict wall_mu = P->wall_friction;
+    const double *restrict wall_rough = P->wall_rough, *restrict bed_mu = X->bed_mu;
     const double *restrict bed_given = X->bed_given, *restrict bed_own = X->bed_own;
-    const double roughi = friction ? wall_rough[i] : 0.0, mu_wi = friction ? wall_mu[i] : 0.0;
+    const double roughi = friction ? wall_rough[i] : 0.0;
     const double bgi = friction ? bed_given[i] : 0.0, boi = friction ? bed_own[i] : 0.0;
-    /* wall particle i's friction: given (tan delta >= 0), the grains' own (-1) or none (-2: no bound) */
-    const double given_i = mu_wi >= 0.0 ? 1.0 : 0.0, own_i = mu_wi < 0.0 && mu_wi > -1.5 ? 1.0 : 0.0;
+    /* the friction coefficients of a pair (bed_friction.h): wall j's on i's medium, down the column
+     * of i's medium byte; wall i's on j's medium, along the row of its wall (its medium byte) */
+    const uint8_t *restrict med = P->medium;
+    const double *restrict mu_on_i = bed_mu + (P->medium[i] & (BED_FRICTION_SIDE - 1));
+    const double *restrict mu_of_i = bed_mu + (size_t)(P->medium[i] & (BED_FRICTION_SIDE - 1)) * BED_FRICTION_SIDE;
     /* the grains in water (grains): roles, the water's pressure at the grains, Ergun's factors */
     const double *restrict role = grains ? X->gw[GW_ROLE] : NULL, *restrict p_water = grains ? X->gw[GW_PRESSURE] : NULL;
     const double *restrict drag_v = grains ? X->gw[GW_DRAG_VISCOUS] : NULL;
@@ -598,10 +603,16 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             }
             /* bed friction: to_i = 1 where wall particle j bounds grain i's shear (bed_friction.h),
              * to_j = 1 where wall particle i bounds grain j's */
-            double given_j = 0.0, own_j = 0.0, to_i = 0.0, to_j = 0.0;
-            if (friction) {
-                given_j = wall_mu[j] >= 0.0 ? 1.0 : 0.0;
-                own_j = wall_mu[j] < 0.0 && wall_mu[j] > -1.5 ? 1.0 : 0.0;
+            double mu_wj = 0.0, mu_wi = 0.0, given_j = 0.0, own_j = 0.0, given_i = 0.0, own_i = 0.0;
+            double to_i = 0.0, to_j = 0.0;
+            if (friction) { /* each coefficient given (tan delta >= 0), the grains' own or none */
+                const unsigned mj = med[j] & (BED_FRICTION_SIDE - 1);
+                mu_wj = mu_on_i[mj * BED_FRICTION_SIDE]; /* wall j's on grain i */
+                mu_wi = mu_of_i[mj];                     /* wall i's on grain j */
+                given_j = mu_wj >= 0.0 ? 1.0 : 0.0;
+                own_j = mu_wj == BED_FRICTION_OWN ? 1.0 : 0.0;
+                given_i = mu_wi >= 0.0 ? 1.0 : 0.0;
+                own_i = mu_wi == BED_FRICTION_OWN ? 1.0 : 0.0;
                 to_i = wall_rough[j] * (1.0 - walli) * (given_j * bgi + own_j * boi);
                 to_j = roughi * (1.0 - wallj) * (given_i * bed_given[j] + own_i * bed_own[j]);
             }
@@ -673,7 +684,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                     wj[WALL_V + d][k] = qj * vi[d];
                 }
                 ws[WALL_Q_GIVEN][k] += qi * given_j;
-                ws[WALL_QMU_GIVEN][k] += qi * given_j * wall_mu[j];
+                ws[WALL_QMU_GIVEN][k] += qi * given_j * mu_wj;
                 ws[WALL_Q_OWN][k] += qi * own_j;
                 wj[WALL_Q_GIVEN][k] = qj * given_i;
                 wj[WALL_QMU_GIVEN][k] = qj * given_i * mu_wi;

@@ -8,6 +8,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "bed_friction.h"
 #include "case.h"
 #include "cells.h"
 #include "kernel.h"
@@ -31,6 +32,7 @@ struct forces_params {
     int bed_friction;       /* the momentum pass replaces the shear of no-slip walls on grains by their
                                Coulomb friction (bed_friction.h) where a grain's law asks for it
                                (LAW_WALL_FRICTION, LAW_WALL_FRICTION_GIVEN) */
+    struct bed_friction_table bed_mu; /* with bed_friction: each (wall, medium) pair's friction coefficient */
     int grains_in_water;    /* a medium has LAW_GRAINS_IN_WATER: its pairs with fluid particles take the
                                water's interpolated pressure and Ergun's drag (docs/model.md [GW]) */
 #define NUMERICS_KEY NUMERICS_MEMBER_OF_PAIR

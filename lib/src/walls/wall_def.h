@@ -16,6 +16,7 @@
 
 #define WALLS_MAX 16 /* walls of one case */
 #define WALL_PATH_LEN 255 /* the longest file name of an stl or terrain wall */
+#define WALL_MEDIA_MAX 8  /* media a wall's friction is given for: those of a case (io/case.h checks) */
 
 enum wall_slip { WALL_NO_SLIP = 0, WALL_FREE_SLIP = 1 };
 
@@ -49,7 +50,10 @@ struct wall {
     int symmetry;             /* 3D: a plane of symmetry (the free-slip side walls of an extruded
                                * polyline): its particles carry the fluid's velocity mirrored
                                * across it in every pair term (walls.c, walls_extrapolate_fluid) */
-    double friction_deg;      /* friction angle delta on grains with a stress [deg]; NaN: the grains' phi */
+    double friction_deg;      /* friction angle delta on grains [deg] (the number form of its key); NaN: not given */
+    double friction_of_medium_deg[WALL_MEDIA_MAX]; /* delta on the grains of each medium of the case [deg]: the
+                                                    * one its key names for it, else friction_deg; NaN: the
+                                                    * grains' own phi (case.c fills it for every medium) */
 };
 
 #endif
