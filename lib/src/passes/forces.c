@@ -233,13 +233,22 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
         for (size_t jb = (rng)[2 * r_], e_ = (rng)[2 * r_ + 1]; jb < e_; jb += FORCES_CHUNK)        \
             for (size_t lanes = e_ - jb < FORCES_CHUNK ? e_ - jb : FORCES_CHUNK, once_ = 1; once_; once_ = 0)
 
-/* Candidate k of the chunk that starts at jb: in 2D the particle itself (the ranges hold
- * particles), in 3D entry jb + k of the pair list idx (neighbours.h: the ranges hold positions in
- * it). The loops' text is the same in both; 2D compiles to the contiguous loads it always had. */
+/* Candidate k of particle i's chunk that starts at jb, m lanes of it inside the range: in 2D the
+ * particle jb + k itself (the ranges hold particles), in 3D entry jb + k of the pair list idx
+ * (neighbours.h: the ranges hold positions in it), and i for a masked lane: its terms are then
+ * zero (r = 0, every factor finite, times the lane mask), and the adds to j need no mask (a masked
+ * lane adds 0 to i, which the walking thread owns); GCC 12 vectorises no masked scatter. The
+ * entry is loaded before the select (the list is padded), so that the load needs no mask
+ * either. The loops' text is the same in both; 2D compiles to the contiguous loads it always had. */
 #if DIM == 3
-#define FORCES_J(idx, jb, k) ((size_t)(idx)[(jb) + (k)])
+FORCES_INLINE size_t forces_j(const uint32_t *restrict idx, size_t jb, size_t k, size_t m, size_t i)
+{
+    const size_t j = idx[jb + k], keep = (size_t)0 - (size_t)(k < m); /* all ones inside the range */
+    return (j & keep) | (i & ~keep); /* bit operations: a select would become a phi of addresses, no gather */
+}
+#define FORCES_J(idx, jb, k, m, i) forces_j(idx, jb, k, m, i)
 #else
-#define FORCES_J(idx, jb, k) ((void)(idx), (jb) + (k))
+#define FORCES_J(idx, jb, k, m, i) ((void)(idx), (void)(i), (jb) + (k))
 #endif
 
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
@@ -249,12 +258,16 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
  * stores (AVX-512, AVX2; in 3D a masked gather and scatter, the candidates of one particle being
  * distinct), so a partial chunk needs no scalar tail and never writes past the range (another
  * thread may own what follows). */
-FORCES_INLINE void chunk_add(double *restrict a, const uint32_t *restrict idx, size_t jb, size_t m,
+FORCES_INLINE void chunk_add(double *restrict a, const uint32_t *restrict idx, size_t jb, size_t m, size_t i,
                              const double *restrict v)
 {
 #pragma omp simd
     for (size_t k = 0; k < FORCES_CHUNK; k++)
-        if (k < m) a[FORCES_J(idx, jb, k)] += v[k];
+#if DIM == 3 /* v is 0 on the masked lanes, whose j is i (FORCES_J) */
+        a[FORCES_J(idx, jb, k, m, i)] += v[k];
+#else
+        if (k < m) a[FORCES_J(idx, jb, k, m, i)] += v[k];
+#endif
 }
 
 /* Continuity between i and its nr ranges of candidates [rng[2r], rng[2r+1]) (one call per
@@ -293,7 +306,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK], ej[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = FORCES_J(idx, jb, k);
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             const double in = FORCES_LANE_IN(k, m);
             double r[DIM], r2 = 0.0, uf = 0.0;
             DIM_UNROLL
@@ -325,9 +338,9 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
                 ej[k] = -voli * q;
             }
         }
-        chunk_add(P->drho, idx, jb, m, dj);
-        chunk_add(count, idx, jb, m, cj);
-        if (diffuse) chunk_add(diff, idx, jb, m, ej);
+        chunk_add(P->drho, idx, jb, m, i, dj);
+        chunk_add(count, idx, jb, m, i, cj);
+        if (diffuse) chunk_add(diff, idx, jb, m, i, ej);
         if (store) fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -361,7 +374,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = FORCES_J(idx, jb, k);
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -376,8 +389,8 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
             aj[k] = -b * voli;
             uj[k] = w * voli;
         }
-        chunk_add(sum, idx, jb, m, aj);
-        chunk_add(weight, idx, jb, m, uj);
+        chunk_add(sum, idx, jb, m, i, aj);
+        chunk_add(weight, idx, jb, m, i, uj);
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *ai += sa[k];
@@ -409,7 +422,7 @@ FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct p
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = FORCES_J(idx, jb, k);
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -424,8 +437,8 @@ FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct p
             aj[k] = gj * voli * (pi + rhoi * g * r[DIM_UP]);
             uj[k] = gj * voli;
         }
-        chunk_add(sum, idx, jb, m, aj);
-        chunk_add(weight, idx, jb, m, uj);
+        chunk_add(sum, idx, jb, m, i, aj);
+        chunk_add(weight, idx, jb, m, i, uj);
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *ai += sa[k];
@@ -572,7 +585,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         double wj[WALL_SUMS][FORCES_CHUNK]; /* what j's wall sums receive from wall particle i */
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = FORCES_J(idx, jb, k);
+            const size_t j = FORCES_J(idx, jb, k, n, i);
             const double in = FORCES_LANE_IN(k, n);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
@@ -716,9 +729,9 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 fj[d][k] = -f[d]; /* forces: divided by the masses once, after the pass */
             }
         }
-        for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], idx, jb, n, fj[d]);
+        for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], idx, jb, n, i, fj[d]);
         if (friction && roughi != 0.0 && Xl.wall_sum[0])
-            for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], idx, jb, n, wj[q]);
+            for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], idx, jb, n, i, wj[q]);
         if (cached) fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
     }
@@ -831,7 +844,7 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
         double oj[DIM][FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = FORCES_J(idx, jb, k);
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             const double w = wl[k];
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -841,8 +854,8 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
             }
             if (diagonal) sd[k] += w;
         }
-        for (int d = 0; d < DIM; d++) chunk_add(o[d], idx, jb, m, oj[d]);
-        if (diagonal) chunk_add(od, idx, jb, m, wl);
+        for (int d = 0; d < DIM; d++) chunk_add(o[d], idx, jb, m, i, oj[d]);
+        if (diagonal) chunk_add(od, idx, jb, m, i, wl);
         wl += FORCES_CHUNK;
     }
     for (int d = 0; d < DIM; d++) {
@@ -889,7 +902,7 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
         const double *wl = X->visc_w + X->fk_off[i];
         FORCES_FOR_EACH_CHUNK(rng, PAIR_RANGES, jb, m) {
                 for (size_t k = 0; k < m; k++) {
-                    const int32_t gj = group[FORCES_J(idx, jb, k)];
+                    const int32_t gj = group[FORCES_J(idx, jb, k, m, i)];
                     if (gj < 0) continue;
                     const long d = (long)gj - (long)gi;
                     const int slot = d == 0 ? 0 : d == 1 ? 1 : d == s - 1 ? 2 : d == s ? 3 : 4;
