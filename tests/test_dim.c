@@ -145,6 +145,30 @@ static void test_neighbours_brute_force(void **state)
             for (size_t j = 0; j < n; j++) brute += dist2(&P, i, j) < rc * rc;
             assert_int_equal(in_ranges, brute);
         }
+        /* the pair list (the 3D pair loops' candidates): every pair closer than rc but those of two
+         * wall particles, each once, ascending per particle; the same on 1 and 2 threads */
+        uint8_t *state = malloc(n);
+        for (size_t i = 0; i < n; i++) state[i] = P.id[i] % 3 == 0 ? MIXSPH_STATE_WALL : MIXSPH_STATE_MOBILE;
+        size_t n_ref_list = 0;
+        for (size_t k = 0; k < n_ref; k++)
+            if ((ref[k] >> 32) % 3 != 0 || (ref[k] & 0xffffffffu) % 3 != 0) ref[n_ref_list++] = ref[k];
+        struct pair_list PL[2] = {{0}, {0}};
+        for (int t = 0; t < 2; t++) assert_int_equal(neighbours_pair_list_build(&PL[t], &NB, state, active, rc, t + 1), 0);
+        assert_int_equal(PL[0].start[n], n_ref_list);
+        assert_memory_equal(PL[0].start, PL[1].start, (n + 1) * sizeof *PL[0].start);
+        assert_memory_equal(PL[0].j, PL[1].j, n_ref_list * sizeof *PL[0].j);
+        n_got = 0;
+        for (size_t i = 0; i < n; i++)
+            for (uint32_t k = PL[0].start[i]; k < PL[0].start[i + 1]; k++) {
+                assert_true(k == PL[0].start[i] || PL[0].j[k] > PL[0].j[k - 1]);
+                got[n_got++] = pair_key(&P, i, PL[0].j[k]);
+            }
+        qsort(got, n_got, sizeof *got, cmp_u64);
+        print_message("DIM %d, kx %d: %zu pairs in the pair list (%zu without wall-wall pairs)\n", DIM, kx, n_got,
+                      n_ref_list);
+        assert_memory_equal(got, ref, n_ref_list * sizeof *ref);
+        for (int t = 0; t < 2; t++) neighbours_pair_list_free(&PL[t]);
+        free(state);
         free(ref);
         free(got);
         neighbours_gather_free(&G);

@@ -70,6 +70,7 @@ struct nb_loop {
     struct gather *G;
     const struct cells *C;
     const uint8_t *state;
+    struct pair_list *L;          /* the pair list being built */
     double rc2;                   /* squared cut-off [m2] */
 };
 
@@ -241,5 +242,75 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
         G->cap_list = cap;
     }
     team_for(n_threads, n, gather_list_range, &L);
+    return 0;
+}
+
+void neighbours_pair_list_free(struct pair_list *L)
+{
+    free(L->start);
+    free(L->j);
+    memset(L, 0, sizeof *L);
+}
+
+/* Particle i's entries of the pair list: counted (out NULL) or written. */
+static inline size_t pair_scan(const struct neighbours *NB, const uint8_t *state, size_t i, double rc2, uint32_t *out)
+{
+    double *const *x = NB->pos0;
+    const uint32_t *r = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+    const int wall_i = state[i] == MIXSPH_STATE_WALL;
+    size_t k = 0;
+    for (int q = 0; q < 2 * NEIGHBOURS_RANGES; q += 2)
+        for (size_t j = r[q]; j < r[q + 1]; j++) {
+            if (wall_i && state[j] == MIXSPH_STATE_WALL) continue;
+            if (distance2(x, i, j) < rc2) {
+                if (out) out[k] = (uint32_t)j;
+                k++;
+            }
+        }
+    return k;
+}
+
+static void pair_count_range(void *arg, size_t b, size_t e)
+{
+    const struct nb_loop *L = arg;
+    uint32_t *cnt = L->L->start + 1;
+    for (size_t i = b; i < e; i++) cnt[i] = (uint32_t)pair_scan(L->cNB, L->state, i, L->rc2, NULL);
+}
+
+static void pair_fill_range(void *arg, size_t b, size_t e)
+{
+    const struct nb_loop *L = arg;
+    for (size_t i = b; i < e; i++) pair_scan(L->cNB, L->state, i, L->rc2, L->L->j + L->L->start[i]);
+}
+
+int neighbours_pair_list_build(struct pair_list *PL, const struct neighbours *NB, const uint8_t *state, size_t n,
+                               double rc, int n_threads)
+{
+    PL->valid = 0;
+    if (n + 1 > PL->cap_n) {
+        const size_t cap = n + n / 4 + 64;
+        if (grow((void **)&PL->start, cap + 1, sizeof(uint32_t))) return -1;
+        PL->cap_n = cap;
+    }
+    struct nb_loop L = {.cNB = NB, .state = state, .L = PL, .rc2 = rc * rc};
+    n_threads = n_threads > 0 ? n_threads : 1;
+    team_for(n_threads, n, pair_count_range, &L); /* a particle's count fits: its ranges are uint32 */
+    uint64_t total = 0;
+    PL->start[0] = 0;
+    for (size_t i = 0; i < n; i++) {
+        total += PL->start[i + 1];
+        if (total > UINT32_MAX) return -1;
+        PL->start[i + 1] = (uint32_t)total;
+    }
+    if (total + NEIGHBOURS_PAD > PL->cap_j) {
+        const size_t cap = total + total / 4 + NEIGHBOURS_PAD + 64;
+        if (grow((void **)&PL->j, cap, sizeof(uint32_t))) return -1;
+        PL->cap_j = cap;
+    }
+    team_for(n_threads, n, pair_fill_range, &L);
+    memset(PL->j + total, 0, NEIGHBOURS_PAD * sizeof(uint32_t));
+    PL->n = n;
+    PL->builds = NB->builds;
+    PL->valid = 1;
     return 0;
 }

@@ -64,6 +64,24 @@ struct gather {
     size_t cap_list;
 };
 
+/* The pair list: each particle's half-stencil candidates (its ranges above) closer than rc at the
+ * build, pairs of two wall particles left out (their forces vanish, and a wall particle's density
+ * rate is not used: it takes the fluid's extrapolated state, walls.h), as one compact
+ * list of indices, ascending per particle. The 3D pair loops walk it instead of the ranges
+ * (forces.c): in 3D the ranges' rows are rc x rc in cross-section, so only about 15 % of their
+ * candidates lie within 2h and, with three wall particles for each fluid one, most of the rest
+ * are wall-wall pairs; the list leaves the pair loops about two thirds of lanes within 2h, at the
+ * cost of indexed loads. In 2D the ranges hold about 40 % of useful candidates and walls are few:
+ * the contiguous ranges are kept there. */
+struct pair_list {
+    uint32_t *start;    /* n + 1 entries: particle i's candidates are j[start[i] .. start[i+1]) */
+    uint32_t *j;        /* the candidates, then NEIGHBOURS_PAD entries of 0 (read by masked lanes) */
+    size_t n;           /* particles listed */
+    size_t cap_n, cap_j;
+    uint64_t builds;    /* the NB->builds it was made from */
+    int valid;          /* it describes the lists of that build */
+};
+
 void neighbours_free(struct neighbours *NB);
 void neighbours_gather_free(struct gather *G);
 /** Make room for cap particles in G. Returns -1 on allocation failure. */
@@ -81,6 +99,13 @@ int neighbours_build(struct neighbours *NB, const struct cells *C, const struct 
 
 /** Rebuild the ranges from the build positions already in pos0 (a restored state). */
 int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads);
+
+/** Build L from the ranges of the first n particles of NB and their build positions: the
+ *  candidates closer than rc, pairs of two particles whose state is MIXSPH_STATE_WALL left out.
+ *  Returns -1 on allocation failure or beyond 2^32 - 1 entries. */
+int neighbours_pair_list_build(struct pair_list *L, const struct neighbours *NB, const uint8_t *state, size_t n,
+                               double rc, int n_threads);
+void neighbours_pair_list_free(struct pair_list *L);
 
 /** Make room for cap particles' build positions. Returns -1 on allocation failure. */
 int neighbours_reserve(struct neighbours *NB, size_t cap);

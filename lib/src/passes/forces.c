@@ -25,7 +25,11 @@
  * Particles are sorted by cell (cells.c); particle i meets the two contiguous ranges of its half
  * stencil kept by neighbours.c (the particles after it in its own row up to kx columns ahead,
  * and kx columns either side in the row above, trimmed to the candidates within 2h + skin at
- * the last build), so each pair is met once and the inner loops run over contiguous memory; they are
+ * the last build), so each pair is met once and the inner loops run over contiguous memory. In 3D
+ * these ranges would leave most lanes idle (rows rc x rc in cross-section, and the walls' own
+ * pairs: 17 % of the lanes within 2h in the SPHERIC dam break), so there i meets its entries of the pair list
+ * instead (neighbours.h: the same half stencil within 2h + skin, without wall-wall pairs) through
+ * indexed loads and stores (FORCES_J, chunk_add). The inner loops are
  * branch-free (the kernel factor is 0 beyond 2h; wall and artificial-viscosity terms are
  * selected arithmetically) and vectorised with `omp simd`. The loops are compiled for AVX-512,
  * AVX2 and baseline x86-64 and the widest is picked at run time (target_clones).
@@ -119,6 +123,7 @@ struct forces {
     double *visc_w;
     size_t visc_w_cap;
     int visc_valid;           /* visc_w holds the couplings at the current positions */
+    struct pair_list list;    /* 3D: the pair list of the current neighbour lists (pair_list_attach) */
 };
 
 /* Constants of one pass of the pair loops. */
@@ -153,6 +158,8 @@ struct pair_ctx {
     double *group_w;           /* and its sums, 5 per group */
     double *gw[GW_ARRAYS];     /* the grains in water (struct forces), or NULL: none */
     double p_background;       /* the water's pressure at a free surface [Pa] (the grains in water) */
+    const uint32_t *idx;        /* 3D: the pair list's candidates (pair_list_attach); 2D: NULL */
+    const uint32_t *list_start; /* 3D: particle i's candidates are idx[list_start[i] .. list_start[i+1]) */
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -188,6 +195,29 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->group_w = NULL;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = NULL;
     X->p_background = fp->p_background;
+    X->idx = X->list_start = NULL;
+}
+
+/* Particle i's candidates for the pair loops: in 2D its NEIGHBOURS_RANGES ranges of particles, in
+ * 3D one range of positions in the pair list X->idx (neighbours.h), written into buf. */
+#if DIM == 3
+#define PAIR_RANGES 1
+#else
+#define PAIR_RANGES NEIGHBOURS_RANGES
+#endif
+FORCES_INLINE const uint32_t *pair_ranges(const struct pair_ctx *X, const struct neighbours *NB, size_t i,
+                                          uint32_t buf[2])
+{
+#if DIM == 3
+    (void)NB;
+    buf[0] = X->list_start[i];
+    buf[1] = X->list_start[i + 1];
+    return buf;
+#else
+    (void)X;
+    (void)buf;
+    return NB->rng + 2 * NEIGHBOURS_RANGES * i;
+#endif
 }
 
 /* F of a pair at squared distance r2 (kernel.h). `wendland` is a compile-time constant in each
@@ -207,17 +237,41 @@ FORCES_INLINE double pair_f(const struct pair_ctx *X, double r2, const int wendl
         for (size_t jb = (rng)[2 * r_], e_ = (rng)[2 * r_ + 1]; jb < e_; jb += FORCES_CHUNK)        \
             for (size_t lanes = e_ - jb < FORCES_CHUNK ? e_ - jb : FORCES_CHUNK, once_ = 1; once_; once_ = 0)
 
+/* Candidate k of particle i's chunk that starts at jb, m lanes of it inside the range: in 2D the
+ * particle jb + k itself (the ranges hold particles), in 3D entry jb + k of the pair list idx
+ * (neighbours.h: the ranges hold positions in it), and i for a masked lane: its terms are then
+ * zero (r = 0, every factor finite, times the lane mask), and the adds to j need no mask (a masked
+ * lane adds 0 to i, which the walking thread owns); GCC 12 vectorises no masked scatter. The
+ * entry is loaded before the select (the list is padded), so that the load needs no mask
+ * either. The loops' text is the same in both; 2D compiles to the contiguous loads it always had. */
+#if DIM == 3
+FORCES_INLINE size_t forces_j(const uint32_t *restrict idx, size_t jb, size_t k, size_t m, size_t i)
+{
+    const size_t j = idx[jb + k], keep = (size_t)0 - (size_t)(k < m); /* all ones inside the range */
+    return (j & keep) | (i & ~keep); /* bit operations: a select would become a phi of addresses, no gather */
+}
+#define FORCES_J(idx, jb, k, m, i) forces_j(idx, jb, k, m, i)
+#else
+#define FORCES_J(idx, jb, k, m, i) ((void)(idx), (void)(i), (jb) + (k))
+#endif
+
 /* Lane mask of a chunk: 1 for the first m lanes, 0 after (a select, no branch). */
 #define FORCES_LANE_IN(k, m) ((k) < (m) ? 1.0 : 0.0)
 
-/* Add the chunk's lane values v[] to a[jb..jb+m): masked vector loads and stores (AVX-512,
- * AVX2), so a partial chunk needs no scalar tail and never writes past the range (another
- * thread may own what follows). */
-FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const double *restrict v)
+/* Add the chunk's lane values v[] to its candidates' a[j] (FORCES_J): in 2D masked vector loads
+ * and stores (AVX-512, AVX2), so a partial chunk needs no scalar tail and never writes past the
+ * range (another thread may own what follows); in 3D a gather and a scatter, the candidates of one
+ * particle being distinct and a masked lane adding its 0 to i. */
+FORCES_INLINE void chunk_add(double *restrict a, const uint32_t *restrict idx, size_t jb, size_t m, size_t i,
+                             const double *restrict v)
 {
 #pragma omp simd
     for (size_t k = 0; k < FORCES_CHUNK; k++)
-        if (k < m) a[jb + k] += v[k];
+#if DIM == 3 /* v is 0 on the masked lanes, whose j is i (FORCES_J) */
+        a[FORCES_J(idx, jb, k, m, i)] += v[k];
+#else
+        if (k < m) a[FORCES_J(idx, jb, k, m, i)] += v[k];
+#endif
 }
 
 /* Continuity between i and its nr ranges of candidates [rng[2r], rng[2r+1]) (one call per
@@ -233,7 +287,7 @@ FORCES_INLINE void chunk_add(double *restrict a, size_t jb, size_t m, const doub
  * not pack them; the fluid's rate counts a grain by the volume its solids take from the water
  * (GW_SOLID): the rest of the parcel is pore space the water flows through. */
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                    const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
+                                    const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
                                     const int wendland, const int store, const int diffuse, const int grains)
 {
@@ -259,7 +313,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
         double dj[FORCES_CHUNK], cj[FORCES_CHUNK], ej[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = jb + k;
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             const double in = FORCES_LANE_IN(k, m);
             double r[DIM], r2 = 0.0, uf = 0.0;
             DIM_UNROLL
@@ -291,9 +345,9 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
                 ej[k] = -voli * q;
             }
         }
-        chunk_add(P->drho, jb, m, dj);
-        chunk_add(count, jb, m, cj);
-        if (diffuse) chunk_add(diff, jb, m, ej);
+        chunk_add(P->drho, idx, jb, m, i, dj);
+        chunk_add(count, idx, jb, m, i, cj);
+        if (diffuse) chunk_add(diff, idx, jb, m, i, ej);
         if (store) fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
@@ -309,7 +363,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
  * extrapolation of p_j to z_i, so a hydrostatic field is left unchanged; B_ji = -B_ij):
  * a_i += B_ij W_ij V_j, u_i += W_ij V_j and a_j -= B_ij W_ij V_i, u_j += W_ij V_i. */
 FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
-                                const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
+                                const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
                                 double *restrict sum, double *restrict weight, const int wendland)
 {
     const double pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
@@ -327,7 +381,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = jb + k;
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -342,8 +396,8 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
             aj[k] = -b * voli;
             uj[k] = w * voli;
         }
-        chunk_add(sum, jb, m, aj);
-        chunk_add(weight, jb, m, uj);
+        chunk_add(sum, idx, jb, m, i, aj);
+        chunk_add(weight, idx, jb, m, i, uj);
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *ai += sa[k];
@@ -356,7 +410,7 @@ FORCES_INLINE void smooth_range(const struct pair_ctx *X, const struct particles
  * (the fluid's pressure carried hydrostatically to the grain's height) and u += V_f W, whose
  * quotient (Shepard's interpolation) is the water's pressure at the grain. */
 FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct particles *restrict P, size_t i,
-                                        const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
+                                        const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double g, double *ai, double *ui,
                                         double *restrict sum, double *restrict weight, const int wendland)
 {
     const double pi = P->p[i], rhoi = P->rho[i], voli = P->vol[i];
@@ -375,7 +429,7 @@ FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct p
         double aj[FORCES_CHUNK], uj[FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = jb + k;
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -390,8 +444,8 @@ FORCES_INLINE void water_pressure_range(const struct pair_ctx *X, const struct p
             aj[k] = gj * voli * (pi + rhoi * g * r[DIM_UP]);
             uj[k] = gj * voli;
         }
-        chunk_add(sum, jb, m, aj);
-        chunk_add(weight, jb, m, uj);
+        chunk_add(sum, idx, jb, m, i, aj);
+        chunk_add(weight, idx, jb, m, i, uj);
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *ai += sa[k];
@@ -484,7 +538,7 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
 enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
-                                  const uint32_t *restrict rng, int nr, double f_i[DIM],
+                                  const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double f_i[DIM],
                                   const double *restrict fk, double *restrict wl, const int wendland,
                                   const int cached, const int implicit, const int stress, const int friction,
                                   const int grains)
@@ -544,7 +598,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         double wj[WALL_SUMS][FORCES_CHUNK]; /* what j's wall sums receive from wall particle i */
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = jb + k;
+            const size_t j = FORCES_J(idx, jb, k, n, i);
             const double in = FORCES_LANE_IN(k, n);
             double r[DIM], r2 = 0.0;
             DIM_UNROLL
@@ -696,9 +750,9 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 fj[d][k] = -f[d]; /* forces: divided by the masses once, after the pass */
             }
         }
-        for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], jb, n, fj[d]);
+        for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], idx, jb, n, i, fj[d]);
         if (friction && roughi != 0.0 && Xl.wall_sum[0])
-            for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], jb, n, wj[q]);
+            for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], idx, jb, n, i, wj[q]);
         if (cached) fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
     }
@@ -749,7 +803,8 @@ FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighb
         double di = 0.0, ni = 0.0, ei = 0.0;
         const int diffuse_i = diffuse && diffuses(X, P, i);
         const double hyd_i = diffuse_i ? diffusion_hydrostatic(X, P, i) : 0.0;
-        continuity_range(X, P, i, NB->rng + 2 * NEIGHBOURS_RANGES * i, NEIGHBOURS_RANGES, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
+        uint32_t buf[2];
+        continuity_range(X, P, i, X->idx, pair_ranges(X, NB, i, buf), PAIR_RANGES, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
                          X->diffusion, hyd_i, wendland, store, diffuse_i, grains);
         P->drho[i] += di;
         X->count[i] += ni;
@@ -775,16 +830,17 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
 {
     for (size_t i = b0; i < b1; i++) {
         double f[DIM] = {0.0};
-        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
         const double *fk = cached ? X->fk + X->fk_off[i] : NULL;
         double *wl = implicit ? X->visc_w + X->fk_off[i] : NULL;
         /* The bed friction's sums of a pair vanish unless i is a grain whose shear walls bound or a
          * wall particle that bounds one (to_i = to_j = 0 in momentum_range): the other particles,
          * the water's most, walk their pairs without them, to the same forces bit for bit. */
         if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0))
-            momentum_range(X, P, i, rng, NEIGHBOURS_RANGES, f, fk, wl, wendland, cached, implicit, stress, 1, grains);
+            momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress, 1, grains);
         else
-            momentum_range(X, P, i, rng, NEIGHBOURS_RANGES, f, fk, wl, wendland, cached, implicit, stress, 0, grains);
+            momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress, 0, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
@@ -792,7 +848,7 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
 /* The viscous operator's pair sums over i's ranges: for each component,
  * out_i += sum_j w_ij (in_i - in_j) and out_j -= w_ij (in_i - in_j); with `diagonal` also
  * diag_i += sum_j w_ij and diag_j += w_ij. */
-FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint32_t *restrict rng,
+FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint32_t *restrict idx, const uint32_t *restrict rng,
                                  const double *restrict wl, const int diagonal)
 {
     const double *restrict u[DIM];
@@ -805,11 +861,11 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
     }
     double *restrict od = X->out_diag;
     double so[DIM][FORCES_CHUNK] = {{0}}, sd[FORCES_CHUNK] = {0};
-    FORCES_FOR_EACH_CHUNK(rng, NEIGHBOURS_RANGES, jb, m) {
+    FORCES_FOR_EACH_CHUNK(rng, PAIR_RANGES, jb, m) {
         double oj[DIM][FORCES_CHUNK];
 #pragma omp simd
         for (size_t k = 0; k < FORCES_CHUNK; k++) {
-            const size_t j = jb + k;
+            const size_t j = FORCES_J(idx, jb, k, m, i);
             const double w = wl[k];
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) {
@@ -819,8 +875,8 @@ FORCES_INLINE void viscous_range(const struct pair_ctx *X, size_t i, const uint3
             }
             if (diagonal) sd[k] += w;
         }
-        for (int d = 0; d < DIM; d++) chunk_add(o[d], jb, m, oj[d]);
-        if (diagonal) chunk_add(od, jb, m, wl);
+        for (int d = 0; d < DIM; d++) chunk_add(o[d], idx, jb, m, i, oj[d]);
+        if (diagonal) chunk_add(od, idx, jb, m, i, wl);
         wl += FORCES_CHUNK;
     }
     for (int d = 0; d < DIM; d++) {
@@ -842,9 +898,10 @@ static void viscous_band(const struct pair_ctx *X, const struct neighbours *NB, 
     (void)P;
     const int diagonal = X->out_diag != NULL;
     for (size_t i = b0; i < b1; i++) {
-        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
-        if (diagonal) viscous_range(X, i, rng, X->visc_w + X->fk_off[i], 1);
-        else viscous_range(X, i, rng, X->visc_w + X->fk_off[i], 0);
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
+        if (diagonal) viscous_range(X, i, X->idx, rng, X->visc_w + X->fk_off[i], 1);
+        else viscous_range(X, i, X->idx, rng, X->visc_w + X->fk_off[i], 0);
     }
 }
 
@@ -855,16 +912,18 @@ static void group_band(const struct pair_ctx *X, const struct neighbours *NB, st
 {
     (void)P;
     const int32_t *group = X->group;
+    const uint32_t *idx = X->idx;
     const long s = X->group_stride;
     for (size_t i = b0; i < b1; i++) {
         const int32_t gi = group[i];
         if (gi < 0) continue;
         double *gw = X->group_w + 5 * (size_t)gi;
-        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
         const double *wl = X->visc_w + X->fk_off[i];
-        FORCES_FOR_EACH_CHUNK(rng, NEIGHBOURS_RANGES, jb, m) {
+        FORCES_FOR_EACH_CHUNK(rng, PAIR_RANGES, jb, m) {
                 for (size_t k = 0; k < m; k++) {
-                    const int32_t gj = group[jb + k];
+                    const int32_t gj = group[FORCES_J(idx, jb, k, m, i)];
                     if (gj < 0) continue;
                     const long d = (long)gj - (long)gi;
                     const int slot = d == 0 ? 0 : d == 1 ? 1 : d == s - 1 ? 2 : d == s ? 3 : 4;
@@ -882,9 +941,10 @@ static void water_pressure_band(const struct pair_ctx *X, const struct neighbour
     double *sum = X->gw[GW_SUM], *weight = X->gw[GW_WEIGHT];
     for (size_t i = b0; i < b1; i++) {
         double a = 0.0, u = 0.0;
-        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
-        if (X->wendland) water_pressure_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, sum, weight, 1);
-        else water_pressure_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, sum, weight, 0);
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
+        if (X->wendland) water_pressure_range(X, P, i, X->idx, rng, PAIR_RANGES, X->g, &a, &u, sum, weight, 1);
+        else water_pressure_range(X, P, i, X->idx, rng, PAIR_RANGES, X->g, &a, &u, sum, weight, 0);
         sum[i] += a;
         weight[i] += u;
     }
@@ -897,9 +957,10 @@ static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, s
     for (size_t i = b0; i < b1; i++) {
         if (P->tag[i] < 0.0) continue; /* walls neither smooth nor are smoothed */
         double a = 0.0, u = 0.0;
-        const uint32_t *rng = NB->rng + 2 * NEIGHBOURS_RANGES * i;
-        if (X->wendland) smooth_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, X->sum, X->weight, 1);
-        else smooth_range(X, P, i, rng, NEIGHBOURS_RANGES, X->g, &a, &u, X->sum, X->weight, 0);
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
+        if (X->wendland) smooth_range(X, P, i, X->idx, rng, PAIR_RANGES, X->g, &a, &u, X->sum, X->weight, 1);
+        else smooth_range(X, P, i, X->idx, rng, PAIR_RANGES, X->g, &a, &u, X->sum, X->weight, 0);
         X->sum[i] += a;
         X->weight[i] += u;
     }
@@ -976,6 +1037,7 @@ void forces_free(struct forces *F)
     free(F->bed_own);
     free(F->diffusion_sum);
     aligned_block_free(F->visc_w);
+    neighbours_pair_list_free(&F->list);
     free(F);
 }
 
@@ -993,9 +1055,9 @@ int forces_viscous_ready(const struct forces *F) { return F->visc_valid; }
  * lanes 0), and the momentum pass of the same step, at the same positions and over the same
  * ranges, reads it instead of evaluating the kernel again (a square root and, for the cubic
  * spline, a division per lane): the same numbers, so results are unchanged. Lanes of particle i
- * start at fk_off[i], FORCES_CHUNK per chunk of each of its two ranges. Returns -1 if the cache
+ * start at fk_off[i], FORCES_CHUNK per chunk of each of its ranges (pair_ranges). Returns -1 if the cache
  * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
-static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n)
+static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struct neighbours *NB, size_t n)
 {
     if (F->fk_off_cap < n + 1) {
         size_t *o = realloc(F->fk_off, (n + 1) * sizeof *o);
@@ -1003,12 +1065,13 @@ static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n
         F->fk_off = o;
         F->fk_off_cap = n + 1;
     }
-    const uint32_t *rng = NB->rng;
     size_t total = 0;
     for (size_t i = 0; i < n; i++) {
+        uint32_t buf[2];
+        const uint32_t *rng = pair_ranges(X, NB, i, buf);
         F->fk_off[i] = total;
-        for (int r = 0; r < NEIGHBOURS_RANGES; r++) {
-            const size_t len = rng[2 * NEIGHBOURS_RANGES * i + 2 * r + 1] - rng[2 * NEIGHBOURS_RANGES * i + 2 * r];
+        for (int r = 0; r < PAIR_RANGES; r++) {
+            const size_t len = rng[2 * r + 1] - rng[2 * r];
             total += (len + FORCES_CHUNK - 1) / FORCES_CHUNK * FORCES_CHUNK;
         }
     }
@@ -1020,6 +1083,28 @@ static int fcache_layout(struct forces *F, const struct neighbours *NB, size_t n
         F->fk_cap = F->fk ? cap : 0;
         if (!F->fk) return -1;
     }
+    return 0;
+}
+
+/* In 3D the pair loops walk the pair list of the current neighbour lists (neighbours.h), made
+ * here at the first pass after each build of the lists (the neighbour search leaves walls to the
+ * state, which the list needs); in 2D they walk the ranges and X is left as it is. */
+static int pair_list_attach(struct forces *F, const struct pair_system *S, size_t n, struct pair_ctx *X)
+{
+#if DIM == 3
+    struct pair_list *L = &F->list;
+    /* the cells' row spacing is the lists' cut-off, 2h + skin (sim.c) */
+    if ((!L->valid || L->builds != S->NB->builds || L->n != n) &&
+        neighbours_pair_list_build(L, S->NB, S->P->state, n, S->C->size, S->n_threads) != 0)
+        return -1;
+    X->idx = L->j;
+    X->list_start = L->start;
+#else
+    (void)F;
+    (void)S;
+    (void)n;
+    (void)X;
+#endif
     return 0;
 }
 
@@ -1186,7 +1271,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     const size_t n = active_count(S);
-    if (scratch_reserve(F, n) != 0) return -1;
+    if (scratch_reserve(F, n) != 0 || pair_list_attach(F, S, n, &X) != 0) return -1;
     memset(P->drho, 0, n * sizeof(double));
     memset(F->nbr_count, 0, n * sizeof(double));
     X.count = F->nbr_count;
@@ -1197,7 +1282,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
         X.diffusion = F->diffusion_sum;
     }
     const double *diffusion = X.diffusion;
-    F->fk_valid = fcache_layout(F, S->NB, n) == 0;
+    F->fk_valid = fcache_layout(F, &X, S->NB, n) == 0;
     if (F->fk_valid) {
         X.fk = F->fk;
         X.fk_off = F->fk_off;
@@ -1302,6 +1387,7 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     const size_t n = active_count(S);
     for (int d = 0; d < DIM; d++) memset(P->acc[d], 0, n * sizeof(double));
     F->visc_valid = 0;
+    if (pair_list_attach(F, S, n, &X) != 0) return -1;
     if (S->params.implicit_viscosity) {
         /* the couplings are stored in the cache's lane layout, so the cache must be there */
         if (!F->fk_valid) return -1;
@@ -1362,6 +1448,8 @@ static int stored_couplings(const struct forces *F, const struct pair_system *S,
     pair_ctx_init(S, X);
     X->visc_w = F->visc_w;
     X->fk_off = F->fk_off;
+    X->idx = F->list.j; /* 3D: the pair list they were stored over (2D: unused) */
+    X->list_start = F->list.start;
     return 0;
 }
 
@@ -1416,19 +1504,25 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
         *drho = NAN;
         return;
     }
-    const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1};
-    momentum_range(&X, P, i, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0, 0);
+#if DIM == 3 /* a list of the one candidate j (its masked lanes read j too) */
+    uint32_t one[FORCES_CHUNK];
+    for (int k = 0; k < FORCES_CHUNK; k++) one[k] = (uint32_t)j;
+    const uint32_t pair[2] = {0, 1}, *idx = one;
+#else
+    const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1}, *idx = NULL;
+#endif
+    momentum_range(&X, P, i, idx, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0, 0);
     for (int d = 0; d < DIM; d++) {
         a[d] = f[d] * P->inv_m[i];
         P->acc[d][j] = save[d];
     }
     const double delta_h = S->params.diffusion * X.K.h;
     if (delta_h > 0.0 && diffuses(&X, P, i)) {
-        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
+        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
                          X.wendland, 0, 1, 0);
         *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
     } else {
-        continuity_range(&X, P, i, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0, 0);
+        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0, 0);
         *drho = P->rho[i] * di;
     }
     P->drho[j] = save[DIM];
@@ -1468,7 +1562,7 @@ int forces_smooth_pressure(struct forces *F, const struct pair_system *S, double
     struct pair_ctx X;
     pair_ctx_init(S, &X);
     const size_t n = active_count(S);
-    if (scratch_reserve(F, n) != 0) return -1;
+    if (scratch_reserve(F, n) != 0 || pair_list_attach(F, S, n, &X) != 0) return -1;
     memset(F->smooth_sum, 0, n * sizeof(double));
     memset(F->smooth_weight, 0, n * sizeof(double));
     X.sum = F->smooth_sum;
