@@ -71,6 +71,19 @@ static void bed_friction_table_fill(const struct case_def *c, struct bed_frictio
             T->mu[w * BED_FRICTION_SIDE + k] = bed_friction_coefficient(c->walls[w].friction_of_medium_deg[k]);
 }
 
+/* Whether some wall gives two media different friction coefficients: then the momentum pass reads
+ * the (wall, medium) table, else each wall particle's one coefficient (particles.h wall_friction),
+ * which keeps its pair loop free of table lookups. */
+static int bed_friction_per_medium(const struct case_def *c)
+{
+    for (size_t w = 0; w < c->n_walls; w++)
+        for (size_t k = 1; k < c->n_media; k++)
+            if (bed_friction_coefficient(c->walls[w].friction_of_medium_deg[k]) !=
+                bed_friction_coefficient(c->walls[w].friction_of_medium_deg[0]))
+                return 1;
+    return 0;
+}
+
 static int site_cmp(const void *a, const void *b)
 {
     const struct site *p = a, *q = b;
@@ -354,7 +367,9 @@ static mixsph_status create_laws(mixsph_sim *s)
         for (size_t i = 0; i < s->phys.P.n; i++) {
             struct particles *P = &s->phys.P;
             const int wall = P->state[i] == MIXSPH_STATE_WALL;
-            P->wall_rough[i] = wall && s->cfg.walls[particles_wall_index(P, i)].slip == WALL_NO_SLIP;
+            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
+            P->wall_rough[i] = wall && w->slip == WALL_NO_SLIP;
+            P->wall_friction[i] = wall ? bed_friction_coefficient(w->friction_of_medium_deg[0]) : 0.0;
         }
     if ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_alloc(&s->work.grad, s->phys.P.n) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (velocity gradient)");
@@ -385,7 +400,10 @@ static void set_scheme_params(mixsph_sim *s)
 #define NUMERICS_KEY COPY_NUMERICS_KEY
 #include "numerics_keys.def"
 #undef NUMERICS_KEY
-    if (s->scheme.pair.bed_friction) bed_friction_table_fill(c, &s->scheme.pair.bed_mu);
+    if (s->scheme.pair.bed_friction) {
+        bed_friction_table_fill(c, &s->scheme.pair.bed_mu);
+        s->scheme.pair.bed_per_medium = bed_friction_per_medium(c);
+    }
     for (size_t k = 0; k < c->n_media; k++) /* a medium's finish may set it (not its law's features) */
         if (c->media[k].features & LAW_GRAINS_IN_WATER) s->scheme.pair.grains_in_water = 1;
 }

@@ -101,6 +101,9 @@ const struct particle_field particle_fields[] = {
      .description = "a free-slip wall particle's unit normal toward the solid, across which it mirrors "
                     "the solid's stress (0 for the others)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+    {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
+     .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi), -2: none)",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
     {.name = "pore_pressure", COMPONENTS1(pore_p), .unit = "Pa",
      .description = "a grain's pore pressure p_w (>= 0) of its law's last update, left out of the bed friction's "
                     "normal force (0 for the others)",

@@ -45,6 +45,10 @@ struct particles {
                                                  * toward the solid, across which they mirror the stress
                                                  * of the solid they meet (no shear); 0 for the others
                                                  * (a no-slip wall takes the stress as it is) */
+    double *wall_friction; /* wall particles: tan(delta) of their wall's friction angle on every medium, or
+                            * -1 where the wall takes the friction angle of the grains it meets, -2 where
+                            * it bounds nothing; 0 for the others [-] (docs/model.md [BF]); the momentum
+                            * pass reads it unless some wall gives its media different angles */
     double *pore_p;       /* grains: the pore pressure p_w [PW] >= 0 their law's last update measured,
                            * which the bed friction's normal force leaves out [Pa]; 0 for the others */
     uint8_t *medium;      /* index into the case's media; for wall particles the wall's index

@@ -142,6 +142,7 @@ struct pair_ctx {
                                         * their friction angle (bed_given) or take its own medium's
                                         * (bed_own) bound its shear, else 0 */
     const double *bed_mu; /* with bed_friction: each (wall, medium) pair's coefficient (bed_friction.h) */
+    int bed_per_medium;   /* read bed_mu (some wall's coefficient differs by medium), else wall_friction */
     double *fk;           /* the kernel-factor cache (see forces_density_rate), or NULL */
     const size_t *fk_off; /* particle i's lanes start at fk + fk_off[i] */
     double *count;        /* scratch sums written by the band walks (see struct forces) */
@@ -178,6 +179,7 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     for (int q = 0; q < WALL_SUMS; q++) X->wall_sum[q] = NULL;
     X->bed_given = X->bed_own = NULL;
     X->bed_mu = fp->bed_mu.mu;
+    X->bed_per_medium = fp->bed_per_medium;
     X->fk = NULL;
     X->fk_off = NULL;
     X->count = X->sum = X->weight = NULL;
@@ -536,6 +538,9 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
  * implicit couplings w_ij with `implicit`). Every term stays a pair force, added to i and
  * subtracted from j. */
 enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
+/* momentum_range's `friction`: none, one coefficient per wall (the wall particles' wall_friction),
+ * or one per (wall, medium) pair (the table bed_mu: gathers, dearer per pair) */
+enum { BED_FRICTION_OFF = 0, BED_FRICTION_BY_WALL = 1, BED_FRICTION_BY_MEDIUM = 2 };
 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double f_i[DIM],
@@ -572,6 +577,8 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     /* the friction coefficients of a pair (bed_friction.h): wall j's on i's medium, down the column
      * of i's medium byte; wall i's on j's medium, along the row of its wall (its medium byte) */
     const uint8_t *restrict med = P->medium;
+    const double *restrict wall_mu = P->wall_friction;
+    const double wall_mu_i = friction == BED_FRICTION_BY_WALL ? wall_mu[i] : 0.0;
     const double *restrict mu_on_i = bed_mu + (P->medium[i] & (BED_FRICTION_SIDE - 1));
     const double *restrict mu_of_i = bed_mu + (size_t)(P->medium[i] & (BED_FRICTION_SIDE - 1)) * BED_FRICTION_SIDE;
     /* the grains in water (grains): roles, the water's pressure at the grains, Ergun's factors */
@@ -660,9 +667,14 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             double mu_wj = 0.0, mu_wi = 0.0, given_j = 0.0, own_j = 0.0, given_i = 0.0, own_i = 0.0;
             double to_i = 0.0, to_j = 0.0;
             if (friction) { /* each coefficient given (tan delta >= 0), the grains' own or none */
-                const unsigned mj = med[j] & (BED_FRICTION_SIDE - 1);
-                mu_wj = mu_on_i[mj * BED_FRICTION_SIDE]; /* wall j's on grain i */
-                mu_wi = mu_of_i[mj];                     /* wall i's on grain j */
+                if (friction == BED_FRICTION_BY_WALL) { /* one per wall: contiguous loads, no lookup */
+                    mu_wj = wall_mu[j];
+                    mu_wi = wall_mu_i;
+                } else {
+                    const unsigned mj = med[j] & (BED_FRICTION_SIDE - 1);
+                    mu_wj = mu_on_i[mj * BED_FRICTION_SIDE]; /* wall j's on grain i */
+                    mu_wi = mu_of_i[mj];                     /* wall i's on grain j */
+                }
                 given_j = mu_wj >= 0.0 ? 1.0 : 0.0;
                 own_j = mu_wj == BED_FRICTION_OWN ? 1.0 : 0.0;
                 given_i = mu_wi >= 0.0 ? 1.0 : 0.0;
@@ -837,9 +849,14 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
         /* The bed friction's sums of a pair vanish unless i is a grain whose shear walls bound or a
          * wall particle that bounds one (to_i = to_j = 0 in momentum_range): the other particles,
          * the water's most, walk their pairs without them, to the same forces bit for bit. */
-        if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0))
-            momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress, 1, grains);
-        else
+        if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0)) {
+            if (X->bed_per_medium)
+                momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
+                               BED_FRICTION_BY_MEDIUM, grains);
+            else
+                momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
+                               BED_FRICTION_BY_WALL, grains);
+        } else
             momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress, 0, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }

@@ -33,6 +33,8 @@ struct forces_params {
                                Coulomb friction (bed_friction.h) where a grain's law asks for it
                                (LAW_WALL_FRICTION, LAW_WALL_FRICTION_GIVEN) */
     struct bed_friction_table bed_mu; /* with bed_friction: each (wall, medium) pair's friction coefficient */
+    int bed_per_medium;     /* with bed_friction: some wall gives two media different coefficients, so
+                               the pass reads bed_mu rather than the wall particles' wall_friction */
     int grains_in_water;    /* a medium has LAW_GRAINS_IN_WATER: its pairs with fluid particles take the
                                water's interpolated pressure and Ergun's drag (docs/model.md [GW]) */
 #define NUMERICS_KEY NUMERICS_MEMBER_OF_PAIR
