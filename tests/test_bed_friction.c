@@ -179,18 +179,26 @@ static char *two_block_case(double dx, double t_end)
 
 /* Each wall-medium pair's coefficient reaches the momentum pass's table (bed_friction.h): the two
  * the ramp names, tan(20) and tan(30), exactly as bed_friction_coefficient gives them. */
-static void test_friction_per_medium_reaches_the_step(void **state)
+/* The two-block case at spacing dx to t_end, created (failing the test if it is refused). */
+static mixsph_sim *two_block_sim(double dx, double t_end)
 {
-    (void)state;
-    char *text = two_block_case(0.04, 0.01);
+    char *text = two_block_case(dx, t_end);
     assert_non_null(text);
     mixsph_sim *s = NULL;
     char err[512] = "";
     const mixsph_status st = mixsph_sim_create_from_text(text, "two_blocks", NULL, 0, &s, err, sizeof err);
     free(text);
     if (st != MIXSPH_OK) fail_msg("%s", err);
+    return s;
+}
+
+static void test_friction_per_medium_reaches_the_step(void **state)
+{
+    (void)state;
+    mixsph_sim *s = two_block_sim(0.04, 0.01);
     const double *mu = s->scheme.pair.bed_mu.mu;
     assert_true(s->scheme.pair.bed_friction);
+    assert_true(s->scheme.pair.bed_per_medium); /* the ramp's two angles: the pass reads the table */
     assert_true(mu[0 * BED_FRICTION_SIDE + 0] == tan(20.0 * GEOM_PI / 180.0)); /* wall 0 on medium 0, lower */
     assert_true(mu[0 * BED_FRICTION_SIDE + 1] == tan(30.0 * GEOM_PI / 180.0)); /* on medium 1, upper */
     mixsph_sim_destroy(s);
@@ -206,13 +214,7 @@ static void test_friction_per_medium_reaches_the_step(void **state)
 static void two_block_ratios(double ratio[2], double swapped[2])
 {
     const double a = 45.0 * GEOM_PI / 180.0, delta[2] = {20.0 * GEOM_PI / 180.0, 30.0 * GEOM_PI / 180.0};
-    char *text = two_block_case(0.02, 0.6);
-    assert_non_null(text);
-    mixsph_sim *s = NULL;
-    char err[512] = "";
-    const mixsph_status st = mixsph_sim_create_from_text(text, "two_blocks", NULL, 0, &s, err, sizeof err);
-    free(text);
-    if (st != MIXSPH_OK) fail_msg("%s", err);
+    mixsph_sim *s = two_block_sim(0.02, 0.6);
     assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
     const struct particles *P = &s->phys.P;
     double s0[2] = {0.0, 0.0}, s1[2] = {0.0, 0.0}, u[2] = {0.0, 0.0};

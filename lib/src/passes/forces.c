@@ -836,6 +836,20 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
     for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) out->l[q][i] = acc[DIM * DIM + q];
 }
 
+/* momentum_range with the (wall, medium) table of bed friction coefficients: one copy, its
+ * options taken at run time, rather than one per combination of them as for the other walks (a
+ * case whose walls give media different friction angles is rare; this copy runs slower, and
+ * forces.c builds in half the time). */
+static __attribute__((noinline)) void momentum_range_by_medium(const struct pair_ctx *X, struct particles *restrict P,
+                                                               size_t i, const uint32_t *restrict rng, double f[DIM],
+                                                               const double *restrict fk, double *restrict wl,
+                                                               int wendland, int cached, int implicit, int stress,
+                                                               int grains)
+{
+    momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
+                   BED_FRICTION_BY_MEDIUM, grains);
+}
+
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
                                  size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
                                  const int stress, const int friction, const int grains)
@@ -851,8 +865,7 @@ FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbou
          * the water's most, walk their pairs without them, to the same forces bit for bit. */
         if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0)) {
             if (X->bed_per_medium)
-                momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
-                               BED_FRICTION_BY_MEDIUM, grains);
+                momentum_range_by_medium(X, P, i, rng, f, fk, wl, wendland, cached, implicit, stress, grains);
             else
                 momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
                                BED_FRICTION_BY_WALL, grains);
