@@ -43,7 +43,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixsph_tools.readers import list_snapshots, read_snapshot  # noqa: E402
-from mixsph_tools.report import reproduce_command  # noqa: E402
+from mixsph_tools.report import write_report  # noqa: E402
 from mixsph_tools.runs import with_law  # noqa: E402
 
 PROG = "tools/granular_heap.py"
@@ -246,12 +246,7 @@ def main(argv=None, prog=PROG):
         lines = []
         for dx in spacings:
             lines += diagnose_one(a, dx)[0]
-        command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
-        text = "\n".join(lines) + "\n```sh\n" + command + "\n```\n"
-        print(text)
-        os.makedirs(a.out, exist_ok=True)
-        with open(os.path.join(a.out, "heap_diagnosis.md"), "w") as fo:
-            fo.write(text)
+        write_report(lines, PROG, list(argv) if argv is not None else sys.argv[1:], a.out, "heap_diagnosis.md")
         return
     rows = [run_one(a, kind, dx) for kind in ("stable", "steep") for dx in spacings]
     head = ("| heap | slope [deg] | dx [m] | status | wall [s] | t [s] | largest displacement to 2 s [dx] | "
@@ -273,15 +268,7 @@ def main(argv=None, prog=PROG):
                      f"{f(r.get('angle'), '.1f')} | "
                      f"{f(d, '+.1f')} | {f(100 * r.get('moving', math.nan), '.1f')} % | {crit} | "
                      f"{'yes' if met else '**no**'} |")
-    command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
-    text = "\n".join(lines) + "\n\n```sh\n" + command + "\n```\n"
-    print(text)
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "granular_heap.md"), "w") as fo:
-        fo.write(text)
-    if a.doc:
-        with open(a.doc, "w") as fo:
-            fo.write(text)
+    write_report(lines, PROG, list(argv) if argv is not None else sys.argv[1:], a.out, "granular_heap.md", a.doc)
     if any(r["status"] != "ok" for r in rows):
         raise SystemExit(1)
     if a.check and not ok_all:

@@ -40,7 +40,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from mixsph_tools.readers import read_monitors  # noqa: E402
-from mixsph_tools.report import reproduce_command  # noqa: E402
+from mixsph_tools.report import write_report  # noqa: E402
 from mixsph_tools.runs import with_law  # noqa: E402
 
 PROG = "tools/impulse_waves.py"
@@ -214,15 +214,7 @@ def main(argv=None, prog=PROG):
                      f"{EXPONENT[1]:g}: {'met' if ex_ok[dx] else '**not met**'}).")
     worst = max((r.get("excluded", 0.0) for r in rows), default=0.0)
     lines.append(f"Largest excluded mass: {100 * worst:.3f} % of the total.")
-    command = reproduce_command(PROG, list(argv) if argv is not None else sys.argv[1:])
-    text = "\n".join(lines) + "\n\n```sh\n" + command + "\n```\n"
-    print(text)
-    os.makedirs(a.out, exist_ok=True)
-    with open(os.path.join(a.out, "impulse_waves.md"), "w") as fo:
-        fo.write(text)
-    if a.doc:
-        with open(a.doc, "w") as fo:
-            fo.write(text)
+    write_report(lines, PROG, list(argv) if argv is not None else sys.argv[1:], a.out, "impulse_waves.md", a.doc)
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
         print(f"{prog}: failed runs: {', '.join(r['name'] + ' dx ' + format(r['dx'], 'g') for r in failed)}",

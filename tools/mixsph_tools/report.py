@@ -38,6 +38,19 @@ def reproduce_command(script, args, drop=("--mixsph", "--doc", "--out")):
     return "PYTHONPATH=$PWD .venv/bin/python " + shlex.join([script] + kept)
 
 
+def write_report(lines, script, args, out, name, doc=None):
+    """A validation script's report: its Markdown ``lines`` and the command that reproduces them
+    (``reproduce_command(script, args)``), printed, written to ``out``/``name`` and, with ``doc``,
+    to that page too. Returns the text."""
+    text = "\n".join(lines) + "\n\n```sh\n" + reproduce_command(script, args) + "\n```\n"
+    print(text)
+    os.makedirs(out, exist_ok=True)
+    for path in [os.path.join(out, name)] + ([doc] if doc else []):
+        with open(path, "w") as fo:
+            fo.write(text)
+    return text
+
+
 def fmt(v, spec, na="n/a"):
     """``format(v, spec)`` for a finite number, else ``na``."""
     return format(v, spec) if isinstance(v, (int, float)) and math.isfinite(v) else na
