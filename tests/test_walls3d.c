@@ -39,6 +39,14 @@
 
 static char err[512];
 
+/* The next uniform number in [0, 1) of a small linear congruential sequence (reproducible points
+ * for the tests below, the same on every platform). */
+static double next_uniform(unsigned *seed)
+{
+    *seed = *seed * 1103515245u + 12345u;
+    return (double)(*seed >> 8) / (double)(1u << 24);
+}
+
 /* A box wall of the case's form. */
 static struct wall box_wall(const double lo[3], const double hi[3], unsigned faces, int outside)
 {
@@ -229,8 +237,7 @@ static void test_box_signed_distance(void **state)
     for (int k = 0; k < 20000; k++) {
         double p[3];
         for (int d = 0; d < 3; d++) {
-            seed = seed * 1103515245u + 12345u;
-            p[d] = lo[d] - 0.3 + (hi[d] - lo[d] + 0.6) * (double)(seed >> 8) / (double)(1u << 24);
+            p[d] = lo[d] - 0.3 + (hi[d] - lo[d] + 0.6) * next_uniform(&seed);
         }
         int at_end;
         const double got = walls_distance(&W, 0, p, &at_end), want = box_signed_distance(p, lo, hi);
@@ -528,8 +535,7 @@ static void test_index_against_brute_force(void **state)
     for (int k = 0; k < 3000; k++) {
         double p[3];
         for (int d = 0; d < 3; d++) {
-            seed = seed * 1103515245u + 12345u;
-            const double u = (double)(seed >> 8) / (double)(1u << 24);
+            const double u = next_uniform(&seed);
             p[d] = d == 0 ? -1.0 + 6.0 * u : d == 1 ? -1.0 + 5.0 * u : 3.0 * pow(2.0 * u - 1.0, 3); /* many near z = 0 */
         }
         const double exact = mesh_distance(&copy, p, NULL, NULL), d = surface_signed_distance(&s, p, NULL);
@@ -574,8 +580,7 @@ static void test_box_filter_exact(void **state)
     for (int k = 0; k < 20000; k++) {
         double p[3];
         for (int d = 0; d < 3; d++) {
-            seed = seed * 1103515245u + 12345u;
-            p[d] = lo[d] - 0.3 + (hi[d] - lo[d] + 0.6) * (double)(seed >> 8) / (double)(1u << 24);
+            p[d] = lo[d] - 0.3 + (hi[d] - lo[d] + 0.6) * next_uniform(&seed);
         }
         const double exact = fabs(surface_signed_distance(&wl.surface, p, NULL));
         if (fabs(exact - reach) < 1e-9) continue;
