@@ -175,7 +175,7 @@ def run_one(a, kind, dx):
             if name.startswith("snap_") or name in ("run.h5", "run.xdmf", "summary.json", "monitors.csv"):
                 os.remove(os.path.join(out, name))
         cmd = [a.mixsph, "run", case, "--out", out, "--set", f"numerics.dx={dx:g}", "--threads", str(a.threads),
-               "--quiet"]
+               "--quiet"] + [w for kv in a.set for w in ("--set", kv)]
         print("$", shlex.join(cmd), flush=True)
         r = subprocess.run(cmd, capture_output=True, text=True)
         with open(os.path.join(out, "mixsph.log"), "w") as f:
@@ -232,6 +232,8 @@ def main(argv=None, prog=PROG):
     ap.add_argument("--doc", help="also write the table (with the command) to this file")
     ap.add_argument("--diagnose", action="store_true", help="the steep heap's angle over time, by variants of "
                     "the measure, its toe, speeds and floor slip (module docstring)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a case override passed to every run (mixsph run --set), e.g. media.sand.rate_dependent=1")
     ap.add_argument("--floor-friction", type=float, help="the floor's friction angle delta [deg] (default: phi)")
     a = ap.parse_args(argv)
     if not (5 < a.phi < 42 and a.dx > 0 and a.t_end > 0 and a.threads >= 1):

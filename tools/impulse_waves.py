@@ -115,7 +115,7 @@ def run_one(a, name, dx):
     summary = os.path.join(out, "summary.json")
     if not (a.reuse and os.path.isfile(summary)):
         cmd = [a.mixsph, "run", case, "--out", out, "--set", f"numerics.dx={dx:g}", "--threads", str(a.threads),
-               "--quiet"]
+               "--quiet"] + [w for kv in a.set for w in ("--set", kv)]
         print("$", shlex.join(cmd), flush=True)
         r = subprocess.run(cmd, capture_output=True, text=True)
         with open(os.path.join(out, "mixsph.log"), "w") as f:
@@ -188,6 +188,8 @@ def main(argv=None, prog=PROG):
     ap.add_argument("--out", default="out/impulse_waves")
     ap.add_argument("--reuse", action="store_true", help="read finished runs instead of running them again")
     ap.add_argument("--check", action="store_true", help="exit status 1 when a criterion fails")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a case override passed to every run (mixsph run --set), e.g. media.sand.rate_dependent=1")
     ap.add_argument("--doc", help="also write the table (with the command) to this file")
     a = ap.parse_args(argv)
     names = list(SCENARIOS) if a.scenarios == "all" else [x for x in a.scenarios.split(",") if x]

@@ -11,6 +11,9 @@
  * mixture density rho0 of (5)), the shear modulus from Poisson's ratio, G = 3 K (1 - 2 nu) /
  * (2 (1 + nu)). No viscosity (mu = 0): the waves are damped by Monaghan's artificial viscosity
  * with alpha_M c = c_p (fixed, below).
+ * With rate_dependent the cone's strength grows with the plastic shear rate, mu(I) (mu_i.h,
+ * docs/model.md [MI]): the trial returns onto the cone of cohesion k_c + dS, dS its step's rate
+ * strength, so that the static cone (I -> 0) is today's law bit for bit.
  * Walls: the rough walls' stress and their friction are the momentum pass's (docs/model.md
  * [DP-W]). Experimental: the bundled cases keep the paper's law. */
 #include <math.h>
@@ -19,6 +22,7 @@
 #include "elasticity.h"
 #include "geometry.h"
 #include "law.h"
+#include "mu_i.h"
 #include "pore_pressure.h"
 #include "status.h"
 #include "team.h"
@@ -65,13 +69,29 @@ static const struct case_key elastic_plastic_keys[] = {
                 "stress in the pair (model.md [WG]); grains (1), a parcel of grains in the water: the water's "
                 "pressure interpolated at it, no stress, Ergun's drag with grain_diameter (model.md [GW])"},
     {.key = "grain_diameter", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "if water_coupling is grains",
-     SCHEMA_RANGE(0, 1, 1, 0), .unit = "m", .field = CASE_FIELD(medium, granular.grain_diameter),
-     .meaning = "diameter d of the grains: the drag of the water through them (water_coupling grains)"},
+     SCHEMA_RANGE(0, 1, 1, 0), .def_text = "with rate_dependent: 0.0005 (Jop et al. 2006's glass beads)", .unit = "m",
+     .field = CASE_FIELD(medium, granular.grain_diameter),
+     .meaning = "diameter d of the grains: the drag of the water through them (water_coupling grains), the inertial "
+                "number I of rate_dependent"},
+    {.key = "rate_dependent", .type = CASE_BOOL, SCHEMA_DEF(0), .field = CASE_FIELD(medium, mu_i.on),
+     .meaning = "friction μ(I) = μ_s + Δμ I/(I + I_0) on the cone, of the inertial number I = γ̇_p d/√(p'/ρ_s) "
+                "(model.md [MI]; μ_s the static cone's, sin φ); else the static cone alone"},
+    {.key = "delta_mu", .type = CASE_NUMBER, SCHEMA_RANGE(0, 0, 2, 0), SCHEMA_DEF(0.26), .unit = "-",
+     .field = CASE_FIELD(medium, mu_i.delta_mu),
+     .meaning = "Δμ = μ_2 − μ_s of rate_dependent (Jop, Forterre & Pouliquen 2006, glass beads: tan 32.76° − tan "
+                "20.9° = 0.26)"},
+    {.key = "I0", .type = CASE_NUMBER, SCHEMA_RANGE(0, 1, 10, 0), SCHEMA_DEF(0.279), .unit = "-",
+     .field = CASE_FIELD(medium, mu_i.I0),
+     .meaning = "I_0 of rate_dependent: the inertial number at which half of Δμ is reached (Jop et al. 2006)"},
 };
 
 static const struct case_section elastic_plastic_section = {
     SCHEMA_SECTION("media.granular.elastic_plastic", "media.<name> of type granular, law elastic_plastic",
                    elastic_plastic_keys)};
+
+/* The grain diameter of rate_dependent when the medium gives none [m]: the glass beads whose mu(I)
+ * Jop, Forterre & Pouliquen (2006) measured, as delta_mu and I0 are theirs. */
+#define MU_I_GRAIN_DIAMETER 0.5e-3
 
 #define FAIL(ctx, ...) status_set((ctx)->err, (ctx)->err_len, MIXSPH_ERR_CASE, __VA_ARGS__)
 
@@ -97,9 +117,16 @@ static mixsph_status elastic_plastic_finish(struct medium *m, const struct law_f
         m->granular.drag_viscous = 150.0 * (1.0 - n) * (1.0 - n) / (n * d * d);
         m->granular.drag_inertial = 1.75 * (1.0 - n) / d;
         m->features |= LAW_GRAINS_IN_WATER;
-    } else if (ctx->given(ctx->entry, "grain_diameter")) {
+    } else if (ctx->given(ctx->entry, "grain_diameter") && !m->mu_i.on) {
         return FAIL(ctx, "%s: %s.grain_diameter: used only with water_coupling \"grains\" (the mixture coupling has "
-                    "no drag of its own)", ctx->origin, ctx->path);
+                    "no drag of its own) or rate_dependent", ctx->origin, ctx->path);
+    }
+    if (m->mu_i.on && !ctx->given(ctx->entry, "grain_diameter")) m->granular.grain_diameter = MU_I_GRAIN_DIAMETER;
+    if (!m->mu_i.on) {
+        const char *unused = ctx->given(ctx->entry, "delta_mu") ? "delta_mu" : ctx->given(ctx->entry, "I0") ? "I0" : NULL;
+        if (unused)
+            return FAIL(ctx, "%s: %s.%s: a parameter of the rate-dependent friction, used only with "
+                        "\"rate_dependent\": true", ctx->origin, ctx->path, unused);
     }
     m->mu = 0.0;
     /* The grains' dissipation (docs/model.md [DP-AV]): Monaghan's term with alpha_M c = c_p, the
@@ -148,12 +175,15 @@ static void plastic_range(void *arg, size_t b, size_t e)
         velocity_gradient_corrected(step->grad, i, g);
         struct deviatoric_stress s = deviatoric_stress_load(P->stress, i);
         elasticity_jaumann_step(&s, g, m->elastic.shear_modulus, dt);
-        const struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->elastic.shear_modulus,
-                                                   .alpha_phi = m->dp.alpha_phi, .k_c = m->dp.k_c,
-                                                   .alpha_psi = m->dp.alpha_psi};
+        struct drucker_prager_material dp = {.K = m->bulk_modulus, .G = m->elastic.shear_modulus,
+                                             .alpha_phi = m->dp.alpha_phi, .k_c = m->dp.k_c,
+                                             .alpha_psi = m->dp.alpha_psi};
         const double pw = fmax(pore_pressure(pore, m, P->pos[0][i], P->pos[DIM_UP][i]), 0.0);
         if (P->pore_p) P->pore_p[i] = pw; /* the bed friction's (passes/bed_friction.h) */
         double p_eff = P->p[i] - pb - pw;
+        if (m->mu_i.on) /* mu(I): the cone widened by the step's rate strength (mu_i.h; psi = 0) */
+            dp.k_c += mu_i_strength_increment(drucker_prager_sqrt_j2(&s), 3.0 * dp.alpha_phi * p_eff + dp.k_c, p_eff,
+                                              dp.G * dt, m->granular.grain_diameter, m->granular.rho_grain, &m->mu_i);
         const enum drucker_prager_outcome out = drucker_prager_return(&s, &p_eff, &dp);
         if (out == DRUCKER_PRAGER_APEX) P->p[i] = p_eff + pb + pw; /* the tension cut-off */
         plastic += out != DRUCKER_PRAGER_ELASTIC;

@@ -10,6 +10,7 @@
 #include "elasticity.h"
 #include "granular.h"
 #include "mixture_paper_params.h"
+#include "mu_i.h"
 #include "schema.h"
 
 #define MEDIUM_NAME_LEN SCHEMA_NAME_LEN
@@ -71,6 +72,7 @@ struct medium {
     struct elastic_params elastic;      /* the elastic solid and the elastic part of the
                                          * elastic-plastic law (elasticity.h) */
     struct drucker_prager_params dp;    /* the elastic-plastic law's cone (drucker_prager_params.h) */
+    struct mu_i_params mu_i;            /* its rate-dependent friction, rate_dependent (mu_i.h) */
 };
 
 /** Whether a held particle of medium m takes the kicks of its forces; `rigid`: the implicit scheme
