@@ -7,7 +7,7 @@ wave relations evaluated for the run's own slide, and plan views of the water su
         [--mixsph build/mixsph [--threads 2]] [--check]
 
 RUN is the output folder of `mixsph run cases/basin_slide_3d.json` (with --mixsph BIN the script
-runs the case into RUN first: about 20 minutes on 2 threads). A gauge's amplitude is that
+runs the case into RUN first: about 11 minutes on 2 threads). A gauge's amplitude is that
 of the leading crest: the largest value its max_elevation monitor took after the impact until it
 first falls back by a fifth of that rise (the crest has passed), minus its value at the impact (the
 first sample at which the slide's front, `slide_front`, reaches the still water line x = -0.3464
