@@ -255,6 +255,9 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     for (size_t k = 0; k < s->cfg.n_media; k++)
         if (law_get(s->cfg.media[k].law)->features & LAW_HAS_STRESS) s->phys.P.features |= PARTICLE_FEATURE_STRESS;
     if (bed_friction_on(&s->cfg)) s->phys.P.features |= PARTICLE_FEATURE_BED_FRICTION;
+    for (size_t w = 0; w < s->cfg.n_walls; w++) /* a free-slip wall mirrors about its normal (walls.h) */
+        if (s->cfg.walls[w].slip == WALL_FREE_SLIP) s->phys.P.features |= PARTICLE_FEATURE_WALL_NORMAL;
+    if (s->phys.P.features & PARTICLE_FEATURE_STRESS) s->phys.P.features |= PARTICLE_FEATURE_WALL_NORMAL;
     if (particles_alloc(&s->phys.P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
@@ -350,19 +353,6 @@ static mixsph_status create_laws(mixsph_sim *s)
             return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory (the state of the material law of medium %s)",
                             s->cfg.media[k].name);
     }
-    if (s->phys.law_features & LAW_HAS_STRESS) /* which walls take the stress of a solid (laws/law.h) */
-        for (size_t i = 0; i < s->phys.P.n; i++) {
-            struct particles *P = &s->phys.P;
-            const int wall = P->state[i] == MIXSPH_STATE_WALL;
-            const struct wall *w = wall ? &s->cfg.walls[particles_wall_index(P, i)] : NULL;
-            double n[DIM] = {0.0};
-            if (wall && w->slip == WALL_FREE_SLIP) {
-                double pos[DIM];
-                for (int d = 0; d < DIM; d++) pos[d] = P->pos[d][i];
-                walls_normal(&s->phys.walls, particles_wall_index(P, i), pos, n);
-            }
-            for (int d = 0; d < DIM; d++) P->wall_n[d][i] = n[d];
-        }
     if (s->phys.P.features & PARTICLE_FEATURE_BED_FRICTION) /* the walls' friction on grains (bed_friction.h) */
         for (size_t i = 0; i < s->phys.P.n; i++) {
             struct particles *P = &s->phys.P;
@@ -436,6 +426,8 @@ static mixsph_status sim_init(mixsph_sim *s)
                         "particles are lattice sites)", s->cfg.origin);
     if (n_wall < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for wall particles");
     s->phys.n_wall = (size_t)n_wall;
+    if (s->phys.P.features & PARTICLE_FEATURE_WALL_NORMAL) /* what the free-slip walls mirror about (walls.h) */
+        walls_set_normals(&s->phys.walls, &s->phys.P);
     set_domain(s);
     if ((st = create_laws(s)) != MIXSPH_OK) return st;
     set_scheme_params(s);

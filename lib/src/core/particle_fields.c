@@ -98,9 +98,9 @@ const struct particle_field particle_fields[] = {
      .description = "1 for a particle of a no-slip wall (its friction applies), 0 for the others",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
     {.name = "wall_normal", VECTOR(wall_n, "wall_n"), .unit = "1",
-     .description = "a free-slip wall particle's unit normal toward the solid, across which it mirrors "
-                    "the solid's stress (0 for the others)",
-     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_STRESS, .where = PF_STATE},
+     .description = "a free-slip wall particle's unit normal toward the fluid, across which it mirrors "
+                    "the velocity and a solid's stress (0 for the others)",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_WALL_NORMAL, .where = PF_STATE},
     {.name = "wall_friction", COMPONENTS1(wall_friction), .unit = "1",
      .description = "a wall particle's friction coefficient tan(delta) on grains (-1: the grains' own tan(phi), -2: none)",
      .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},

@@ -36,7 +36,8 @@ enum {
 enum {
     PARTICLE_FEATURE_IMPLICIT_VISCOUS = 1u << 0, /* numerics.viscosity = "implicit" (viscous.h) */
     PARTICLE_FEATURE_STRESS = 1u << 1,           /* a medium's law carries a stress (laws/law.h) */
-    PARTICLE_FEATURE_BED_FRICTION = 1u << 2      /* walls' Coulomb friction on grains (sim.c bed_friction_on) */
+    PARTICLE_FEATURE_BED_FRICTION = 1u << 2,     /* walls' Coulomb friction on grains (sim.c bed_friction_on) */
+    PARTICLE_FEATURE_WALL_NORMAL = 1u << 3       /* a free-slip wall or a stress to mirror (walls_set_normals) */
 };
 
 struct particle_field {

@@ -41,10 +41,10 @@ struct particles {
                                * laws with LAW_HAS_STRESS, 0 elsewhere and on walls */
     double *wall_rough;   /* wall particles: 1 on a no-slip wall, 0 on a free-slip one; 0 for the
                            * others [-] (a wall's friction applies to rough walls only) */
-    double *wall_n[DIM]; /* free-slip wall particles: their wall's unit normal
-                                                 * toward the solid, across which they mirror the stress
-                                                 * of the solid they meet (no shear); 0 for the others
-                                                 * (a no-slip wall takes the stress as it is) */
+    double *wall_n[DIM]; /* free-slip wall particles: their wall's unit normal toward the fluid
+                          * (walls_set_normals), across which they mirror the fluid's velocity and
+                          * the stress of the solid they meet (no shear); 0 for the others (a
+                          * no-slip wall takes the stress as it is) */
     double *wall_friction; /* wall particles: tan(delta) of their wall's friction angle on every medium, or
                             * -1 where the wall takes the friction angle of the grains it meets, -2 where
                             * it bounds nothing; 0 for the others [-] (docs/model.md [BF]); the momentum

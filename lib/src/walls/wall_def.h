@@ -46,10 +46,8 @@ struct wall {
     int flip;                 /* stl: the fluid is behind the facets' normals (right-hand rule) */
     struct surface surface;   /* 3D: the wall's triangles, normals toward the fluid (wall_surface_build) */
     int motion;               /* index into the case's motions, -1 for a fixed wall */
-    int slip;                 /* enum wall_slip */
-    int symmetry;             /* 3D: a plane of symmetry (the free-slip side walls of an extruded
-                               * polyline): its particles carry the fluid's velocity mirrored
-                               * across it in every pair term (walls.c, walls_extrapolate_fluid) */
+    int slip;                 /* enum wall_slip; a free-slip wall's particles carry the fluid's
+                               * velocity mirrored across it in every pair term (walls.h) */
     double friction_deg;      /* friction angle delta on grains [deg] (the number form of its key); NaN: not given */
     double friction_of_medium_deg[WALL_MEDIA_MAX]; /* delta on the grains of each medium of the case [deg]: the
                                                     * one its key names for it, else friction_deg; NaN: the

@@ -80,7 +80,6 @@ mixsph_status wall_side_walls(const struct wall *flume, struct wall *sides, char
                            .y_max = NAN,
                            .motion = -1,
                            .slip = flume->side_walls,
-                           .symmetry = flume->side_walls == WALL_FREE_SLIP,
                            .friction_deg = flume->friction_deg};
     memcpy(sides->friction_of_medium_deg, flume->friction_of_medium_deg, sizeof sides->friction_of_medium_deg);
     const size_t len = strlen(flume->name); /* checked above: the name and "_sides" fit */

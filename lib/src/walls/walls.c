@@ -5,8 +5,10 @@
  * their pressure is extrapolated from the fluid (Adami, Hu & Adams 2012, J. Comput. Phys. 231, eq. 27):
  *     p_w = [ sum_f p_f W_wf + (g - a_w) . sum_f rho_f (x_w - x_f) W_wf ] / sum_f W_wf
  * clamped at 0 (no suction at walls), and their velocity in viscous terms is the no-slip mirror
- * 2 v_wall - v~ (v~ the kernel average of the fluid velocity) or v~ for free slip; their density
- * (used by the artificial viscosity only) is the kernel average of the fluid's.
+ * 2 v_wall - v~ (v~ the kernel average of the fluid velocity); on a free-slip wall the mirror image
+ * of the fluid across the wall, v~ - 2 ((v~ - v_wall) . n) n, in every pair term (viscous,
+ * continuity, artificial viscosity), so that no pair term sees a tangential jump across it; their
+ * density (used by the artificial viscosity only) is the kernel average of the fluid's.
  * Moving walls (the Vajont plate) translate with a prescribed piecewise-linear velocity law.
  * On top of the pressure barrier, a geometric guarantee: a particle whose step would cross a
  * wall segment (in the wall's frame) is put back on the fluid side at 0.1 dx and loses its
@@ -35,6 +37,16 @@ static inline void from_plane(double x, double z, double v[DIM])
     for (int d = 0; d < DIM; d++) v[d] = 0.0;
     v[0] = x;
     v[DIM_UP] = z;
+}
+
+/* How a free-slip wall particle's mirror image of the fluid, v~ - 2 ((v~ - v_w) . n) n, changes
+ * when its wall's velocity changes by dv: by 2 (dv . n) n (n = P->wall_n). */
+static void mirror_shift(const struct particles *P, size_t i, const double dv[DIM], double shift[DIM])
+{
+    double n[DIM];
+    for (int d = 0; d < DIM; d++) n[d] = P->wall_n[d][i];
+    const double dvn = dot(dv, n);
+    for (int d = 0; d < DIM; d++) shift[d] = 2.0 * dvn * n[d];
 }
 
 #if DIM == 2
@@ -111,7 +123,7 @@ void walls_init(struct walls *W, const struct wall *def, size_t n, const struct 
 void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const double a[DIM], struct particles *P)
 {
     struct wall_state *ws = &W->state[w];
-    const double mirror = W->def[w].slip == WALL_NO_SLIP ? 2.0 : 0.0; /* d u_g / d v_w */
+    const int noslip = W->def[w].slip == WALL_NO_SLIP;
     double dv[DIM];
     for (int d = 0; d < DIM; d++) {
         dv[d] = v[d] - ws->v[d];
@@ -120,9 +132,18 @@ void walls_change_velocity(struct walls *W, size_t w, const double v[DIM], const
     }
     for (size_t i = 0; i < P->n; i++) {
         if (P->state[i] != MIXSPH_STATE_WALL || particles_wall_index(P, i) != w) continue;
-        for (int d = 0; d < DIM; d++) {
-            P->vel[d][i] = v[d];
-            P->uv[d][i] += mirror * dv[d];
+        if (noslip) {
+            for (int d = 0; d < DIM; d++) {
+                P->vel[d][i] = v[d];
+                P->uv[d][i] += 2.0 * dv[d]; /* d u_g / d v_w = 2 I */
+            }
+        } else {
+            double shift[DIM];
+            mirror_shift(P, i, dv, shift);
+            for (int d = 0; d < DIM; d++) {
+                P->vel[d][i] += shift[d];
+                P->uv[d][i] += shift[d];
+            }
         }
     }
 }
@@ -464,14 +485,16 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
 {
     struct wall_state *wstate = W->state;
     int moving = 0;
-    double shift[WALLS_MAX][DIM] = {{0}}, force[WALLS_MAX][DIM] = {{0}};
+    double shift[WALLS_MAX][DIM] = {{0}}, force[WALLS_MAX][DIM] = {{0}}, dv[WALLS_MAX][DIM] = {{0}};
     for (size_t w = 0; w < W->n; w++) {
         const int mo = W->def[w].motion;
         if (mo < 0) continue;
         const struct motion *m = &W->motions[mo];
         struct wall_state *ws = &wstate[w];
         double v[DIM]; /* the velocity over the step */
+        for (int d = 0; d < DIM; d++) dv[w][d] = -ws->v[d];
         step_end_velocity(m, ws, t_from, dt, ws->v);
+        for (int d = 0; d < DIM; d++) dv[w][d] += ws->v[d];
         if (ws->ext) {
             for (int d = 0; d < DIM; d++) {
                 v[d] = ws->v[d];
@@ -495,7 +518,13 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
         for (int d = 0; d < DIM; d++) {
             force[w][d] += P->acc[d][i];
             P->pos[d][i] += shift[w][d];
-            P->vel[d][i] = wstate[w].v[d];
+        }
+        if (W->def[w].slip == WALL_NO_SLIP) {
+            for (int d = 0; d < DIM; d++) P->vel[d][i] = wstate[w].v[d];
+        } else { /* the mirror of the last wall pass, about the wall's new velocity */
+            double vs[DIM];
+            mirror_shift(P, i, dv[w], vs);
+            for (int d = 0; d < DIM; d++) P->vel[d][i] += vs[d];
         }
     }
     for (size_t w = 0; w < W->n; w++) wstate[w].work -= dot(force[w], shift[w]);
@@ -591,19 +620,14 @@ static inline void separation(const struct particles *P, size_t i, size_t j, dou
     for (int d = 0; d < DIM; d++) r[d] = P->pos[d][i] - P->pos[d][j];
 }
 
-/* A wall particle's velocity in the viscous terms from the fluid's kernel average: the mirror
- * about the wall's velocity (no-slip: the average at the wall is its velocity) or the average
- * itself (free slip: no shear across it). */
-static inline double mirror_velocity(int noslip, double v_wall, double v_fluid)
-{
-    return noslip ? 2.0 * v_wall - v_fluid : v_fluid;
-}
-
-/* A free-slip wall particle's velocity v seen by a solid, which has a stress: besides the fluid's
- * tangential velocity, its normal velocity mirrored about the wall's, so that a solid pressing
- * on the wall is strained by it (its velocity gradient) as by its mirror image. n = 0 leaves v
- * as it is. */
-static inline void mirror_normal_velocity(const double n[DIM], const double v_wall[DIM], double v[DIM])
+/* A free-slip wall particle's velocity: the mirror image across the wall (unit normal n, 0 for
+ * none) of the fluid's velocity v, about the wall's velocity: the tangential part kept, the normal
+ * part relative to the wall reversed. With the wall's own velocity instead, the continuity
+ * equation and the artificial viscosity saw a jump of the tangential velocity across the wall,
+ * and the artificial viscosity of the wall pairs was a tangential drag (docs/model.md section 8);
+ * with v itself the normal part had no jump, so a solid pressing on the wall was not strained
+ * by it (its velocity gradient) as by its mirror image. */
+static inline void mirror_image(const double n[DIM], const double v_wall[DIM], double v[DIM])
 {
     double dv[DIM];
     for (int d = 0; d < DIM; d++) dv[d] = v[d] - v_wall[d];
@@ -611,23 +635,18 @@ static inline void mirror_normal_velocity(const double n[DIM], const double v_wa
     for (int d = 0; d < DIM; d++) v[d] -= 2.0 * vn * n[d];
 }
 
-#if DIM == 3
-/* The unit normal toward the fluid of the face of box wall wl (a plane of symmetry, fluid inside)
- * behind which wall particle i lies (the faces it is behind, summed and normalised at a corner). */
-static void symmetry_normal(const struct wall *wl, const struct particles *P, size_t i, double n[DIM])
+void walls_set_normals(const struct walls *W, struct particles *P)
 {
-    double len2 = 0.0;
-    for (int d = 0; d < DIM; d++) {
-        const unsigned lo_face = MESH_BOX_XMIN << (2 * d), hi_face = MESH_BOX_XMAX << (2 * d);
-        n[d] = (wl->box_faces & lo_face) && P->pos[d][i] < wl->box_min[d]   ? 1.0
-               : (wl->box_faces & hi_face) && P->pos[d][i] > wl->box_max[d] ? -1.0
-                                                                            : 0.0;
-        len2 += n[d] * n[d];
+    for (size_t i = 0; i < P->n; i++) {
+        double n[DIM] = {0.0};
+        if (P->state[i] == MIXSPH_STATE_WALL && W->def[particles_wall_index(P, i)].slip == WALL_FREE_SLIP) {
+            double pos[DIM];
+            for (int d = 0; d < DIM; d++) pos[d] = P->pos[d][i];
+            walls_normal(W, particles_wall_index(P, i), pos, n);
+        }
+        for (int d = 0; d < DIM; d++) P->wall_n[d][i] = n[d];
     }
-    const double inv = len2 > 0.0 ? 1.0 / sqrt(len2) : 0.0;
-    for (int d = 0; d < DIM; d++) n[d] *= inv;
 }
-#endif
 
 /* The arguments of a parallel loop of this file (core/team.h). */
 /* The parallel loops of this file (core/team.h), each with its own arguments. */
@@ -697,11 +716,15 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
         if (sw > 0.0) {
             const double pw = sp / sw;
             P->p[i] = pw > 0.0 ? pw : 0.0;
-            for (int d = 0; d < DIM; d++) uv[d] = mirror_velocity(noslip, ws->v[d], sv[d] / sw);
-            if (P->wall_n[0] && !noslip) { /* a wall that mirrors a solid's stress (particles.h) */
+            if (noslip) {
+                for (int d = 0; d < DIM; d++) uv[d] = 2.0 * ws->v[d] - sv[d] / sw;
+            } else {
                 double n[DIM];
-                for (int d = 0; d < DIM; d++) n[d] = P->wall_n[d][i];
-                mirror_normal_velocity(n, ws->v, uv);
+                for (int d = 0; d < DIM; d++) {
+                    uv[d] = sv[d] / sw;
+                    n[d] = P->wall_n[d][i];
+                }
+                mirror_image(n, ws->v, uv);
             }
             P->rho[i] = srho / sw;
         } else {
@@ -709,19 +732,9 @@ static void extrapolate_range(void *arg, size_t b, size_t e)
             P->rho[i] = rho_alone;
             for (int d = 0; d < DIM; d++) uv[d] = ws->v[d];
         }
-#if DIM == 3
-        /* a plane of symmetry: the mirror image of the fluid's velocity (its normal part mirrored
-         * above when a solid's stress needs wall_n), in the viscous and every other pair term */
-        if (W->def[w].symmetry) {
-            if (sw > 0.0 && !P->wall_n[0]) {
-                double n[DIM];
-                symmetry_normal(&W->def[w], P, i, n);
-                mirror_normal_velocity(n, ws->v, uv);
-            }
-            for (int d = 0; d < DIM; d++) P->vel[d][i] = uv[d];
-        }
-#endif
         for (int d = 0; d < DIM; d++) P->uv[d][i] = uv[d];
+        if (!noslip) /* the mirror image in every pair term (walls.h) */
+            for (int d = 0; d < DIM; d++) P->vel[d][i] = uv[d];
         P->m[i] = P->rho[i] * vol; /* the mass seen by the artificial viscosity */
         P->inv_rho[i] = 1.0 / P->rho[i];
     }
@@ -780,6 +793,7 @@ int walls_mirror_build(struct wall_mirror *M, const struct walls *W, const struc
     M->n_rows = 0;
     for (size_t i = 0; i < n; i++)
         if (P->state[i] == MIXSPH_STATE_WALL) M->rows[M->n_rows++] = i;
+    for (int d = 0; d < DIM; d++) M->normal[d] = P->wall_n[d];
     struct mirror_weights_loop L = {.W = W, .K = K, .G = G, .P = P, .M = M};
     team_for(n_threads, M->n_rows, mirror_weights_range, &L);
     return 0;
@@ -823,8 +837,16 @@ static void mirror_at_range(void *arg, size_t b, size_t e)
     for (size_t r = b; r < e; r++) {
         const size_t i = M->rows[r];
         const size_t w = particles_wall_index(P, i);
-        const int noslip = W->def[w].slip == WALL_NO_SLIP;
-        for (int d = 0; d < DIM; d++) M->c[d][i] = M->sign[i] ? mirror_velocity(noslip, v[w][d], 0.0) : v[w][d];
+        if (!M->sign[i]) { /* no fluid around it: the wall's velocity */
+            for (int d = 0; d < DIM; d++) M->c[d][i] = v[w][d];
+        } else if (W->def[w].slip == WALL_NO_SLIP) {
+            for (int d = 0; d < DIM; d++) M->c[d][i] = 2.0 * v[w][d];
+        } else { /* the mirror image's part from the wall's velocity, 2 (v_w . n) n */
+            double n[DIM];
+            for (int d = 0; d < DIM; d++) n[d] = P->wall_n[d][i];
+            const double vn = dot(v[w], n);
+            for (int d = 0; d < DIM; d++) M->c[d][i] = 2.0 * vn * n[d];
+        }
     }
 }
 
@@ -862,6 +884,12 @@ static void mirror_apply_range(void *arg, size_t b, size_t e)
         for (size_t k = G->start[i]; k < G->start[i + 1]; k++) {
             const size_t j = G->list[k];
             for (int d = 0; d < DIM; d++) av[d] += M->weight[k] * v[d][j];
+        }
+        if (M->sign[i] > 0) { /* free slip: R a u, the reflection across the wall */
+            double n[DIM];
+            for (int d = 0; d < DIM; d++) n[d] = M->normal[d][i];
+            const double an = dot(av, n);
+            for (int d = 0; d < DIM; d++) av[d] -= 2.0 * an * n[d];
         }
         for (int d = 0; d < DIM; d++) v[d][i] = c * M->c[d][i] + M->sign[i] * av[d];
     }

@@ -105,21 +105,34 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt);
 void walls_keep_fluid_side(const struct walls *W, const double (*o_old)[DIM], double gap, const double p0[DIM],
                            double p1[DIM], double v[DIM], long *clips);
 
+/** Every particle's wall normal P->wall_n (the field must be there when a wall is free-slip):
+ *  on a free-slip wall's particle its wall's unit normal toward the fluid at the point of the
+ *  wall nearest to it (walls_normal: at a polyline's vertex or a surface's edge or corner the
+ *  normalised sum of the faces' normals), 0 elsewhere. Once, after walls_generate: walls only
+ *  translate. */
+void walls_set_normals(const struct walls *W, struct particles *P);
+
 /** The state of the first n particles' wall particles from the fluid around them (Adami et
- *  al. 2012): pressure, viscous (mirror) velocity uv, density and the mass the artificial
- *  viscosity sees. Needs the gather lists of G. */
+ *  al. 2012): pressure, density and the mass the artificial viscosity sees, and their velocity
+ *  from the kernel average v~ of the fluid's: on a no-slip wall uv = 2 v_wall - v~ in the viscous
+ *  terms (vel stays the wall's own); on a free-slip wall the mirror image of the fluid across
+ *  the wall, v~ - 2 ((v~ - v_wall) . n) n (n = P->wall_n), as both uv and vel, so that every
+ *  pair term (viscous, continuity, artificial viscosity) sees no tangential jump across it.
+ *  Needs the gather lists of G. */
 void walls_extrapolate_fluid(const struct walls *W, const struct kernel *K,
                              const struct gather *G, double dx, struct particles *P, size_t n, int n_threads);
 
 /* The wall particles' velocity in the viscous terms as the affine map of the non-wall
  * velocities that walls_extrapolate_fluid evaluates, for a solve whose unknowns are those
  * velocities (viscous.h): wall particle g takes
- *     u_g = c_g + s_g sum_k a_gk u_k,   a_gk = W_gk / sum_k W_gk over its non-wall neighbours,
- * with s_g = -1, c_g = 2 v_w (no-slip) or s_g = +1, c_g = 0 (free slip), v_w its wall's
- * velocity at the end of the step; a wall particle with no non-wall neighbour takes v_w. */
+ *     u_g = c_g + s_g R_g sum_k a_gk u_k,   a_gk = W_gk / sum_k W_gk over its non-wall neighbours,
+ * with s_g = -1, R_g = I, c_g = 2 v_w (no-slip) or s_g = +1, R_g = I - 2 n n^T, c_g = 2 (v_w . n) n
+ * (free slip: the reflection across the wall, n = P->wall_n), v_w its wall's velocity at the end
+ * of the step; a wall particle with no non-wall neighbour takes v_w. */
 struct wall_mirror {
     double *weight;      /* a_gk, aligned with the gather list */
     double *c[DIM];      /* c_g [m/s] */
+    const double *normal[DIM]; /* n of R_g: P->wall_n at the last build (NULL with no free-slip wall) */
     signed char *sign;   /* s_g */
     size_t *rows;        /* the wall particles among the first n, in order */
     size_t n_rows;
