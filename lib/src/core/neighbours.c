@@ -110,7 +110,7 @@ static void relist_range(void *arg, size_t b, size_t e)
 int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads)
 {
     struct nb_loop L = {.NB = NB, .C = C, .rc2 = rc * rc};
-    team_for(n_threads > 0 ? n_threads : 1, n, relist_range, &L);
+    team_for_dynamic(n_threads > 0 ? n_threads : 1, n, relist_range, &L);
     NB->builds++;
     return 0;
 }
@@ -232,7 +232,7 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
 {
     struct nb_loop L = {.cNB = NB, .G = G, .C = C, .state = state, .rc2 = rc * rc};
     n_threads = n_threads > 0 ? n_threads : 1;
-    team_for(n_threads, n, gather_ranges_range, &L);
+    team_for_dynamic(n_threads, n, gather_ranges_range, &L);
     G->start[0] = 0;
     for (size_t i = 0; i < n; i++) G->start[i + 1] += G->start[i];
     const size_t total = G->start[n];
@@ -241,7 +241,7 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
         if (grow((void **)&G->list, cap, sizeof(uint32_t))) return -1;
         G->cap_list = cap;
     }
-    team_for(n_threads, n, gather_list_range, &L);
+    team_for_dynamic(n_threads, n, gather_list_range, &L);
     return 0;
 }
 
@@ -294,7 +294,7 @@ int neighbours_pair_list_build(struct pair_list *PL, const struct neighbours *NB
     }
     struct nb_loop L = {.cNB = NB, .state = state, .L = PL, .rc2 = rc * rc};
     n_threads = n_threads > 0 ? n_threads : 1;
-    team_for(n_threads, n, pair_count_range, &L); /* a particle's count fits: its ranges are uint32 */
+    team_for_dynamic(n_threads, n, pair_count_range, &L); /* a particle's count fits: its ranges are uint32 */
     uint64_t total = 0;
     PL->start[0] = 0;
     for (size_t i = 0; i < n; i++) {
@@ -307,7 +307,7 @@ int neighbours_pair_list_build(struct pair_list *PL, const struct neighbours *NB
         if (grow((void **)&PL->j, cap, sizeof(uint32_t))) return -1;
         PL->cap_j = cap;
     }
-    team_for(n_threads, n, pair_fill_range, &L);
+    team_for_dynamic(n_threads, n, pair_fill_range, &L);
     memset(PL->j + total, 0, NEIGHBOURS_PAD * sizeof(uint32_t));
     PL->n = n;
     PL->builds = NB->builds;

@@ -126,6 +126,7 @@ struct forces {
     struct pair_list list;    /* 3D: the pair list of the current neighbour lists (pair_list_attach) */
 #if DIM == 3
     struct pair_blocks blocks; /* 3D: the threads' blocks of that list (neighbours.h) */
+    int fk_layout_ok;          /* 3D: fk_off is the lane layout of that list (made once per list) */
 #endif
 };
 
@@ -1101,6 +1102,9 @@ int forces_viscous_ready(const struct forces *F) { return F->visc_valid; }
  * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
 static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struct neighbours *NB, size_t n)
 {
+#if DIM == 3 /* the list's layout, kept until the list is made again (pair_list_attach) */
+    if (F->fk_layout_ok) return 0;
+#endif
     if (F->fk_off_cap < n + 1) {
         size_t *o = realloc(F->fk_off, (n + 1) * sizeof *o);
         if (!o) return -1;
@@ -1125,6 +1129,9 @@ static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struc
         F->fk_cap = F->fk ? cap : 0;
         if (!F->fk) return -1;
     }
+#if DIM == 3
+    F->fk_layout_ok = 1;
+#endif
     return 0;
 }
 
@@ -1137,6 +1144,7 @@ static int pair_list_attach(struct forces *F, const struct pair_system *S, size_
     struct pair_list *L = &F->list;
     /* the cells' row spacing is the lists' cut-off, 2h + skin (sim.c) */
     if (!L->valid || L->builds != S->NB->builds || L->n != n) {
+        F->fk_layout_ok = 0;
         if (neighbours_pair_list_build(L, S->NB, S->P->state, n, S->C->size, S->n_threads) != 0 ||
             neighbours_pair_blocks_build(&F->blocks, L, S->C) != 0) {
             L->valid = 0;
