@@ -13,8 +13,8 @@
  * can have come closer than 2h unseen), so the sort and the build run once every many steps:
  * in this model the time step is set by the viscosity of the grains or by the sound speed, and a
  * particle moves a small fraction of h per step. Between builds particles keep their memory
- * order and the cells keep describing the build positions; bands of cell rows are fixed index
- * ranges, so the threads' write sets stay disjoint (forces.c). */
+ * order and the cells keep describing the build positions; bands of cell rows (3D: the blocks
+ * below) are fixed index ranges, so the threads' write sets stay disjoint (forces.c). */
 #ifndef MIXSPH_NEIGHBOURS_H
 #define MIXSPH_NEIGHBOURS_H
 #include <stddef.h>

@@ -36,7 +36,9 @@
  *
  * Threads: the grid is cut into bands of two cell rows (index ranges fixed at the last build); a
  * band writes its own rows and the row above, so even bands never touch each other, nor odd bands: even bands run in parallel, then
- * odd bands. The bands do not depend on the thread count and each band is walked in memory
+ * odd bands. In 3D the bands are the pair list's blocks instead (neighbours.h: one layer and two
+ * search radii along x or y, in four colours run one after the other), so that two threads find
+ * several loaded blocks in each phase. The bands do not depend on the thread count and each band is walked in memory
  * order, so every particle receives its contributions in the same order whatever the number of
  * threads: results are bit-identical for any thread count.
  *
