@@ -4,6 +4,8 @@
  *     quadrature of the radial integrals, exact for these piecewise polynomials (to 1e-10);
  *   - the neighbour and gather ranges against brute force on a random cloud (every pair closer
  *     than the cut-off exactly once in the half stencils, every neighbour in the gather ranges);
+ *   - in 3D, the threads' blocks of the pair list: each particle in one block, no particle written
+ *     by two blocks of one colour;
  *   - the Jaumann rotation of a stressed block spun about each axis (the out-of-plane one in 2D)
  *     against the exact rotation by the Hughes-Winget angle 2 atan(w dt / 2) per step. */
 #include <math.h>
@@ -178,6 +180,86 @@ static void test_neighbours_brute_force(void **state)
     particles_free(&P);
 }
 
+
+#if DIM == 3
+/* The threads' blocks of the 3D pair loops (neighbours.h) on random clouds in two boxes, one
+ * longer along x (blocks cut along x) and one along y (cut along y), for kx = 1 and 2: every
+ * active particle in exactly one block; two blocks of one colour never write the same particle
+ * (a block writes its particles and their pair-list entries: the property that lets a colour's
+ * blocks run in parallel and keeps results independent of the thread count); within a colour the
+ * blocks by descending work (pair-list entries plus particles). */
+static void test_pair_blocks(void **state)
+{
+    (void)state;
+    const size_t n = 6000;
+    const double rc = 0.1, lo[DIM] = {0.0};
+    const double boxes[2][DIM] = {{1.0, 0.4, 0.6}, {0.4, 1.0, 0.6}};
+    for (int box = 0; box < 2; box++)
+        for (int kx = 1; kx <= 2; kx++) {
+            struct particles P;
+            memset(&P, 0, sizeof P);
+            uint64_t seed = 777 + (uint64_t)box;
+            for (size_t k = 0; k < n; k++) {
+                double p[DIM];
+                for (int d = 0; d < DIM; d++) p[d] = test_random_uniform(&seed, lo[d], boxes[box][d]);
+                assert_true(particles_push(&P, p, 1000.0, 1.0, 0, MIXSPH_STATE_MOBILE) != (size_t)-1);
+            }
+            struct cells C;
+            struct neighbours NB = {0};
+            assert_int_equal(cells_init_columns(&C, lo, boxes[box], rc, kx), 0);
+            assert_true(cells_build(&C, &P) >= 0);
+            const size_t active = C.start[C.ncell];
+            assert_int_equal(neighbours_build(&NB, &C, &P, active, rc, 2), 0);
+            uint8_t *st = malloc(n);
+            for (size_t i = 0; i < n; i++) st[i] = P.id[i] % 3 == 0 ? MIXSPH_STATE_WALL : MIXSPH_STATE_MOBILE;
+            struct pair_list PL = {0};
+            struct pair_blocks B = {0};
+            assert_int_equal(neighbours_pair_list_build(&PL, &NB, st, active, rc, 2), 0);
+            assert_int_equal(neighbours_pair_blocks_build(&B, &PL, &C), 0);
+            assert_int_equal(B.axis, box == 0 ? 0 : 1);
+            long *walked = calloc(n, sizeof *walked), *writer = malloc(n * sizeof *writer);
+            for (int c = 0; c < NEIGHBOURS_COLOURS; c++) {
+                for (size_t i = 0; i < n; i++) writer[i] = -1;
+                assert_true(B.first[c + 1] > B.first[c] + 4); /* several blocks in every colour */
+                uint64_t prev_work = UINT64_MAX;
+                for (size_t b = B.first[c]; b < B.first[c + 1]; b++) {
+                    uint64_t work = 0;
+                    for (size_t q = 0; q < neighbours_block_ranges(&B, &C); q++) {
+                        const struct range r = neighbours_block_range(&B, &C, b, q);
+                        work += r.end - r.begin + PL.start[r.end] - PL.start[r.begin];
+                        for (size_t i = r.begin; i < r.end; i++) {
+                            walked[i]++;
+                            assert_true(writer[i] == -1 || writer[i] == (long)b);
+                            writer[i] = (long)b;
+                            for (uint32_t k = PL.start[i]; k < PL.start[i + 1]; k++) {
+                                const uint32_t j = PL.j[k];
+                                if (writer[j] != -1 && writer[j] != (long)b)
+                                    fail_msg("box %d, kx %d: particle %u written by blocks %ld and %zu of colour %d", box,
+                                             kx, j, writer[j], b, c);
+                                writer[j] = (long)b;
+                            }
+                        }
+                    }
+                    assert_true(work > 0 && work <= prev_work);
+                    prev_work = work;
+                }
+            }
+            for (size_t i = 0; i < n; i++) assert_int_equal(walked[i], 1);
+            print_message("box %d, kx %d: axis %d, blocks per colour %zu %zu %zu %zu\n", box, kx, B.axis,
+                          B.first[1] - B.first[0], B.first[2] - B.first[1], B.first[3] - B.first[2],
+                          B.first[4] - B.first[3]);
+            free(walked);
+            free(writer);
+            free(st);
+            neighbours_pair_blocks_free(&B);
+            neighbours_pair_list_free(&PL);
+            neighbours_free(&NB);
+            cells_free(&C);
+            particles_free(&P);
+        }
+}
+#endif
+
 /* R s R^T of a full 3x3 s. */
 static void rotate3(double R[3][3], const double s[3][3], double out[3][3])
 {
@@ -247,6 +329,9 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_kernel_normalisation),
         cmocka_unit_test(test_neighbours_brute_force),
+#if DIM == 3
+        cmocka_unit_test(test_pair_blocks),
+#endif
         cmocka_unit_test(test_jaumann_rotation),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

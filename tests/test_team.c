@@ -122,6 +122,24 @@ static void test_for(void **state)
         }
 }
 
+/* team_for_dynamic covers every item once and no more, for counts around its smallest chunk and
+ * for many chunks per thread. */
+static void test_for_dynamic(void **state)
+{
+    (void)state;
+    static const size_t counts[] = {0, 1, TEAM_CHUNK_MIN, TEAM_CHUNK_MIN + 1, 5000, 100003};
+    for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        for (int th = 1; th <= 4; th++) {
+            const size_t n = counts[c];
+            struct range_arg A = {calloc(n + 1, 1)};
+            assert_non_null(A.hit);
+            team_for_dynamic(th, n, mark, &A);
+            for (size_t i = 0; i < n; i++) assert_int_equal(A.hit[i], 1);
+            assert_int_equal(A.hit[n], 0);
+            free(A.hit);
+        }
+}
+
 static void *host_thread(void *arg)
 {
     int *ok = arg;
@@ -145,6 +163,7 @@ static void test_two_hosts(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_regions), cmocka_unit_test(test_for),
+                                       cmocka_unit_test(test_for_dynamic),
                                        cmocka_unit_test(test_two_hosts)};
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

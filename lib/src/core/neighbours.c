@@ -110,7 +110,7 @@ static void relist_range(void *arg, size_t b, size_t e)
 int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, double rc, int n_threads)
 {
     struct nb_loop L = {.NB = NB, .C = C, .rc2 = rc * rc};
-    team_for(n_threads > 0 ? n_threads : 1, n, relist_range, &L);
+    team_for_dynamic(n_threads > 0 ? n_threads : 1, n, relist_range, &L);
     NB->builds++;
     return 0;
 }
@@ -232,7 +232,7 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
 {
     struct nb_loop L = {.cNB = NB, .G = G, .C = C, .state = state, .rc2 = rc * rc};
     n_threads = n_threads > 0 ? n_threads : 1;
-    team_for(n_threads, n, gather_ranges_range, &L);
+    team_for_dynamic(n_threads, n, gather_ranges_range, &L);
     G->start[0] = 0;
     for (size_t i = 0; i < n; i++) G->start[i + 1] += G->start[i];
     const size_t total = G->start[n];
@@ -241,7 +241,7 @@ int neighbours_gather_build(struct gather *G, const struct neighbours *NB, const
         if (grow((void **)&G->list, cap, sizeof(uint32_t))) return -1;
         G->cap_list = cap;
     }
-    team_for(n_threads, n, gather_list_range, &L);
+    team_for_dynamic(n_threads, n, gather_list_range, &L);
     return 0;
 }
 
@@ -294,7 +294,7 @@ int neighbours_pair_list_build(struct pair_list *PL, const struct neighbours *NB
     }
     struct nb_loop L = {.cNB = NB, .state = state, .L = PL, .rc2 = rc * rc};
     n_threads = n_threads > 0 ? n_threads : 1;
-    team_for(n_threads, n, pair_count_range, &L); /* a particle's count fits: its ranges are uint32 */
+    team_for_dynamic(n_threads, n, pair_count_range, &L); /* a particle's count fits: its ranges are uint32 */
     uint64_t total = 0;
     PL->start[0] = 0;
     for (size_t i = 0; i < n; i++) {
@@ -307,10 +307,89 @@ int neighbours_pair_list_build(struct pair_list *PL, const struct neighbours *NB
         if (grow((void **)&PL->j, cap, sizeof(uint32_t))) return -1;
         PL->cap_j = cap;
     }
-    team_for(n_threads, n, pair_fill_range, &L);
+    team_for_dynamic(n_threads, n, pair_fill_range, &L);
     memset(PL->j + total, 0, NEIGHBOURS_PAD * sizeof(uint32_t));
     PL->n = n;
     PL->builds = NB->builds;
     PL->valid = 1;
     return 0;
 }
+
+#if DIM == 3
+void neighbours_pair_blocks_free(struct pair_blocks *B)
+{
+    free(B->block);
+    memset(B, 0, sizeof *B);
+}
+
+/* A block's place in the schedule: its colour, then its work (descending), then its place in the
+ * grid, so that the order is total and depends on nothing but the lists. */
+struct block_key {
+    uint64_t work;
+    uint32_t colour, place;
+};
+
+static int block_key_cmp(const void *a, const void *b)
+{
+    const struct block_key *p = a, *q = b;
+    if (p->colour != q->colour) return p->colour < q->colour ? -1 : 1;
+    if (p->work != q->work) return p->work > q->work ? -1 : 1;
+    return p->place < q->place ? -1 : p->place > q->place;
+}
+
+int neighbours_pair_blocks_build(struct pair_blocks *B, const struct pair_list *L, const struct cells *C)
+{
+    /* the longer of x and y, in search radii; 2 radii per block along it */
+    B->axis = (size_t)C->n[0] > (size_t)C->kx * (size_t)C->n[1] ? 0 : 1;
+    const uint32_t width = B->axis == 0 ? 2u * (uint32_t)C->kx : 2u;
+    const uint32_t cells = (uint32_t)C->n[B->axis], layers = (uint32_t)C->n[DIM_UP];
+    const size_t per_layer = (cells + width - 1) / width, total = per_layer * layers;
+    struct block_key *key = malloc((total > 0 ? total : 1) * sizeof *key);
+    if (!key) return -1;
+    if (total > B->cap) {
+        free(B->block);
+        B->block = malloc(total * sizeof *B->block);
+        B->cap = B->block ? total : 0;
+        if (!B->block) {
+            free(key);
+            return -1;
+        }
+    }
+    size_t kept = 0;
+    for (uint32_t z = 0; z < layers; z++)
+        for (uint32_t a = 0; a < per_layer; a++) {
+            const size_t b = kept;
+            B->block[b][0] = a * width;
+            B->block[b][1] = a * width + width < cells ? a * width + width : cells;
+            B->block[b][2] = z;
+            uint64_t particles = 0, entries = 0;
+            for (size_t k = 0; k < neighbours_block_ranges(B, C); k++) {
+                const struct range r = neighbours_block_range(B, C, b, k);
+                particles += r.end - r.begin;
+                entries += (uint64_t)L->start[r.end] - L->start[r.begin];
+            }
+            if (particles == 0) continue;
+            key[b] = (struct block_key){.work = entries + particles, .colour = (z & 1u) * 2u + (a & 1u),
+                                        .place = (uint32_t)b};
+            kept++;
+        }
+    qsort(key, kept, sizeof *key, block_key_cmp);
+    /* reorder the blocks by their keys (a copy through the keys' places, which are the old indices) */
+    uint32_t(*old)[3] = malloc((kept > 0 ? kept : 1) * sizeof *old);
+    if (!old) {
+        free(key);
+        return -1;
+    }
+    memcpy(old, B->block, kept * sizeof *old);
+    for (int c = 0; c <= NEIGHBOURS_COLOURS; c++) B->first[c] = 0;
+    for (size_t k = 0; k < kept; k++) {
+        memcpy(B->block[k], old[key[k].place], sizeof *old);
+        B->first[key[k].colour + 1]++;
+    }
+    for (int c = 0; c < NEIGHBOURS_COLOURS; c++) B->first[c + 1] += B->first[c];
+    free(old);
+    free(key);
+    B->builds = L->builds;
+    return 0;
+}
+#endif

@@ -13,8 +13,8 @@
  * can have come closer than 2h unseen), so the sort and the build run once every many steps:
  * in this model the time step is set by the viscosity of the grains or by the sound speed, and a
  * particle moves a small fraction of h per step. Between builds particles keep their memory
- * order and the cells keep describing the build positions; bands of cell rows are fixed index
- * ranges, so the threads' write sets stay disjoint (forces.c). */
+ * order and the cells keep describing the build positions; bands of cell rows (3D: the blocks
+ * below) are fixed index ranges, so the threads' write sets stay disjoint (forces.c). */
 #ifndef MIXSPH_NEIGHBOURS_H
 #define MIXSPH_NEIGHBOURS_H
 #include <stddef.h>
@@ -82,6 +82,32 @@ struct pair_list {
     int valid;          /* it describes the lists of that build */
 };
 
+/* The threads' schedule of the 3D pair loops over the pair list: the grid cut into blocks of one
+ * layer and two search radii along a second axis (the rows' axis x or the axis y across them,
+ * whichever holds more search radii: the longer), each block a set of whole cells. The half stencil of
+ * a particle reaches its own layer and the one above, and one search radius either side along x
+ * and y (cells.h), so the pair loops of a block write only its own particles and those of the
+ * layer above, one radius around it; blocks of one colour (the parities of their layer and of
+ * their place along the axis: NEIGHBOURS_COLOURS of them) therefore never write the same particle
+ * and run in parallel, the colours one after the other. A particle receives the additions of its
+ * blocks in the order of their colours and those within a block in memory order, whichever thread
+ * walks it: results do not depend on the thread count. Within a colour the blocks are listed by
+ * descending work (pair-list entries plus particles; ties by place), so that threads taking
+ * them one at a time finish together (longest first). Blocks without particles are left out.
+ * Bands of whole layers, as in 2D, left two threads with one or two loaded bands per phase: the
+ * dam break's water fills a few layers. */
+#if DIM == 3
+enum { NEIGHBOURS_COLOURS = 4 };
+
+struct pair_blocks {
+    uint32_t (*block)[3]; /* per block: its first and end cell index along the axis, its layer */
+    size_t first[NEIGHBOURS_COLOURS + 1]; /* colour c's blocks are block[first[c] .. first[c + 1]) */
+    int axis;             /* the axis the blocks cut within a layer: 0 (x, columns) or 1 (y, rows) */
+    size_t cap;
+    uint64_t builds;      /* the NB->builds of the list it was made from */
+};
+#endif
+
 void neighbours_free(struct neighbours *NB);
 void neighbours_gather_free(struct gather *G);
 /** Make room for cap particles in G. Returns -1 on allocation failure. */
@@ -106,6 +132,35 @@ int neighbours_relist(struct neighbours *NB, const struct cells *C, size_t n, do
 int neighbours_pair_list_build(struct pair_list *L, const struct neighbours *NB, const uint8_t *state, size_t n,
                                double rc, int n_threads);
 void neighbours_pair_list_free(struct pair_list *L);
+
+#if DIM == 3
+/** Build the blocks B of the grid C from the pair list L of the particles it sorted (built from
+ *  the same lists). Returns -1 on allocation failure. */
+int neighbours_pair_blocks_build(struct pair_blocks *B, const struct pair_list *L, const struct cells *C);
+void neighbours_pair_blocks_free(struct pair_blocks *B);
+
+/** Particle range number k (0 .. neighbours_block_ranges(...) - 1) of block b of B: the cells of
+ *  one row of the block (axis 0), or of the whole block (axis 1: its rows are contiguous). */
+static inline size_t neighbours_block_ranges(const struct pair_blocks *B, const struct cells *C)
+{
+    return B->axis == 0 ? (size_t)C->n[1] : 1;
+}
+static inline struct range neighbours_block_range(const struct pair_blocks *B, const struct cells *C, size_t b,
+                                                  size_t k)
+{
+    const uint32_t *q = B->block[b];
+    const size_t layer0 = (size_t)q[2] * C->layer, n0 = (size_t)C->n[0];
+    struct range r;
+    if (B->axis == 0) {
+        r.begin = C->start[layer0 + k * n0 + q[0]];
+        r.end = C->start[layer0 + k * n0 + q[1]];
+    } else {
+        r.begin = C->start[layer0 + q[0] * n0];
+        r.end = C->start[layer0 + q[1] * n0];
+    }
+    return r;
+}
+#endif
 
 /** Make room for cap particles' build positions. Returns -1 on allocation failure. */
 int neighbours_reserve(struct neighbours *NB, size_t cap);

@@ -332,3 +332,33 @@ void team_for(int n_threads, size_t n, team_range_fn body, void *arg)
     if (n_threads > 1 && n < (size_t)n_threads) n_threads = n > 0 ? (int)n : 1;
     team_run(n_threads, for_region, &A);
 }
+
+struct for_dynamic_arg {
+    team_range_fn body;
+    void *arg;
+    size_t n, chunk;
+    team_counter next;
+};
+
+static void for_dynamic_region(void *arg, int tid, int nth)
+{
+    (void)tid;
+    (void)nth;
+    struct for_dynamic_arg *A = arg;
+    for (long k; (size_t)(k = team_next(&A->next)) < (A->n + A->chunk - 1) / A->chunk;) {
+        const size_t b = (size_t)k * A->chunk, e = b + A->chunk < A->n ? b + A->chunk : A->n;
+        A->body(A->arg, b, e);
+    }
+}
+
+void team_for_dynamic(int n_threads, size_t n, team_range_fn body, void *arg)
+{
+    if (n_threads <= 1 || n <= TEAM_CHUNK_MIN) {
+        if (n > 0) body(arg, 0, n);
+        return;
+    }
+    struct for_dynamic_arg A = {body, arg, n, n / ((size_t)n_threads * TEAM_CHUNKS_PER_THREAD), {0}};
+    if (A.chunk < TEAM_CHUNK_MIN) A.chunk = TEAM_CHUNK_MIN;
+    team_counter_reset(&A.next);
+    team_run(n_threads, for_dynamic_region, &A);
+}

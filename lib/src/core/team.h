@@ -38,6 +38,16 @@ void team_run(int n, team_fn fn, void *arg);
 typedef void (*team_range_fn)(void *arg, size_t begin, size_t end);
 void team_for(int n_threads, size_t n, team_range_fn body, void *arg);
 
+/* As team_for, but the items in about TEAM_CHUNKS_PER_THREAD chunks per thread (at least
+ * TEAM_CHUNK_MIN items each) that the threads take one at a time: body(arg, begin, end) once per
+ * chunk, so the body must not depend on how the items are grouped (per-item results, exact
+ * reductions). For loops whose items cost unevenly along the index (the neighbour lists' builds:
+ * particles sorted by cell, the fluid in the lower layers), where team_for's equal blocks leave
+ * one thread waiting for the other. One thread: body(arg, 0, n). */
+#define TEAM_CHUNKS_PER_THREAD 16
+#define TEAM_CHUNK_MIN 256
+void team_for_dynamic(int n_threads, size_t n, team_range_fn body, void *arg);
+
 /* Inside fn of team_run: return when all n threads of the team have called it. */
 void team_barrier(void);
 

@@ -36,7 +36,9 @@
  *
  * Threads: the grid is cut into bands of two cell rows (index ranges fixed at the last build); a
  * band writes its own rows and the row above, so even bands never touch each other, nor odd bands: even bands run in parallel, then
- * odd bands. The bands do not depend on the thread count and each band is walked in memory
+ * odd bands. In 3D the bands are the pair list's blocks instead (neighbours.h: one layer and two
+ * search radii along x or y, in four colours run one after the other), so that two threads find
+ * several loaded blocks in each phase. The bands do not depend on the thread count and each band is walked in memory
  * order, so every particle receives its contributions in the same order whatever the number of
  * threads: results are bit-identical for any thread count.
  *
@@ -124,6 +126,10 @@ struct forces {
     size_t visc_w_cap;
     int visc_valid;           /* visc_w holds the couplings at the current positions */
     struct pair_list list;    /* 3D: the pair list of the current neighbour lists (pair_list_attach) */
+#if DIM == 3
+    struct pair_blocks blocks; /* 3D: the threads' blocks of that list (neighbours.h) */
+    int fk_layout_ok;          /* 3D: fk_off is the lane layout of that list (made once per list) */
+#endif
 };
 
 /* Constants of one pass of the pair loops. */
@@ -161,6 +167,9 @@ struct pair_ctx {
     double p_background;       /* the water's pressure at a free surface [Pa] (the grains in water) */
     const uint32_t *idx;        /* 3D: the pair list's candidates (pair_list_attach); 2D: NULL */
     const uint32_t *list_start; /* 3D: particle i's candidates are idx[list_start[i] .. list_start[i+1]) */
+#if DIM == 3
+    const struct pair_blocks *blocks; /* 3D: the threads' blocks of the list (bands_in_team) */
+#endif
 };
 
 static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
@@ -198,6 +207,9 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = NULL;
     X->p_background = fp->p_background;
     X->idx = X->list_start = NULL;
+#if DIM == 3
+    X->blocks = NULL;
+#endif
 }
 
 /* Particle i's candidates for the pair loops: in 2D its NEIGHBOURS_RANGES ranges of particles, in
@@ -1068,6 +1080,9 @@ void forces_free(struct forces *F)
     free(F->diffusion_sum);
     aligned_block_free(F->visc_w);
     neighbours_pair_list_free(&F->list);
+#if DIM == 3
+    neighbours_pair_blocks_free(&F->blocks);
+#endif
     free(F);
 }
 
@@ -1089,6 +1104,9 @@ int forces_viscous_ready(const struct forces *F) { return F->visc_valid; }
  * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
 static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struct neighbours *NB, size_t n)
 {
+#if DIM == 3 /* the list's layout, kept until the list is made again (pair_list_attach) */
+    if (F->fk_layout_ok) return 0;
+#endif
     if (F->fk_off_cap < n + 1) {
         size_t *o = realloc(F->fk_off, (n + 1) * sizeof *o);
         if (!o) return -1;
@@ -1113,6 +1131,9 @@ static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struc
         F->fk_cap = F->fk ? cap : 0;
         if (!F->fk) return -1;
     }
+#if DIM == 3
+    F->fk_layout_ok = 1;
+#endif
     return 0;
 }
 
@@ -1124,11 +1145,17 @@ static int pair_list_attach(struct forces *F, const struct pair_system *S, size_
 #if DIM == 3
     struct pair_list *L = &F->list;
     /* the cells' row spacing is the lists' cut-off, 2h + skin (sim.c) */
-    if ((!L->valid || L->builds != S->NB->builds || L->n != n) &&
-        neighbours_pair_list_build(L, S->NB, S->P->state, n, S->C->size, S->n_threads) != 0)
-        return -1;
+    if (!L->valid || L->builds != S->NB->builds || L->n != n) {
+        F->fk_layout_ok = 0;
+        if (neighbours_pair_list_build(L, S->NB, S->P->state, n, S->C->size, S->n_threads) != 0 ||
+            neighbours_pair_blocks_build(&F->blocks, L, S->C) != 0) {
+            L->valid = 0;
+            return -1;
+        }
+    }
     X->idx = L->j;
     X->list_start = L->start;
+    X->blocks = &F->blocks;
 #else
     (void)F;
     (void)S;
@@ -1166,8 +1193,10 @@ typedef void (*band_fn)(const struct pair_ctx *, const struct neighbours *, stru
  * thread walks them all in the same order. A pass runs its bands and its per-particle loop after
  * them in one region, so that a step has few fork-joins and barriers: each waits for a thread
  * that another process may have descheduled (docs/performance.md, "Under load"). */
-static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X, team_counter bands[2],
-                          int last_nowait)
+#if DIM == 2
+enum { FORCES_PHASES = 2 }; /* even bands, odd bands */
+static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X,
+                          team_counter bands[FORCES_PHASES], int last_nowait)
 {
     const struct cells *C = S->C;
     const long layers = C->n[DIM_UP], nb = (layers + FORCES_BAND_ROWS - 1) / FORCES_BAND_ROWS;
@@ -1185,12 +1214,35 @@ static void bands_in_team(const struct pair_system *S, band_fn fn, const struct 
 #undef FORCES_BAND
 }
 
+#else
+/* In 3D the phases are the colours of the pair list's blocks (neighbours.h: layers cut along a
+ * second axis, so that two threads find several loaded blocks in every phase), the threads taking
+ * a colour's blocks one at a time, longest first, from the counter bands[c]; otherwise as in 2D. */
+enum { FORCES_PHASES = NEIGHBOURS_COLOURS };
+static void bands_in_team(const struct pair_system *S, band_fn fn, const struct pair_ctx *X,
+                          team_counter bands[FORCES_PHASES], int last_nowait)
+{
+    const struct cells *C = S->C;
+    const struct pair_blocks *B = X->blocks;
+    const size_t ranges = neighbours_block_ranges(B, C);
+    for (int c = 0; c < NEIGHBOURS_COLOURS; c++) {
+        const long nb = (long)(B->first[c + 1] - B->first[c]);
+        for (long k; (k = team_next(&bands[c])) < nb;)
+            for (size_t q = 0; q < ranges; q++) {
+                const struct range r = neighbours_block_range(B, C, B->first[c] + (size_t)k, q);
+                if (r.end > r.begin) fn(X, S->NB, S->P, r.begin, r.end);
+            }
+        if (c + 1 < NEIGHBOURS_COLOURS || !last_nowait) team_barrier();
+    }
+}
+#endif
+
 /* A pass's parallel region: its pair context, band counters and outcome. */
 struct pass_region {
     const struct pair_system *S;
     const struct pair_ctx *X;
     band_fn fn;
-    team_counter bands[2];
+    team_counter bands[FORCES_PHASES];
     size_t n;                         /* active particles */
     struct velocity_gradient *grad;   /* density pass: the grains' velocity gradient, or NULL */
     const double *count;              /* density pass: the neighbour counts */
@@ -1212,8 +1264,7 @@ static void pass_region_init(struct pass_region *R, const struct pair_system *S,
     R->X = X;
     R->fn = fn;
     R->n = n;
-    team_counter_reset(&R->bands[0]);
-    team_counter_reset(&R->bands[1]);
+    for (int c = 0; c < FORCES_PHASES; c++) team_counter_reset(&R->bands[c]);
 }
 
 /* A region of the bands alone (the viscous operator, the group couplings). */
@@ -1480,6 +1531,9 @@ static int stored_couplings(const struct forces *F, const struct pair_system *S,
     X->fk_off = F->fk_off;
     X->idx = F->list.j; /* 3D: the pair list they were stored over (2D: unused) */
     X->list_start = F->list.start;
+#if DIM == 3
+    X->blocks = &F->blocks;
+#endif
     return 0;
 }
 
