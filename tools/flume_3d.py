@@ -5,7 +5,7 @@ walls, run both at the same dx, and compare their monitors (docs/validation/thre
     python tools/flume_3d.py CASE [--cells N] [--dx DX] [--t-end T] [--set KEY=VALUE]...
                              [--compare MONITOR:series|max]... [--tol REL] [--check]
                              [--threads N] [--mixsph build/mixsph] [--out DIR]
-                             [--write-case PATH] [--doc FILE]
+                             [--write-case PATH] [--doc FILE] [--lanes]
 
 The flume (``extrude``): ``"dimensions": 3``; every polygon body and every polyline wall spans
 y in [0, W], W = N dx (N = --cells, default 4; the lattice puts N particles across it); the first
@@ -24,6 +24,12 @@ known failure, tests/known_failure.h's rule) unless every difference is beyond -
 [LO, HI], so that it fails on a regression and the day the criterion is met. Runs: ``mixsph run CASE --set
 numerics.dx=DX [--set numerics.t_end=T] [--set ...] --threads N --quiet --out OUT/{2d,3d}``,
 the CPU lock of a shared machine is the caller's business.
+
+``--lanes`` (give the runs CSV snapshots, e.g. ``--set output.snapshot_interval=0.02``) prints, at
+each snapshot, the 2D front and the front of each lane of the 3D flume: the largest x of the mobile
+particles whose y lies in [k dx, (k + 1) dx), k = 0 .. N - 1. The ``front`` monitor of the 3D run is
+the largest of these; in a flume whose flow does not depend on y they are all the 2D front
+(docs/validation/three_d.md, "Where the 3D front's lead comes from").
 """
 
 import argparse
@@ -85,6 +91,31 @@ def extrude(case, dx, cells):
     return c
 
 
+def lane_fronts(snap, dx, cells):
+    """The front (largest x) of the mobile particles of each lane k = 0 .. cells - 1 of a 3D flume's
+    snapshot (a read_snapshot dict), the lane of a particle being floor(y / dx) clipped to the
+    flume; nan for a lane with no particle."""
+    mobile = snap["state"] == 0
+    x, lane = snap["x"][mobile], np.clip(np.floor(snap["y"][mobile] / dx), 0, cells - 1).astype(int)
+    return np.array([x[lane == k].max() if (lane == k).any() else np.nan for k in range(cells)])
+
+
+def lane_table(out2, out3, dx, cells):
+    """Markdown rows: at each snapshot (the 2D run's time), the 2D front and each 3D lane's front
+    relative to it [%] (mobile particles, no spray filter: the front monitor's min_neighbours
+    is not in the snapshots)."""
+    lines = ["| t [s] | 2D front [m] | " + " | ".join(f"lane {k} [%]" for k in range(cells)) + " |",
+             "|---" * (cells + 2) + "|"]
+    # the two runs take their snapshots at the first step ends past the same times: pair them in order
+    for (t, path2), (_, path3) in zip(readers.list_snapshots(out2)[1:], readers.list_snapshots(out3)[1:]):
+        _, s2 = readers.read_snapshot(path2)
+        _, s3 = readers.read_snapshot(path3)
+        x2 = s2["x"][s2["state"] == 0].max()
+        rel = 100 * (lane_fronts(s3, dx, cells) - x2) / x2
+        lines.append(f"| {t:.3f} | {x2:.4f} | " + " | ".join(f"{r:+.2f}" for r in rel) + " |")
+    return lines
+
+
 def run(mixsph, case_path, outdir, sets, threads):
     cmd = [mixsph, "run", case_path, "--out", outdir, "--quiet", "--threads", str(threads)]
     for s in sets:
@@ -137,6 +168,7 @@ def main(argv=None):
     ap.add_argument("--out", default="out/flume_3d")
     ap.add_argument("--write-case")
     ap.add_argument("--doc", help="append the table and the command to this markdown file")
+    ap.add_argument("--lanes", action="store_true", help="print the 3D front of each lane beside the 2D front")
     args = ap.parse_args(argv)
     try:
         with open(args.case) as f:
@@ -169,6 +201,8 @@ def main(argv=None):
                     failed.append(what)
             elif not rel <= args.tol:
                 failed.append(what)
+        if args.lanes:
+            lines += [""] + lane_table(os.path.join(args.out, "2d"), os.path.join(args.out, "3d"), dx, args.cells)
         given = list(argv if argv is not None else sys.argv[1:])
         kept = [a for k, a in enumerate(given) if a not in ("--mixsph", "--doc", "--out")
                 and (k == 0 or given[k - 1] not in ("--mixsph", "--doc", "--out"))]

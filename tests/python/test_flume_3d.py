@@ -42,3 +42,13 @@ def test_refusals():
     case["walls"]["tank"]["motion"] = "m"
     with pytest.raises(readers.ToolError, match="no fixed polyline wall"):
         flume_3d.extrude(case, 0.02, 4)
+
+
+def test_lane_fronts_takes_each_lanes_largest_x_of_the_mobile_particles():
+    import numpy as np
+    # lanes of dx = 0.02: y = 0.01 (lane 0), 0.03 and 0.039 (lane 1), 0.07 (lane 3, beyond: clipped 0.085)
+    snap = {"x": np.array([0.20, 0.30, 0.25, 0.90, 0.40, 0.35]),
+            "y": np.array([0.01, 0.03, 0.039, 0.03, 0.07, 0.085]),
+            "state": np.array([0, 0, 0, 2, 0, 0])}  # the wall particle at x = 0.9 is not water
+    fronts = flume_3d.lane_fronts(snap, 0.02, 4)
+    assert fronts[0] == 0.20 and fronts[1] == 0.30 and np.isnan(fronts[2]) and fronts[3] == 0.40
