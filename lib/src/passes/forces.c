@@ -679,7 +679,12 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                             rdr += (a == b ? 1.0 : 2.0) * (wi * gstrain_i[q] + wj * gstrain[q][j]) * r[a] * r[b];
                         }
                     }
-                    vdotr -= gp * rdr;
+                    /* kept dissipative: of the pair's own sign and no larger than its u_ij . x_ij (the
+                     * residual alone pushed pairs that separate slower than the gradient says apart:
+                     * energy fed in, docs/model.md [DP-AV]) */
+                    const double res = vdotr - gp * rdr;
+                    vdotr = vdotr < 0.0 ? (res < vdotr ? vdotr : res < 0.0 ? res : 0.0)
+                                        : (res > 0.0 ? (res < vdotr ? res : vdotr) : 0.0);
                 } else if (gform == GRAIN_DISSIPATION_QUARTER) {
                     vdotr *= 1.0 - 0.75 * gp;
                 }
