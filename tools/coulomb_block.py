@@ -74,7 +74,7 @@ def run(args, law, angle, delta, dx, travel_max, out):
         x, z = point(a, s, d)
         sets += [f"walls.ramp.polyline.{k}.0={x:.9f}", f"walls.ramp.polyline.{k}.1={z:.9f}"]
     cmd = [args.mixsph, "run", CASE, "--threads", str(args.threads), "--fixed-threads", "--quiet", "--out", out]
-    for s in sets:
+    for s in sets + args.set:
         cmd += ["--set", s]
     print("$", " ".join(cmd), flush=True)
     r = subprocess.run(cmd, capture_output=True, text=True)
@@ -126,6 +126,9 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--reuse", action="store_true", help="read existing output folders instead of running")
     ap.add_argument("--markdown", action="store_true", help="print the table as Markdown")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a case override passed to every run after the tool's own (mixsph run --set), e.g. "
+                         "numerics.grain_dissipation=1")
     try:
         a = ap.parse_args(argv)
         laws = a.laws.split(",")

@@ -207,7 +207,8 @@ const struct material_law law_elastic_plastic = {
     .type = "granular",
     .name = "elastic_plastic",
     .keys = &elastic_plastic_section,
-    .features = LAW_USES_GRADIENT | LAW_HAS_STRESS | LAW_CAPS_TENSION | LAW_WALL_FRICTION,
+    .features = LAW_USES_GRADIENT | LAW_HAS_STRESS | LAW_CAPS_TENSION | LAW_WALL_FRICTION |
+                LAW_ACOUSTIC_DISSIPATION,
     .finish = elastic_plastic_finish,
     .wave_speed = elastic_plastic_wave_speed,
     .viscosity_bound = elastic_plastic_viscosity_bound,
