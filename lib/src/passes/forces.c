@@ -618,9 +618,9 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double solid_i = grains ? solid[i] : 1.0;
     const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
     /* the elastic-plastic grains' form of the Monaghan term (numerics.grain_dissipation): only
-     * the variants with a stress law carry it (a constant 0 elsewhere keeps the water's and the
-     * paper's pair loops as they were; with it the loop ran 2x slower) */
-    const int gform = stress ? X->grain_form : GRAIN_DISSIPATION_ACOUSTIC;
+     * the variants with stress = 2 (a stress law and a form other than acoustic) carry it; a
+     * constant elsewhere keeps the other loops as they were (with it they ran 2-2.5x slower) */
+    const int gform = stress == 2 ? X->grain_form : GRAIN_DISSIPATION_ACOUSTIC;
     const double *restrict gflag = X->grain_flag;
     const double *restrict gstrain[VELOCITY_GRADIENT_L_N];
     double gstrain_i[VELOCITY_GRADIENT_L_N];
@@ -1115,7 +1115,9 @@ static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB,
                           size_t b0, size_t b1)
 {
     /* the grains in water come with a granular law that has a stress (the elastic-plastic law) */
-    if (X->gw[GW_ROLE]) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 1);
+    if (X->stress && X->grain_form != GRAIN_DISSIPATION_ACOUSTIC) /* stress = 2: see momentum_range */
+        momentum_band_variant(X, NB, P, b0, b1, 2, X->bed_friction, X->gw[GW_ROLE] ? 1 : 0);
+    else if (X->gw[GW_ROLE]) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 1);
     else if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 0);
     else if (X->bed_friction) momentum_band_variant(X, NB, P, b0, b1, 0, 1, 0);
     else momentum_band_variant(X, NB, P, b0, b1, 0, 0, 0);
