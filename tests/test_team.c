@@ -97,6 +97,17 @@ static void mark(void *arg, size_t b, size_t e)
     for (size_t i = b; i < e; i++) A->hit[i]++;
 }
 
+/* loop (team_for or team_for_dynamic) on th threads hits each of n items once and nothing past them. */
+static void assert_each_item_once(void (*loop)(int, size_t, team_range_fn, void *), int th, size_t n)
+{
+    struct range_arg A = {calloc(n + 1, 1)};
+    assert_non_null(A.hit);
+    loop(th, n, mark, &A);
+    for (size_t i = 0; i < n; i++) assert_int_equal(A.hit[i], 1);
+    assert_int_equal(A.hit[n], 0);
+    free(A.hit);
+}
+
 /* team_share and team_for cover every item once, for counts below and above the thread count. */
 static void test_for(void **state)
 {
@@ -105,11 +116,7 @@ static void test_for(void **state)
     for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
         for (int th = 1; th <= 4; th++) {
             const size_t n = counts[c];
-            struct range_arg A = {calloc(n + 1, 1)};
-            assert_non_null(A.hit);
-            team_for(th, n, mark, &A);
-            for (size_t i = 0; i < n; i++) assert_int_equal(A.hit[i], 1);
-            free(A.hit);
+            assert_each_item_once(team_for, th, n);
             size_t prev = 0;
             for (int t = 0; t < th; t++) {
                 size_t b, e;
@@ -130,13 +137,7 @@ static void test_for_dynamic(void **state)
     static const size_t counts[] = {0, 1, TEAM_CHUNK_MIN, TEAM_CHUNK_MIN + 1, 5000, 100003};
     for (size_t c = 0; c < sizeof counts / sizeof counts[0]; c++)
         for (int th = 1; th <= 4; th++) {
-            const size_t n = counts[c];
-            struct range_arg A = {calloc(n + 1, 1)};
-            assert_non_null(A.hit);
-            team_for_dynamic(th, n, mark, &A);
-            for (size_t i = 0; i < n; i++) assert_int_equal(A.hit[i], 1);
-            assert_int_equal(A.hit[n], 0);
-            free(A.hit);
+            assert_each_item_once(team_for_dynamic, th, counts[c]);
         }
 }
 
