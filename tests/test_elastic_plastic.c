@@ -372,72 +372,6 @@ static void test_rate_in_simple_shear(void **state)
     mixsph_sim_destroy(s);
 }
 
-/* The block of shear_block_json with numerics.grain_dissipation = `form`, in the parabolic shear
- * u = A (z - 0.1)^2 at a uniform pressure, no stress: the x acceleration of its centre grain after a
- * density pass (which gathers the velocity gradient) and a momentum pass. */
-static double parabolic_shear_acceleration(const char *form, double A, double *h, double *c_p)
-{
-    char json[1536];
-    snprintf(json, sizeof json,
-             "{ \"name\": \"shear_av\", \"gravity\": 0,"
-             "  \"numerics\": { \"dx\": 0.01, \"t_end\": 1.0, \"grain_dissipation\": \"%s\" },"
-             "  \"media\": { \"sand\": { \"type\": \"granular\", \"law\": \"elastic_plastic\", \"rho\": 2650.0,"
-             "    \"K\": 4.24e6, \"porosity\": 0.35, \"phi\": 32.0 } },"
-             "  \"bodies\": { \"block\": { \"medium\": \"sand\", \"polygon\": [[0, 0], [0.2, 0], [0.2, 0.2], [0, 0.2]] } },"
-             "  \"walls\": { \"floor\": { \"polyline\": [[-0.1, -0.08], [0.3, -0.08]], \"fluid_side\": \"left\" } },"
-             "  \"domain\": { \"x_min\": -0.1, \"x_max\": 0.3, \"z_min\": -0.1, \"z_max\": 0.3 } }",
-             form);
-    mixsph_sim *s = NULL;
-    char err[512] = "";
-    assert_int_equal(mixsph_sim_create_from_text(json, "shear_av", NULL, 0, &s, err, sizeof err), MIXSPH_OK);
-    assert_int_equal(mixsph_sim_set_threads(s, 1), MIXSPH_OK);
-    struct particles *P = &s->phys.P;
-    size_t centre = 0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] == MIXSPH_STATE_WALL) continue;
-        const double z = P->pos[DIM_UP][i] - 0.1;
-        P->p[i] = 2000.0 + s->cfg.p_background;
-        P->vel[0][i] = P->uv[0][i] = A * z * z;
-        for (int a = 1; a < DIM; a++) P->vel[a][i] = P->uv[a][i] = 0.0;
-        for (int c = 0; c < SYM_N; c++) P->stress[c][i] = 0.0;
-        if (hypot(P->pos[0][i] - 0.1, z) < hypot(P->pos[0][centre] - 0.1, P->pos[DIM_UP][centre] - 0.1)) centre = i;
-    }
-    assert_int_equal(sim_density_pass(s), 0);
-    assert_int_equal(sim_momentum_pass(s), 0);
-    const double a = P->acc[0][centre];
-    *h = s->phys.h;
-    *c_p = s->cfg.media[0].alpha_m * s->cfg.media[0].c;
-    mixsph_sim_destroy(s);
-    return a;
-}
-
-/* numerics.grain_dissipation (docs/model.md [DP-AV]) in a parabolic shear u = A z^2, whose centre grain
- * (10 dx from the block's edges) has a lattice of neighbours with exact corrected gradients. Each
- * form's Monaghan acceleration is its difference from "affine", whose term vanishes there: the
- * pair's mean gradient (G_i + G_j) / 2 . x_ij is u_i - u_j exactly in a quadratic field (the
- * trapezoidal rule), so the pressure's part (uniform p, the same in every form) is all that is left.
- * Then (i) "quarter" is a quarter of "acoustic" (to round-off: 1e-9 relative); (ii) "acoustic" is the
- * numerical viscosity of the estimate in [DP-AV], nu ~ c_p h / 8 on approaching pairs only, roughly
- * half of it: a = nu u'' = nu 2 A within a factor 2 of (c_p h / 8) 2 A / 2; (iii) "limited" takes
- * min(3 |u_r| / c_p, 1) of it, |u_r| ~ A (2h)^2 = 7e-4 m/s here against c_p ~ 60 m/s: below 1e-4 of
- * "acoustic". */
-static void test_grain_dissipation_forms(void **state)
-{
-    (void)state;
-    const double A = 1.0; /* [1/(m s)] */
-    double h = 0.0, c_p = 0.0;
-    const double affine = parabolic_shear_acceleration("affine", A, &h, &c_p);
-    const double acoustic = parabolic_shear_acceleration("acoustic", A, &h, &c_p) - affine;
-    const double quarter = parabolic_shear_acceleration("quarter", A, &h, &c_p) - affine;
-    const double limited = parabolic_shear_acceleration("limited", A, &h, &c_p) - affine;
-    const double estimate = c_p * h / 8.0 * 2.0 * A / 2.0;
-    print_message("parabolic shear, centre grain: Monaghan acceleration acoustic %.6g, quarter %.6g, limited %.3g m/s2; "
-                  "estimate (c_p h / 8) A = %.6g m/s2\n", acoustic, quarter, limited, estimate);
-    assert_true(fabs(quarter / acoustic - 0.25) < 1e-9);
-    assert_true(acoustic / estimate > 0.5 && acoustic / estimate < 2.0);
-    assert_true(fabs(limited) < 1e-4 * fabs(acoustic));
-}
-
 /* A heap of 45-degree slopes, 10 degrees steeper than phi, fails; the criterion (the issue): it
  * comes to rest at its repose angle, phi = 35 degrees in plane strain (docs/model.md section 10),
  * within 3 degrees. NOT MET (12-06): after 3 s its flanks stand at 26.5 degrees and 31 % of its
@@ -487,7 +421,6 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_block_on_incline),
         cmocka_unit_test(test_rate_keys),
         cmocka_unit_test(test_rate_in_simple_shear),
-        cmocka_unit_test(test_grain_dissipation_forms),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -128,7 +128,7 @@ def main(argv=None):
     ap.add_argument("--markdown", action="store_true", help="print the table as Markdown")
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a case override passed to every run after the tool's own (mixsph run --set), e.g. "
-                         "numerics.grain_dissipation=1")
+                         "numerics.density_diffusion=0.05")
     try:
         a = ap.parse_args(argv)
         laws = a.laws.split(",")

@@ -38,8 +38,6 @@ static const struct case_choice viscous_schemes[] = {{"explicit", 0}, {"implicit
 static const struct case_choice viscous_preconditioners[] = {{"jacobi", 0}, {"two_level", 1}, {NULL, 0}};
 static const struct case_choice viscosity_means[] = {{"harmonic", 0}, {"arithmetic", 1}, {NULL, 0}};
 static const struct case_choice diffusion_forms[] = {{"hydrostatic", 0}, {"molteni", 1}, {NULL, 0}};
-static const struct case_choice grain_dissipations[] = {
-    {"acoustic", 0}, {"limited", 1}, {"affine", 2}, {"quarter", 3}, {NULL, 0}};
 static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};

@@ -207,8 +207,7 @@ const struct material_law law_elastic_plastic = {
     .type = "granular",
     .name = "elastic_plastic",
     .keys = &elastic_plastic_section,
-    .features = LAW_USES_GRADIENT | LAW_HAS_STRESS | LAW_CAPS_TENSION | LAW_WALL_FRICTION |
-                LAW_ACOUSTIC_DISSIPATION,
+    .features = LAW_USES_GRADIENT | LAW_HAS_STRESS | LAW_CAPS_TENSION | LAW_WALL_FRICTION,
     .finish = elastic_plastic_finish,
     .wave_speed = elastic_plastic_wave_speed,
     .viscosity_bound = elastic_plastic_viscosity_bound,

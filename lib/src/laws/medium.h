@@ -45,10 +45,8 @@ enum law_feature {
                                    it instead of its own, no deviatoric stress, the drag of the fluid through
                                    its grains, and leaves the fluid out of its density rate; set by a
                                    medium's finish (a granular law's key water_coupling = "grains") */
-    LAW_WALL_FRICTION_GIVEN = 256u, /* as LAW_WALL_FRICTION, at the no-slip walls that give their friction angle
+    LAW_WALL_FRICTION_GIVEN = 256u /* as LAW_WALL_FRICTION, at the no-slip walls that give their friction angle
                                       only (elsewhere the law's own no-slip shear: the paper's) */
-    LAW_ACOUSTIC_DISSIPATION = 512u /* its Monaghan term is the acoustic jump of its P wave (docs/model.md
-                                       [DP-AV]), whose form numerics.grain_dissipation chooses */
 };
 
 struct medium {

@@ -120,11 +120,6 @@ struct forces {
     double *diffusion_sum;    /* density pass: sum_j V_j psi_ij (-F_ij) of the density diffusion */
     double *gw[GW_ARRAYS];    /* the grains in water (above) */
     size_t scratch_cap;
-    /* momentum pass with numerics.grain_dissipation other than acoustic, per particle: 1 for a
-     * particle of a LAW_ACOUSTIC_DISSIPATION medium, else 0; its strain rate (grad u + grad u^T) / 2
-     * in the layout of L (velocity_gradient.h) with "affine", else 0 */
-    double *grain_flag, *grain_strain[VELOCITY_GRADIENT_L_N];
-    size_t grain_cap;
     /* implicit viscosity: the viscous coupling w_ij >= 0 of every lane (layout of fk), stored by
      * the momentum pass, so that m_i du_i/dt = -sum_j w_ij (u_i - u_j) */
     double *visc_w;
@@ -170,10 +165,6 @@ struct pair_ctx {
     double *group_w;           /* and its sums, 5 per group */
     double *gw[GW_ARRAYS];     /* the grains in water (struct forces), or NULL: none */
     double p_background;       /* the water's pressure at a free surface [Pa] (the grains in water) */
-    int grain_form;            /* enum grain_dissipation; acoustic unless grain_flag is set */
-    double h;                  /* the smoothing length [m] (grain_form limited: c_p = alpha c h / h) */
-    const double *grain_flag;  /* struct forces' grain_flag and grain_strain, or NULL */
-    const double *grain_strain[VELOCITY_GRADIENT_L_N];
     const uint32_t *idx;        /* 3D: the pair list's candidates (pair_list_attach); 2D: NULL */
     const uint32_t *list_start; /* 3D: particle i's candidates are idx[list_start[i] .. list_start[i+1]) */
 #if DIM == 3
@@ -215,10 +206,6 @@ static void pair_ctx_init(const struct pair_system *S, struct pair_ctx *X)
     X->group_w = NULL;
     for (int q = 0; q < GW_ARRAYS; q++) X->gw[q] = NULL;
     X->p_background = fp->p_background;
-    X->grain_form = GRAIN_DISSIPATION_ACOUSTIC;
-    X->h = fp->K.h;
-    X->grain_flag = NULL;
-    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) X->grain_strain[q] = NULL;
     X->idx = X->list_start = NULL;
 #if DIM == 3
     X->blocks = NULL;
@@ -617,18 +604,6 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double *restrict solid = grains ? X->gw[GW_SOLID] : NULL;
     const double solid_i = grains ? solid[i] : 1.0;
     const double drag_vi = grains ? drag_v[i] : 0.0, drag_ri = grains ? drag_r[i] : 0.0, rhoi = P->rho[i];
-    /* the elastic-plastic grains' form of the Monaghan term (numerics.grain_dissipation): only
-     * the variants with stress = 2 (a stress law and a form other than acoustic) carry it; a
-     * constant elsewhere keeps the other loops as they were (with it they ran 2-2.5x slower) */
-    const int gform = stress == 2 ? X->grain_form : GRAIN_DISSIPATION_ACOUSTIC;
-    const double *restrict gflag = X->grain_flag;
-    const double *restrict gstrain[VELOCITY_GRADIENT_L_N];
-    double gstrain_i[VELOCITY_GRADIENT_L_N];
-    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) {
-        gstrain[q] = X->grain_strain[q];
-        gstrain_i[q] = gform == GRAIN_DISSIPATION_AFFINE ? gstrain[q][i] : 0.0;
-    }
-    const double gflag_i = gform ? gflag[i] : 0.0;
 #if DIM == 2
     /* i's mirror (a free-slip wall particle): cos 2theta and sin 2theta / 2 of its normal */
     const double mbi = ni[0] * ni[0] - ni[1] * ni[1];
@@ -678,42 +653,9 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             double vdotr = 0.0;
             DIM_UNROLL
             for (int d = 0; d < DIM; d++) vdotr += (vi[d] - v[d][j]) * r[d];
-            const double avc_ij = avci > avc[j] ? avci : avc[j];
-            if (gform) { /* a pair with an elastic-plastic grain (gp = 1), docs/model.md [DP-AV] */
-                const double gp = gflag_i > gflag[j] ? gflag_i : gflag[j];
-                if (gform == GRAIN_DISSIPATION_AFFINE) { /* less r . D . r, D the grains' mean strain rate */
-                    const double wsum = gflag_i + gflag[j];
-                    const double wi = wsum > 0.0 ? gflag_i / wsum : 0.0, wj = wsum > 0.0 ? gflag[j] / wsum : 0.0;
-                    double rdr = 0.0;
-                    DIM_UNROLL
-                    for (int a = 0; a < DIM; a++) {
-                        DIM_UNROLL
-                        for (int b = a; b < DIM; b++) {
-                            const int q = velocity_gradient_l_index(a, b);
-                            rdr += (a == b ? 1.0 : 2.0) * (wi * gstrain_i[q] + wj * gstrain[q][j]) * r[a] * r[b];
-                        }
-                    }
-                    /* kept dissipative: of the pair's own sign and no larger than its u_ij . x_ij (the
-                     * residual alone pushed pairs that separate slower than the gradient says apart:
-                     * energy fed in, docs/model.md [DP-AV]) */
-                    const double res = vdotr - gp * rdr;
-                    vdotr = vdotr < 0.0 ? (res < vdotr ? vdotr : res < 0.0 ? res : 0.0)
-                                        : (res > 0.0 ? (res < vdotr ? res : vdotr) : 0.0);
-                } else if (gform == GRAIN_DISSIPATION_QUARTER) {
-                    vdotr *= 1.0 - 0.75 * gp;
-                }
-                vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
-                if (gform == GRAIN_DISSIPATION_LIMITED) { /* min(beta |u_r| / c_p, 1), c_p = avc_ij / h */
-                    const double ur_h = fabs(vdotr) * Xl.h;
-                    const double lim_den = sqrt(r2e) * avc_ij;
-                    const double lim = GRAIN_DISSIPATION_LIMITER * ur_h < lim_den
-                                           ? GRAIN_DISSIPATION_LIMITER * ur_h / lim_den : 1.0;
-                    vdotr *= 1.0 - gp * (1.0 - lim);
-                }
-            } else {
-                vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
-            }
+            vdotr = vdotr < Xl.av_cap ? vdotr : Xl.av_cap;
             const double same = (tag[j] == ti ? 1.0 : 0.0) + Xl.av_mixed * (1.0 - walli - wallj) + Xl.av_wall * (walli + wallj) > 0.0 ? 1.0 : 0.0;
+            const double avc_ij = avci > avc[j] ? avci : avc[j];
             /* m_i m_j (1/rho_i + 1/rho_j) / 2 = m_i (m_j / rho_i + V_j) / 2 */
             fr += same * (1.0 - walli * wallj) * avc_ij * mi * (m[j] * irhoi + vol[j]) * vdotr * inv_r2e * 0.5;
             /* laminar viscosity, pairwise harmonic mean: mu_i + mu_j of Morris is replaced by
@@ -1115,9 +1057,7 @@ static void momentum_band(const struct pair_ctx *X, const struct neighbours *NB,
                           size_t b0, size_t b1)
 {
     /* the grains in water come with a granular law that has a stress (the elastic-plastic law) */
-    if (X->stress && X->grain_form != GRAIN_DISSIPATION_ACOUSTIC) /* stress = 2: see momentum_range */
-        momentum_band_variant(X, NB, P, b0, b1, 2, X->bed_friction, X->gw[GW_ROLE] ? 1 : 0);
-    else if (X->gw[GW_ROLE]) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 1);
+    if (X->gw[GW_ROLE]) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 1);
     else if (X->stress) momentum_band_variant(X, NB, P, b0, b1, 1, X->bed_friction, 0);
     else if (X->bed_friction) momentum_band_variant(X, NB, P, b0, b1, 0, 1, 0);
     else momentum_band_variant(X, NB, P, b0, b1, 0, 0, 0);
@@ -1138,8 +1078,6 @@ void forces_free(struct forces *F)
     free(F->bed_given);
     free(F->bed_own);
     free(F->diffusion_sum);
-    free(F->grain_flag);
-    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) free(F->grain_strain[q]);
     aligned_block_free(F->visc_w);
     neighbours_pair_list_free(&F->list);
 #if DIM == 3
@@ -1243,53 +1181,6 @@ static int scratch_reserve(struct forces *F, size_t n)
         *a[k] = q;
     }
     F->scratch_cap = cap;
-    return 0;
-}
-
-/* The per-particle arrays of numerics.grain_dissipation (struct forces' grain_flag, grain_strain). */
-static int grain_reserve(struct forces *F, size_t n)
-{
-    if (F->grain_cap >= n) return 0;
-    const size_t cap = n + n / 4 + 64;
-    double **a[1 + VELOCITY_GRADIENT_L_N] = {&F->grain_flag};
-    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) a[1 + q] = &F->grain_strain[q];
-    for (int k = 0; k < 1 + VELOCITY_GRADIENT_L_N; k++) {
-        double *q = realloc(*a[k], (cap + FORCES_CHUNK) * sizeof(double));
-        if (!q) return -1;
-        memset(q, 0, (cap + FORCES_CHUNK) * sizeof(double));
-        *a[k] = q;
-    }
-    F->grain_cap = cap;
-    return 0;
-}
-
-/* Which particles take numerics.grain_dissipation's form of the Monaghan term (their medium has
- * LAW_ACOUSTIC_DISSIPATION) and, with "affine", their strain rate from this step's corrected
- * velocity gradient; the padding past n stays 0. */
-static int grain_dissipation_prepare(struct forces *F, const struct pair_system *S, size_t n, struct pair_ctx *X)
-{
-    const int form = S->params.grain_dissipation;
-    if (form == GRAIN_DISSIPATION_ACOUSTIC) return 0;
-    if (form == GRAIN_DISSIPATION_AFFINE && !S->grad) return -1;
-    if (grain_reserve(F, n) != 0) return -1;
-    const struct particles *P = S->P;
-    for (size_t i = 0; i < n; i++) {
-        const int grain = P->state[i] != MIXSPH_STATE_WALL && P->state[i] != MIXSPH_STATE_LOST &&
-                          (S->media[P->medium[i]].features & LAW_ACOUSTIC_DISSIPATION);
-        F->grain_flag[i] = grain ? 1.0 : 0.0;
-        double g[DIM * DIM] = {0};
-        if (grain && form == GRAIN_DISSIPATION_AFFINE) velocity_gradient_corrected(S->grad, i, g);
-        for (int a = 0; a < DIM; a++)
-            for (int b = a; b < DIM; b++)
-                F->grain_strain[velocity_gradient_l_index(a, b)][i] = 0.5 * (g[a * DIM + b] + g[b * DIM + a]);
-    }
-    for (size_t i = n; i < n + FORCES_CHUNK; i++) {
-        F->grain_flag[i] = 0.0;
-        for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) F->grain_strain[q][i] = 0.0;
-    }
-    X->grain_form = form;
-    X->grain_flag = F->grain_flag;
-    for (int q = 0; q < VELOCITY_GRADIENT_L_N; q++) X->grain_strain[q] = F->grain_strain[q];
     return 0;
 }
 
@@ -1598,7 +1489,6 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     F->fk_valid = 0;
     const int friction = X.bed_friction;
     if ((friction || S->params.grains_in_water) && scratch_reserve(F, n) != 0) return -1;
-    if (grain_dissipation_prepare(F, S, n, &X) != 0) return -1;
     if (S->params.grains_in_water) { /* the water's pressure at the grains, before the pairs use it */
         grains_in_water_roles(F, S, n, &X);
         memset(F->gw[GW_SUM], 0, n * sizeof(double));

@@ -42,17 +42,6 @@ struct forces_params {
 #undef NUMERICS_KEY
 };
 
-/* The Monaghan term of the pairs of a medium with LAW_ACOUSTIC_DISSIPATION (numerics.grain_dissipation,
- * docs/model.md [DP-AV]); u_r = u_ij . x_ij / r < 0 on approaching pairs. */
-enum grain_dissipation {
-    GRAIN_DISSIPATION_ACOUSTIC = 0, /* alpha_M c = c_p on u_r (the law's default) */
-    GRAIN_DISSIPATION_LIMITED = 1,  /* times min(GRAIN_DISSIPATION_LIMITER |u_r| / c_p, 1): quadratic in a slow approach */
-    GRAIN_DISSIPATION_AFFINE = 2,   /* on u_ij - (grad u_i + grad u_j) / 2 . x_ij: no term in a linear velocity field */
-    GRAIN_DISSIPATION_QUARTER = 3   /* alpha_M c = c_p / 4 (a control) */
-};
-/* beta of the limiter, as the low-dissipation Riemann solver of Zhang, Hu & Adams (2017) takes it */
-#define GRAIN_DISSIPATION_LIMITER 3.0
-
 /* What the density diffusion acts on (numerics.density_diffusion_form, docs/numerics.md). */
 enum density_diffusion_form {
     DENSITY_DIFFUSION_HYDROSTATIC = 0, /* rho_j - rho_i less rho0 g (z_i - z_j) / c^2 (Fourtakas et al. 2019) */
@@ -67,8 +56,6 @@ struct pair_system {
     const struct gather *G;   /* gather ranges (the velocity gradient of grains) */
     const struct medium *media;
     struct forces_params params;
-    const struct velocity_gradient *grad; /* the velocity gradient of this step (numerics.grain_dissipation
-                                           * "affine"), or NULL */
     double dt;                /* the time step just taken [s] (the bed friction's stick force) */
     int n_threads;
 };

@@ -199,7 +199,6 @@ struct pair_system sim_pair_system(mixsph_sim *s)
     S.G = &s->work.G;
     S.media = s->scheme.media;
     S.params = s->scheme.pair;
-    S.grad = &s->work.grad;
     S.dt = s->phys.dt;
     S.n_threads = SIM_THREADS(s);
     return S;
