@@ -48,7 +48,7 @@ from mixsph_tools import readers  # noqa: E402
 TWO_D_ONLY_MONITORS = ("profile", "wall_pressure")
 
 
-def extrude(case, dx, cells):
+def extrude(case, dx, cells, side_walls="free-slip"):
     """The 3D flume of the 2D case (a dict; not modified): see the module's docstring."""
     if case.get("dimensions", 2) != 2:
         raise readers.ToolError(f"case {case.get('name')}: not a 2D case")
@@ -57,7 +57,7 @@ def extrude(case, dx, cells):
     c["dimensions"] = 3
     c["name"] = f"{case['name']}_flume_3d"
     c["description"] = (f"The 2D case {case['name']} extruded by tools/flume_3d.py into a 3D flume {cells} dx wide "
-                        f"(dx = {dx:g} m, W = {width:g} m) with free-slip side walls; its monitors must match the "
+                        f"(dx = {dx:g} m, W = {width:g} m) with {side_walls} side walls; its monitors must match the "
                         f"2D run's (docs/validation/three_d.md). The 2D case: " + case.get("description", ""))
     numerics = c.setdefault("numerics", {})
     numerics["dx"] = dx
@@ -76,7 +76,7 @@ def extrude(case, dx, cells):
             raise readers.ToolError(f"walls.{name}: only polyline walls are extruded")
         wall["y_min"], wall["y_max"] = 0.0, width
         if sides is None and "motion" not in wall:
-            wall["side_walls"] = "free-slip"
+            wall["side_walls"] = side_walls
             sides = name
     if sides is None:
         raise readers.ToolError(f"case {case['name']}: no fixed polyline wall to carry the side walls")
@@ -168,13 +168,15 @@ def main(argv=None):
     ap.add_argument("--out", default="out/flume_3d")
     ap.add_argument("--write-case")
     ap.add_argument("--doc", help="append the table and the command to this markdown file")
+    ap.add_argument("--side-walls", choices=("free-slip", "mirror"), default="free-slip",
+                    help="the side walls: free-slip wall particles (default) or mirror planes (images, no particles)")
     ap.add_argument("--lanes", action="store_true", help="print the 3D front of each lane beside the 2D front")
     args = ap.parse_args(argv)
     try:
         with open(args.case) as f:
             case = json.load(f)
         dx = args.dx if args.dx else case["numerics"]["dx"]
-        flume = extrude(case, dx, args.cells)
+        flume = extrude(case, dx, args.cells, args.side_walls)
         if args.write_case:
             with open(args.write_case, "w") as f:
                 json.dump(flume, f, indent=2)

@@ -164,7 +164,10 @@ typedef struct {
     const uint32_t *id;
 } mixsph_particles_view;
 
-enum { MIXSPH_STATE_MOBILE = 0, MIXSPH_STATE_FIXED = 1, MIXSPH_STATE_WALL = 2, MIXSPH_STATE_LOST = 3 };
+/* MIXSPH_STATE_IMAGE: the mirror image of a fluid or granular particle across a mirror side wall
+ * (3D, a polyline's side_walls = "mirror"), not a particle of the run (its ids from the run's
+ * particle count on); an image of a wall particle is a wall particle */
+enum { MIXSPH_STATE_MOBILE = 0, MIXSPH_STATE_FIXED = 1, MIXSPH_STATE_WALL = 2, MIXSPH_STATE_LOST = 3, MIXSPH_STATE_IMAGE = 4 };
 
 mixsph_status mixsph_sim_particles_view(const mixsph_sim *s, mixsph_particles_view *v);
 

@@ -258,6 +258,8 @@ static mixsph_status fill_bodies(mixsph_sim *s)
     for (size_t w = 0; w < s->cfg.n_walls; w++) /* a free-slip wall mirrors about its normal (walls.h) */
         if (s->cfg.walls[w].slip == WALL_FREE_SLIP) s->phys.P.features |= PARTICLE_FEATURE_WALL_NORMAL;
     if (s->phys.P.features & PARTICLE_FEATURE_STRESS) s->phys.P.features |= PARTICLE_FEATURE_WALL_NORMAL;
+    for (size_t w = 0; w < s->cfg.n_walls && DIM == 3; w++) /* images across mirror side walls (mirror_sides.h) */
+        if (s->cfg.walls[w].side_walls == WALL_SIDES_MIRROR) s->phys.P.features |= PARTICLE_FEATURE_MIRROR_SIDES;
     if (particles_alloc(&s->phys.P, n + n / 2 + 1024) != 0) {
         free(sites);
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for %zu particles", n);
@@ -407,6 +409,38 @@ static mixsph_status sim_fail_outside(mixsph_sim *s, size_t i)
     return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: domain: a particle at (%s) lies outside it", s->cfg.origin, at);
 }
 
+/* The planes of the mirror side walls (the extruded polylines whose side_walls is "mirror", all
+ * with the same y range), the images' reach, and a domain that holds the images: with the
+ * feature PARTICLE_FEATURE_MIRROR_SIDES only. */
+static mixsph_status mirror_sides_init(mixsph_sim *s)
+{
+    struct mirror_sides *M = &s->work.mirror;
+    if (!(s->phys.P.features & PARTICLE_FEATURE_MIRROR_SIDES)) return MIXSPH_OK;
+    M->on = 1;
+    M->y_lo = NAN;
+    for (size_t w = 0; w < s->cfg.n_walls; w++) {
+        const struct wall *wl = &s->cfg.walls[w];
+        if (wl->side_walls != WALL_SIDES_MIRROR) continue;
+        if (!isnan(M->y_lo) && (wl->y_min != M->y_lo || wl->y_max != M->y_hi))
+            return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: walls.%s.side_walls: \"mirror\" on walls of different y ranges "
+                            "([%g, %g] and [%g, %g]): the mirror planes are one pair", s->cfg.origin, wl->name, M->y_lo, M->y_hi,
+                            wl->y_min, wl->y_max);
+        M->y_lo = wl->y_min;
+        M->y_hi = wl->y_max;
+    }
+    const double skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
+    M->reach = 2.0 * s->phys.h + 0.5 * skin; /* mirror_sides.h */
+    if (!(M->y_hi - M->y_lo >= 2.0 * s->phys.h + skin))
+        return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: side_walls \"mirror\": the planes y = %g and y = %g m are closer than "
+                        "2h + skin = %g m (no image of an image is made)", s->cfg.origin, M->y_lo, M->y_hi, 2.0 * s->phys.h + skin);
+    const long trimmed = mirror_sides_trim(M, &s->phys.P);
+    if (trimmed < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
+    s->phys.n_wall -= (size_t)trimmed;
+    s->phys.domain[2] = fmin(s->phys.domain[2], M->y_lo - M->reach - s->phys.dx);
+    s->phys.domain[3] = fmax(s->phys.domain[3], M->y_hi + M->reach + s->phys.dx);
+    return MIXSPH_OK;
+}
+
 static mixsph_status sim_init(mixsph_sim *s)
 {
     mixsph_status st;
@@ -429,6 +463,7 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (s->phys.P.features & PARTICLE_FEATURE_WALL_NORMAL) /* what the free-slip walls mirror about (walls.h) */
         walls_set_normals(&s->phys.walls, &s->phys.P);
     set_domain(s);
+    if ((st = mirror_sides_init(s)) != MIXSPH_OK) return st;
     if ((st = create_laws(s)) != MIXSPH_OK) return st;
     set_scheme_params(s);
     if (!(s->work.forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -448,6 +483,8 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (cells_init_columns(&s->work.C, grid_lo, grid_hi, 2.0 * s->phys.h + s->work.NB.skin, SIM_CELL_COLUMNS) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "%s: cannot build a cell grid for the domain [%g, %g] x [%g, %g]",
                         s->cfg.origin, s->phys.domain[0], s->phys.domain[1], s->phys.domain[2], s->phys.domain[3]);
+    if (s->work.mirror.on && mirror_sides_make(&s->work.mirror, &s->phys.P) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
     if (cells_build(&s->work.C, &s->phys.P) < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
     s->phys.n_lost = 0;
     for (size_t i = 0; i < s->phys.P.n; i++)
@@ -610,6 +647,7 @@ void mixsph_sim_destroy(mixsph_sim *s)
     viscous_free(s->work.viscous);
     free(s->work.viscous_unknown);
     walls_mirror_free(s->work.wall_mirror);
+    mirror_sides_free(&s->work.mirror);
     particles_free(&s->phys.P);
     cells_free(&s->work.C);
     neighbours_free(&s->work.NB);

@@ -15,6 +15,7 @@
 #include "kernel.h"
 #include "mixsph.h"
 #include "law.h"
+#include "mirror_sides.h"
 #include "neighbours.h"
 #include "particles.h"
 #include "scheme_params.h"
@@ -67,6 +68,7 @@ struct sim_workspace {
     struct velocity_gradient grad; /* per particle, gathered every step when a law asks for it */
     struct viscous_solver *viscous; /* numerics.viscosity = "implicit": the solver's workspace */
     struct wall_mirror *wall_mirror; /* the walls in the implicit viscous step (walls.h) */
+    struct mirror_sides mirror;   /* 3D mirror side walls: the planes and their images (mirror_sides.h) */
     unsigned char *viscous_unknown; /* per particle: an unknown of the implicit viscous step */
     struct viscous_report viscous_last; /* the last solve */
     uint64_t viscous_iterations;  /* iterations of all solves so far (their mean is a diagnostic) */

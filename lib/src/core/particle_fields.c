@@ -25,10 +25,11 @@
 #else
 #define VECTOR(v, prefix)                                                                                            \
     .columns = prefix "x," prefix "y," prefix "z", .type = PF_F64, .components = 3,                                   \
-    .member = {AT(v[0]), AT(v[1]), AT(v[2])}
+    .member = {AT(v[0]), AT(v[1]), AT(v[2])}, .y_odd = 1u << 1
 #define STRESS(s, prefix)                                                                                            \
     .columns = prefix "xx," prefix "xz," prefix "zz," prefix "yy," prefix "xy," prefix "yz", .type = PF_F64,          \
-    .components = SYM_N, .member = {AT(s[0]), AT(s[1]), AT(s[2]), AT(s[3]), AT(s[4]), AT(s[5])}
+    .components = SYM_N, .member = {AT(s[0]), AT(s[1]), AT(s[2]), AT(s[3]), AT(s[4]), AT(s[5])},              \
+    .y_odd = (1u << SYM_XY) | (1u << SYM_YZ)
 #endif
 
 enum { OUT = PF_STATE | PF_HDF5 | PF_CSV | PF_VIEW }; /* a field of the snapshots */
@@ -50,7 +51,7 @@ const struct particle_field particle_fields[] = {
     {.name = "medium", COMPONENTS1(medium), .unit = "1",
      .description = "index into /metadata media (fluid and granular particles) or walls (wall particles)",
      .owner = PF_OWNER_CORE, .where = OUT},
-    {.name = "state", COMPONENTS1(state), .unit = "1", .description = "0 mobile, 1 fixed, 2 wall, 3 lost",
+    {.name = "state", COMPONENTS1(state), .unit = "1", .description = "0 mobile, 1 fixed, 2 wall, 3 lost, 4 mirror image",
      .owner = PF_OWNER_CORE, .where = OUT},
     {.name = "id", COMPONENTS1(id), .unit = "1", .description = "stable particle id", .owner = PF_OWNER_CORE,
      .where = OUT | PF_KEY},
@@ -108,6 +109,9 @@ const struct particle_field particle_fields[] = {
      .description = "a grain's pore pressure p_w (>= 0) of its law's last update, left out of the bed friction's "
                     "normal force (0 for the others)",
      .owner = PF_OWNER_LAW, .needs = PARTICLE_FEATURE_BED_FRICTION, .where = PF_STATE},
+    {.name = "image_of", COMPONENTS1(image_of), .unit = "1",
+     .description = "a mirror image across a mirror side wall: 1 + the id of the particle it images (0 for the others)",
+     .owner = PF_OWNER_CORE, .needs = PARTICLE_FEATURE_MIRROR_SIDES, .where = PF_STATE},
 };
 
 const size_t particle_field_count = sizeof particle_fields / sizeof particle_fields[0];

@@ -37,7 +37,8 @@ enum {
     PARTICLE_FEATURE_IMPLICIT_VISCOUS = 1u << 0, /* numerics.viscosity = "implicit" (viscous.h) */
     PARTICLE_FEATURE_STRESS = 1u << 1,           /* a medium's law carries a stress (laws/law.h) */
     PARTICLE_FEATURE_BED_FRICTION = 1u << 2,     /* walls' Coulomb friction on grains (sim.c bed_friction_on) */
-    PARTICLE_FEATURE_WALL_NORMAL = 1u << 3       /* a free-slip wall or a stress to mirror (walls_set_normals) */
+    PARTICLE_FEATURE_WALL_NORMAL = 1u << 3,      /* a free-slip wall or a stress to mirror (walls_set_normals) */
+    PARTICLE_FEATURE_MIRROR_SIDES = 1u << 4      /* 3D mirror side walls: images of particles (mirror_sides.h) */
 };
 
 struct particle_field {
@@ -51,6 +52,9 @@ struct particle_field {
     unsigned needs;          /* PARTICLE_FEATURE_* bits; 0: every simulation */
     unsigned where;          /* PF_STATE, PF_HDF5, ... bits */
     int csv_digits;          /* significant digits of a F64 value in the CSV (%.*g) */
+    unsigned y_odd;          /* bit c: component c (F64) changes sign under a reflection across a plane
+                              * y = const (a vector's y, a tensor's xy and yz; 3D only): an image
+                              * across a mirror side wall takes it reversed (mirror_sides.h) */
     size_t member[PARTICLE_FIELD_MAX_COMPONENTS]; /* offsetof(struct particles, array) per component */
 };
 

@@ -56,6 +56,8 @@ struct particles {
     uint8_t *state;       /* MIXSPH_STATE_* */
     uint16_t *nneigh;     /* neighbours of the same medium within 2h (last force pass) */
     uint32_t *id;         /* stable id */
+    uint32_t *image_of;   /* a mirror image (3D mirror side walls, walls/mirror_sides.h): 1 + the id of
+                           * the particle it images; 0 for the others; NULL without mirror side walls */
 };
 
 /* The array of struct particles at byte offset `member` (a particle_field's member[c]; copied
@@ -69,6 +71,9 @@ static inline void *particles_array(const struct particles *P, size_t member)
 
 /** The wall a wall particle belongs to (its `medium` field holds the wall's index). */
 static inline size_t particles_wall_index(const struct particles *P, size_t i) { return P->medium[i]; }
+
+/** Whether particle i is a mirror image (walls/mirror_sides.h), not a particle of the run. */
+static inline int particles_is_image(const struct particles *P, size_t i) { return P->image_of && P->image_of[i] != 0; }
 
 /** Allocate room for cap particles (first call: n = 0; later calls grow, keeping the particles),
  *  the arrays of the table's rows present with P->features. Returns 0 on success. */

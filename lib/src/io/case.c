@@ -575,6 +575,7 @@ static mixsph_status build_wall_surface(const struct case_reader *r, const cJSON
     if (wall_surface_build(wl, dir, why, sizeof why) != MIXSPH_OK)
         return FAIL(r, "%s: %s: %s", r->origin, path, why);
     if (wl->form != WALL_FORM_POLYLINE || wl->side_walls == WALL_SIDES_NONE) return MIXSPH_OK;
+    if (wl->side_walls == WALL_SIDES_MIRROR) return MIXSPH_OK; /* images, no wall (walls/mirror_sides.h) */
     if (c->n_walls == CASE_MAX_WALLS)
         return FAIL(r, "%s: %s.side_walls: at most %d walls, with the side walls", r->origin, path, CASE_MAX_WALLS);
     struct wall *sides = &c->walls[c->n_walls];

@@ -41,6 +41,8 @@ static const struct case_choice diffusion_forms[] = {{"hydrostatic", 0}, {"molte
 static const struct case_choice held_grain_modes[] = {{"solved", 0}, {"rigid", 1}, {NULL, 0}};
 static const struct case_choice sides[] = {{"left", 1}, {"right", -1}, {NULL, 0}};
 static const struct case_choice slips[] = {{"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {NULL, 0}};
+static const struct case_choice side_walls[] = {
+    {"no-slip", WALL_NO_SLIP}, {"free-slip", WALL_FREE_SLIP}, {"mirror", WALL_SIDES_MIRROR}, {NULL, 0}};
 static const struct case_choice wall_forms[] = {{"polyline", WALL_FORM_POLYLINE},
                                                 {"box", WALL_FORM_BOX},
                                                 {"stl", WALL_FORM_STL},
@@ -151,10 +153,11 @@ static const struct case_key wall_keys[] = {
      .meaning = "3D: the extruded polyline spans y from y_min to y_max"},
     {.key = "y_max", .type = CASE_NUMBER, .need = CASE_SOMETIMES, .need_text = "a polyline of a 3D case", ANYWHERE,
      .unit = "m", .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, y_max), .meaning = "3D: see y_min"},
-    {.key = "side_walls", .type = CASE_CHOICE, .def_text = "none", .choices = slips, .only = V(WALL_FORM_POLYLINE),
+    {.key = "side_walls", .type = CASE_CHOICE, .def_text = "none", .choices = side_walls, .only = V(WALL_FORM_POLYLINE),
      .field = CASE_FIELD(wall, side_walls),
      .meaning = "3D: add the planes y = y_min and y = y_max, fluid between them, as the wall <name>_sides with this "
-                "slip condition (fixed, the polyline's friction)"},
+                "slip condition (fixed, the polyline's friction); \"mirror\": the planes are planes of symmetry, "
+                "without wall particles: every particle within 2h + skin/2 of one has its mirror image across it"},
     {.key = "side_walls_z_max", .type = CASE_NUMBER, ANYWHERE, .def_text = "the polyline's top", .unit = "m",
      .only = V(WALL_FORM_POLYLINE), .field = CASE_FIELD(wall, side_walls_z_max),
      .meaning = "3D: the side walls reach from the polyline's lowest point up to this height"},

@@ -245,7 +245,9 @@ static double monitor_eval(const mixsph_sim *s, const struct monitor_def *md, in
     }
     if (md->kind == MONITOR_WALL_PRESSURE) {
         for (size_t i = 0; i < P->n; i++) {
-            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || !monitor_in_region(md, P, i)) continue;
+            if (P->state[i] != MIXSPH_STATE_WALL || P->medium[i] != md->wall || particles_is_image(P, i) ||
+                !monitor_in_region(md, P, i))
+                continue;
             int at_end;
             double pos[DIM];
             position_of(P, i, pos);

@@ -127,6 +127,8 @@ void integrate_pressure_and_derived(mixsph_sim *s)
 
 mixsph_status integrate_rebuild_lists(mixsph_sim *s)
 {
+    if (s->work.mirror.on && mirror_sides_make(&s->work.mirror, &s->phys.P) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
     const long lost = cells_build(&s->work.C, &s->phys.P);
     if (lost < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the cell list");
     s->phys.n_lost += lost;
@@ -165,6 +167,8 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
 {
     const struct particles *P = &s->phys.P;
     const size_t n = s->work.C.start[s->work.C.ncell];
+    if (s->work.mirror.on && mirror_sides_resolve(&s->work.mirror, P) != 0)
+        return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
     if (neighbours_gather_reserve(&s->work.G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     for (size_t i = 0; i < n; i++) {
         uint8_t mode = NEIGHBOURS_GATHER_NONE;
@@ -244,7 +248,9 @@ static int pressures_and_regimes(mixsph_sim *s, const struct pair_system *S, int
 {
     if (smooth && forces_smooth_pressure(s->work.forces, S, s->scheme.pressure_smoothing * s->phys.dt / s->phys.h) != 0) return -1;
     integrate_update_laws(s, law_dt);
+    mirror_sides_refresh(&s->work.mirror, &s->phys.P, S->n_threads); /* the fluid's images, for the walls */
     walls_extrapolate_fluid(&s->phys.walls, &s->phys.K, &s->work.G, s->phys.dx, &s->phys.P, active_particles(s), S->n_threads);
+    mirror_sides_refresh(&s->work.mirror, &s->phys.P, S->n_threads); /* and the walls' images */
     return 0;
 }
 
@@ -487,6 +493,7 @@ static void drift_range(void *arg, size_t b, size_t e)
                     x1[d] = x0[d] + dt * v[d];
                 }
                 if (s->work.near_wall[i]) walls_keep_fluid_side(&s->phys.walls, L->o_old, gap, x0, x1, v, &clips);
+                if (s->work.mirror.on) mirror_sides_reflect(&s->work.mirror, x1, v);
                 for (int d = 0; d < DIM; d++) P->pos[d][i] = x1[d];
             }
             for (int d = 0; d < DIM; d++) P->vel[d][i] = P->uv[d][i] = v[d];
@@ -526,7 +533,11 @@ static mixsph_status move_particles(mixsph_sim *s, double dt, double half_kick)
     s->phys.step++;
     /* the lists hold while no particle has moved skin/2 since their build; a particle that left
      * the grid is marked lost by the rebuild at once */
-    if (L.outside || 4.0 * L.shift2 >= s->work.NB.skin * s->work.NB.skin) return integrate_rebuild_lists(s);
+    if (L.outside || 4.0 * L.shift2 >= s->work.NB.skin * s->work.NB.skin) {
+        const mixsph_status st = integrate_rebuild_lists(s); /* images made afresh at their sources' state */
+        if (st != MIXSPH_OK) return st;
+    }
+    mirror_sides_refresh(&s->work.mirror, P, SIM_THREADS(s)); /* the images at the new positions and velocities */
     return MIXSPH_OK;
 }
 
@@ -630,6 +641,7 @@ static mixsph_status new_rates(mixsph_sim *s, double dt)
     struct density_update_loop L = {.s = s, .dt = dt};
     team_for(SIM_THREADS(s), P->n, density_update_range, &L);
     bad_rho |= L.bad_rho;
+    mirror_sides_refresh(&s->work.mirror, P, SIM_THREADS(s)); /* the images' densities, for the smoothing */
     if (pressures_and_regimes(s, &S, s->scheme.pressure_smoothing > 0.0, dt) != 0)
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the pair loops");
     const int bad_a = forces_momentum(s->work.forces, &S);

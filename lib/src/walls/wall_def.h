@@ -29,7 +29,10 @@ enum wall_form {
 };
 
 /* The sides a flume's side walls take (the key side_walls of an extruded polyline). */
-enum wall_side_walls { WALL_SIDES_NONE = -1 /* else the side walls' enum wall_slip */ };
+enum wall_side_walls {
+    WALL_SIDES_NONE = -1,  /* else the side walls' enum wall_slip */
+    WALL_SIDES_MIRROR = -2 /* the planes are planes of symmetry: images, no particles (mirror_sides.h) */
+};
 
 struct wall {
     char name[SCHEMA_NAME_LEN];

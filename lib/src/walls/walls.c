@@ -512,7 +512,7 @@ void walls_move(struct walls *W, struct particles *P, double t_from, double dt)
     }
     if (!moving) return;
     for (size_t i = 0; i < P->n; i++) {
-        if (P->state[i] != MIXSPH_STATE_WALL) continue;
+        if (P->state[i] != MIXSPH_STATE_WALL || particles_is_image(P, i)) continue; /* an image follows its source */
         const size_t w = particles_wall_index(P, i);
         if (W->def[w].motion < 0) continue;
         for (int d = 0; d < DIM; d++) {
