@@ -1,16 +1,20 @@
 #!/usr/bin/env python3
-"""A 2D case as a 3D flume: extrude its section across a width of a few dx between free-slip side
+"""A 2D case as a 3D flume: extrude its section across a width of a few dx between mirror side
 walls, run both at the same dx, and compare their monitors (docs/validation/three_d.md).
 
     python tools/flume_3d.py CASE [--cells N] [--dx DX] [--t-end T] [--set KEY=VALUE]...
                              [--compare MONITOR:series|max]... [--tol REL] [--check]
                              [--threads N] [--mixsph build/mixsph] [--out DIR]
                              [--write-case PATH] [--doc FILE] [--lanes]
+                             [--side-walls mirror|free-slip]
 
 The flume (``extrude``): ``"dimensions": 3``; every polygon body and every polyline wall spans
 y in [0, W], W = N dx (N = --cells, default 4; the lattice puts N particles across it); the first
-fixed polyline wall (no motion) gets ``"side_walls": "free-slip"``, the planes y = 0 and y = W up to
-its highest point, so that nothing in the flow depends on y; a domain gets y in
+fixed polyline wall (no motion) gets ``"side_walls": "mirror"`` (--side-walls; default), the
+planes y = 0 and y = W as planes of symmetry without wall particles, every particle within 2h of
+one imaged across it (docs/cases.md), so that nothing in the flow depends on y by construction;
+``--side-walls free-slip`` gives them free-slip wall particles instead, up to the wall's highest
+point, as before 2026-12-08; a domain gets y in
 [-(wall_layers + 2) dx, W + (wall_layers + 2) dx]; a pressure probe sits at y = W / 2; the 2D-only
 monitors (``profile``, ``wall_pressure``) are left out. Everything else (media, motions, numerics,
 parameters) is the 2D case's. ``--write-case PATH`` only writes the flume (at the case's own dx,
@@ -48,7 +52,7 @@ from mixsph_tools import readers  # noqa: E402
 TWO_D_ONLY_MONITORS = ("profile", "wall_pressure")
 
 
-def extrude(case, dx, cells, side_walls="free-slip"):
+def extrude(case, dx, cells, side_walls="mirror"):
     """The 3D flume of the 2D case (a dict; not modified): see the module's docstring."""
     if case.get("dimensions", 2) != 2:
         raise readers.ToolError(f"case {case.get('name')}: not a 2D case")
@@ -168,8 +172,8 @@ def main(argv=None):
     ap.add_argument("--out", default="out/flume_3d")
     ap.add_argument("--write-case")
     ap.add_argument("--doc", help="append the table and the command to this markdown file")
-    ap.add_argument("--side-walls", choices=("free-slip", "mirror"), default="free-slip",
-                    help="the side walls: free-slip wall particles (default) or mirror planes (images, no particles)")
+    ap.add_argument("--side-walls", choices=("mirror", "free-slip"), default="mirror",
+                    help="the side walls: mirror planes (images, no particles; default) or free-slip wall particles")
     ap.add_argument("--lanes", action="store_true", help="print the 3D front of each lane beside the 2D front")
     args = ap.parse_args(argv)
     try:

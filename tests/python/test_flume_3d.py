@@ -27,7 +27,8 @@ def test_vajont_flume():
     for body in flume["bodies"].values():
         assert (body["y_min"], body["y_max"]) == (0.0, pytest.approx(0.08))
     # the side walls on the first fixed wall (the bed), not on the moving plate
-    assert flume["walls"]["bed"]["side_walls"] == "free-slip"
+    assert flume["walls"]["bed"]["side_walls"] == "mirror"
+    assert flume_3d.extrude(case, 0.02, 4, "free-slip")["walls"]["bed"]["side_walls"] == "free-slip"
     assert "side_walls" not in flume["walls"]["plate"]
     # 2D-only monitors left out, the rest kept; the domain widened across y beyond the walls
     assert "water_surface" not in flume["monitors"] and "run_up" in flume["monitors"]

@@ -24,7 +24,7 @@
  *       viscosity (n)    float64 [Pa s]
  *       mass      (n)    float64 [kg]
  *       medium    (n)    uint8   [1]      index into /metadata media (walls: into walls)
- *       state     (n)    uint8   [1]      0 mobile, 1 fixed, 2 wall, 3 lost
+ *       state     (n)    uint8   [1]      0 mobile, 1 fixed, 2 wall, 3 lost, 4 mirror image
  *       id        (n)    uint32  [1]      stable particle id
  *     then any fields of the simulation's material laws or scheme; every dataset has the
  *     attributes units and description.
@@ -339,7 +339,7 @@ static mixsph_status run_create(mixsph_sim *s, struct output *o)
               attr_f64(g, "monitor_interval", s->cfg.monitor_interval) || attr_f64(g, "gravity", s->cfg.g) ||
               attr_i64(g, "n_particles", (long long)s->phys.n_fluid) || attr_i64(g, "n_wall_particles", (long long)s->phys.n_wall) ||
               attr_strs(g, "media", media, s->cfg.n_media) || attr_strs(g, "walls", walls, s->cfg.n_walls) ||
-              attr_str(g, "states", "0 mobile, 1 fixed (granular, elastic-plastic regime), 2 wall, 3 lost");
+              attr_str(g, "states", "0 mobile, 1 fixed (granular, elastic-plastic regime), 2 wall, 3 lost, 4 mirror image");
     if (g >= 0) H5Gclose(g);
     free(ov);
     hid_t g2 = -1, g3 = -1;
