@@ -249,7 +249,8 @@ static void mixture_region(void *arg, int tid, int nth)
     team_share(step->n, tid, nth, &b, &e);
     long fixed = 0;
     for (size_t i = b; i < e; i++) {
-        if (P->state[i] == MIXSPH_STATE_WALL) continue;
+        /* a mirror image takes its source's regime at the refresh after the laws (mirror_sides.h) */
+        if (P->state[i] == MIXSPH_STATE_WALL || P->state[i] == MIXSPH_STATE_IMAGE) continue;
         const struct medium *m = &media[P->medium[i]];
         if (m->law != LAW_MIXTURE_PAPER) continue;
         double grad[DIM * DIM];
