@@ -428,11 +428,11 @@ static mixsph_status mirror_sides_init(mixsph_sim *s)
         M->y_lo = wl->y_min;
         M->y_hi = wl->y_max;
     }
-    const double skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
-    M->reach = 2.0 * s->phys.h + 0.5 * skin; /* mirror_sides.h */
-    if (!(M->y_hi - M->y_lo >= 2.0 * s->phys.h + skin))
+    const double rc = 2.0 * s->phys.h + s->work.NB.skin; /* the lists' reach */
+    M->reach = rc - 0.5 * s->work.NB.skin;              /* 2h + skin/2 (mirror_sides.h) */
+    if (!(M->y_hi - M->y_lo >= rc))
         return SIM_FAIL(s, MIXSPH_ERR_CASE, "%s: side_walls \"mirror\": the planes y = %g and y = %g m are closer than "
-                        "2h + skin = %g m (no image of an image is made)", s->cfg.origin, M->y_lo, M->y_hi, 2.0 * s->phys.h + skin);
+                        "2h + skin = %g m (no image of an image is made)", s->cfg.origin, M->y_lo, M->y_hi, rc);
     const long trimmed = mirror_sides_trim(M, &s->phys.P);
     if (trimmed < 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
     s->phys.n_wall -= (size_t)trimmed;
@@ -463,7 +463,6 @@ static mixsph_status sim_init(mixsph_sim *s)
     if (s->phys.P.features & PARTICLE_FEATURE_WALL_NORMAL) /* what the free-slip walls mirror about (walls.h) */
         walls_set_normals(&s->phys.walls, &s->phys.P);
     set_domain(s);
-    if ((st = mirror_sides_init(s)) != MIXSPH_OK) return st;
     if ((st = create_laws(s)) != MIXSPH_OK) return st;
     set_scheme_params(s);
     if (!(s->work.forces = forces_create())) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory");
@@ -475,6 +474,7 @@ static mixsph_status sim_init(mixsph_sim *s)
         if (!inside) return sim_fail_outside(s, i);
     }
     s->work.NB.skin = NEIGHBOURS_SKIN_OVER_H * s->phys.h;
+    if ((st = mirror_sides_init(s)) != MIXSPH_OK) return st; /* before the grid: it widens the domain */
     double grid_lo[DIM], grid_hi[DIM];
     for (int d = 0; d < DIM; d++) {
         grid_lo[d] = s->phys.domain[2 * d];
