@@ -18,6 +18,7 @@ static inline int velocity_gradient_l_index(int a, int b) { return a * DIM - a *
 struct velocity_gradient {
     double *g[DIM * DIM];             /* G: component a * DIM + b is d u_a / d x_b [1/s] */
     double *l[VELOCITY_GRADIENT_L_N]; /* L [-] */
+    size_t cap;                       /* particles the arrays hold */
 };
 
 #define VELOCITY_GRADIENT_DET_MIN 0.05 /* below this det L the correction is not applied */
@@ -71,6 +72,9 @@ static inline void velocity_gradient_corrected(const struct velocity_gradient *V
 
 /** Allocate the arrays for cap particles (zeroed); 0 on success (free with velocity_gradient_free). */
 int velocity_gradient_alloc(struct velocity_gradient *V, size_t cap);
+/* Room for n particles (the set grows: the images of mirror side walls, walls/mirror_sides.h),
+ * the values of the first cap kept; nothing when it has it. Returns 0, -1 when out of memory. */
+int velocity_gradient_reserve(struct velocity_gradient *V, size_t n);
 void velocity_gradient_free(struct velocity_gradient *V);
 
 #endif

@@ -167,7 +167,8 @@ mixsph_status integrate_build_gather_lists(mixsph_sim *s)
 {
     const struct particles *P = &s->phys.P;
     const size_t n = s->work.C.start[s->work.C.ncell];
-    if (s->work.mirror.on && mirror_sides_resolve(&s->work.mirror, P) != 0)
+    if (s->work.mirror.on && (mirror_sides_resolve(&s->work.mirror, P) != 0 ||
+                              ((s->phys.law_features & LAW_USES_GRADIENT) && velocity_gradient_reserve(&s->work.grad, P->n) != 0)))
         return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory for the mirror images");
     if (neighbours_gather_reserve(&s->work.G, P->cap) != 0) return SIM_FAIL(s, MIXSPH_ERR_NOMEM, "out of memory in the gather lists");
     for (size_t i = 0; i < n; i++) {
