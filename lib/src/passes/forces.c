@@ -303,7 +303,7 @@ FORCES_INLINE void chunk_add(double *restrict a, const uint32_t *restrict idx, s
 FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                     const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double *di, double *ni, double *ei,
                                     double *restrict count, double *restrict fk, double *restrict diff, double hyd_i,
-                                    const int wendland, const int store, const int diffuse, const int grains)
+                                    const int wendland, const int diffuse, const int grains)
 {
     const double ti = P->tag[i], voli = P->vol[i], rhoi = P->rho[i];
     double xi[DIM], vi[DIM];
@@ -340,7 +340,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
             for (int d = 0; d < DIM; d++) uf += (vi[d] - v[d][j]) * r[d];
             uf *= F;
             const double c = (r2 < Xl.K.r2max ? 1.0 : 0.0) * (tag[j] == ti ? 1.0 : 0.0) * fluid_i * in;
-            if (store) fk[k] = F;
+            fk[k] = F;
             if (grains) { /* a grain's side of a grain-fluid pair drops out */
                 const double keep_i = role_i == GRAIN_ROLE_GRAIN && role[j] == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
                 const double keep_j = role[j] == GRAIN_ROLE_GRAIN && role_i == GRAIN_ROLE_FLUID ? 0.0 : 1.0;
@@ -362,7 +362,7 @@ FORCES_INLINE void continuity_range(const struct pair_ctx *X, struct particles *
         chunk_add(P->drho, idx, jb, m, i, dj);
         chunk_add(count, idx, jb, m, i, cj);
         if (diffuse) chunk_add(diff, idx, jb, m, i, ej);
-        if (store) fk += FORCES_CHUNK;
+        fk += FORCES_CHUNK;
     }
     for (size_t k = 0; k < FORCES_CHUNK; k++) {
         *di += acc[k];
@@ -540,8 +540,9 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
 /* Momentum between i and its nr ranges of candidates: the pair force f_ij (per unit depth in 2D)
  * is added to i and subtracted from j (acc holds forces during the pass; forces_momentum divides
  * by the masses after it). With `implicit` the viscous force is left out and its coupling
- * w_ij = -F fv (>= 0) is stored per lane in wl instead; `implicit` = MOMENTUM_IMPLICIT_ARITHMETIC
- * makes the pair viscosity the arithmetic mean (numerics.viscosity_mean). With `grains` a pair of a
+ * w_ij = -F fv (>= 0) is stored per lane in wl instead, with the pair viscosity the arithmetic mean
+ * where numerics.viscosity_mean says so. The kernel factors F are the density pass's (fk, the
+ * cache); `wendland` only shapes the kernel W of the grains' drag. With `grains` a pair of a
  * grain in water and a fluid particle is that of docs/model.md [GW]: the grain's pressure in it is
  * the water's interpolated at the grain (water_pressure_range) acting on the volume of the
  * parcel's solids (GW_SOLID times m / rho0), it carries no deviatoric stress,
@@ -549,7 +550,7 @@ FORCES_INLINE void wall_mirror_change(const double n[3], const double s[SYM_N], 
  * the fluid particle's mu and rho and the pair's slip |u_i - u_j|, acts between them (in the
  * implicit couplings w_ij with `implicit`). Every term stays a pair force, added to i and
  * subtracted from j. */
-enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_HARMONIC = 1, MOMENTUM_IMPLICIT_ARITHMETIC = 2 };
+enum { MOMENTUM_EXPLICIT_VISCOSITY = 0, MOMENTUM_IMPLICIT_VISCOSITY = 1 };
 /* momentum_range's `friction`: none, one coefficient per wall (the wall particles' wall_friction),
  * or one per (wall, medium) pair (the table bed_mu: gathers, dearer per pair) */
 enum { BED_FRICTION_OFF = 0, BED_FRICTION_BY_WALL = 1, BED_FRICTION_BY_MEDIUM = 2 };
@@ -557,8 +558,7 @@ enum { BED_FRICTION_OFF = 0, BED_FRICTION_BY_WALL = 1, BED_FRICTION_BY_MEDIUM = 
 FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *restrict P, size_t i,
                                   const uint32_t *restrict idx, const uint32_t *restrict rng, int nr, double f_i[DIM],
                                   const double *restrict fk, double *restrict wl, const int wendland,
-                                  const int cached, const int implicit, const int stress, const int friction,
-                                  const int grains)
+                                  const int implicit, const int stress, const int friction, const int grains)
 {
     const double pi = P->p[i], voli = P->vol[i], mi = P->m[i], irhoi = P->inv_rho[i], mui = P->mu[i];
     const double ti = P->tag[i], avci = P->avc[i];
@@ -609,6 +609,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
     const double mbi = ni[0] * ni[0] - ni[1] * ni[1];
     const double mai = ni[0] * ni[1];
 #endif
+    const int arithmetic = implicit && X->arithmetic_mean; /* the implicit couplings' mean */
     const struct pair_ctx Xl = *X;
     double sf[DIM][FORCES_CHUNK] = {{0}};         /* per-lane sums, reduced once */
     double ws[WALL_SUMS][FORCES_CHUNK] = {{0}};   /* i's wall sums (stress), per lane */
@@ -625,7 +626,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
                 r[d] = xi[d] - x[d][j];
                 r2 += r[d] * r[d];
             }
-            const double F = cached ? fk[k] : pair_f(&Xl, r2, wendland) * in;
+            const double F = fk[k];
             const double wallj = tag[j] < 0.0 ? 1.0 : 0.0;
             /* one division for 1 / (r^2 + eta^2) and 1 / (mu_i + mu_j) (a wall takes the
              * viscosity of the particle it meets; mu_i + mu_j > 0 but for wall-wall pairs,
@@ -661,7 +662,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
             /* laminar viscosity, pairwise harmonic mean: mu_i + mu_j of Morris is replaced by
              * 2 mu_ij = 4 mu_i mu_j / (mu_i + mu_j); times r^2 / (r^2 + eta^2). The arithmetic
              * mean keeps Morris's mu_i + mu_j, between particles of one medium only. */
-            const double fv = implicit == MOMENTUM_IMPLICIT_ARITHMETIC && tag[j] == ti
+            const double fv = arithmetic && tag[j] == ti
                                   ? vv * mus * mus * r2 * inv_d
                                   : vv * 4.0 * mu_i * muj * r2 * inv_d;
             double cd = 0.0; /* Ergun's drag of a grain-fluid pair, c_ij */
@@ -777,7 +778,7 @@ FORCES_INLINE void momentum_range(const struct pair_ctx *X, struct particles *re
         for (int d = 0; d < DIM; d++) chunk_add(P->acc[d], idx, jb, n, i, fj[d]);
         if (friction && roughi != 0.0 && Xl.wall_sum[0])
             for (int q = 0; q < WALL_SUMS; q++) chunk_add(Xl.wall_sum[q], idx, jb, n, i, wj[q]);
-        if (cached) fk += FORCES_CHUNK;
+        fk += FORCES_CHUNK;
         if (implicit) wl += FORCES_CHUNK;
     }
     for (int d = 0; d < DIM; d++) {
@@ -820,16 +821,15 @@ static inline double diffusion_rate(double delta_h, const struct medium *m, doub
 
 /* The band walks, one inlined copy per kernel (`wendland` constant), dispatched below. */
 FORCES_INLINE void continuity_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                   size_t b0, size_t b1, const int grains, const int diffuse, const int wendland,
-                                   const int store)
+                                   size_t b0, size_t b1, const int grains, const int diffuse, const int wendland)
 {
     for (size_t i = b0; i < b1; i++) {
         double di = 0.0, ni = 0.0, ei = 0.0;
         const int diffuse_i = diffuse && diffuses(X, P, i);
         const double hyd_i = diffuse_i ? diffusion_hydrostatic(X, P, i) : 0.0;
         uint32_t buf[2];
-        continuity_range(X, P, i, X->idx, pair_ranges(X, NB, i, buf), PAIR_RANGES, &di, &ni, &ei, X->count, store ? X->fk + X->fk_off[i] : NULL,
-                         X->diffusion, hyd_i, wendland, store, diffuse_i, grains);
+        continuity_range(X, P, i, X->idx, pair_ranges(X, NB, i, buf), PAIR_RANGES, &di, &ni, &ei, X->count,
+                         X->fk + X->fk_off[i], X->diffusion, hyd_i, wendland, diffuse_i, grains);
         P->drho[i] += di;
         X->count[i] += ni;
         if (diffuse_i) X->diffusion[i] += ei;
@@ -855,34 +855,34 @@ static void gradient_particle(const struct pair_ctx *X, const struct gather *G, 
 static __attribute__((noinline)) void momentum_range_by_medium(const struct pair_ctx *X, struct particles *restrict P,
                                                                size_t i, const uint32_t *restrict rng, double f[DIM],
                                                                const double *restrict fk, double *restrict wl,
-                                                               int wendland, int cached, int implicit, int stress,
-                                                               int grains)
+                                                               int wendland, int implicit, int stress, int grains)
 {
-    momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
-                   BED_FRICTION_BY_MEDIUM, grains);
+    momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, implicit, stress, BED_FRICTION_BY_MEDIUM,
+                   grains);
 }
 
 FORCES_INLINE void momentum_walk(const struct pair_ctx *X, const struct neighbours *NB, struct particles *restrict P,
-                                 size_t b0, size_t b1, const int wendland, const int cached, const int implicit,
-                                 const int stress, const int friction, const int grains)
+                                 size_t b0, size_t b1, const int implicit, const int stress, const int friction,
+                                 const int grains)
 {
+    const int wendland = X->wendland;
     for (size_t i = b0; i < b1; i++) {
         double f[DIM] = {0.0};
         uint32_t buf[2];
         const uint32_t *rng = pair_ranges(X, NB, i, buf);
-        const double *fk = cached ? X->fk + X->fk_off[i] : NULL;
+        const double *fk = X->fk + X->fk_off[i];
         double *wl = implicit ? X->visc_w + X->fk_off[i] : NULL;
         /* The bed friction's sums of a pair vanish unless i is a grain whose shear walls bound or a
          * wall particle that bounds one (to_i = to_j = 0 in momentum_range): the other particles,
          * the water's most, walk their pairs without them, to the same forces bit for bit. */
         if (friction && (P->wall_rough[i] != 0.0 || X->bed_given[i] != 0.0 || X->bed_own[i] != 0.0)) {
             if (X->bed_per_medium)
-                momentum_range_by_medium(X, P, i, rng, f, fk, wl, wendland, cached, implicit, stress, grains);
+                momentum_range_by_medium(X, P, i, rng, f, fk, wl, wendland, implicit, stress, grains);
             else
-                momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress,
+                momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, implicit, stress,
                                BED_FRICTION_BY_WALL, grains);
         } else
-            momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, cached, implicit, stress, 0, grains);
+            momentum_range(X, P, i, X->idx, rng, PAIR_RANGES, f, fk, wl, wendland, implicit, stress, 0, grains);
         for (int d = 0; d < DIM; d++) P->acc[d][i] += f[d];
     }
 }
@@ -1008,13 +1008,12 @@ static void smooth_band(const struct pair_ctx *X, const struct neighbours *NB, s
     }
 }
 
-/* Call walk(X, ..., wendland, cached) with both flags as constants: one inlined copy of the walk
- * per kernel and per use of the kernel-factor cache. */
-#define FORCES_DISPATCH(walk, X, ...)                                        \
-    do {                                                                     \
-        const int c_ = (X)->fk != NULL;                                      \
-        if ((X)->wendland) c_ ? walk(X, __VA_ARGS__, 1, 1) : walk(X, __VA_ARGS__, 1, 0); \
-        else c_ ? walk(X, __VA_ARGS__, 0, 1) : walk(X, __VA_ARGS__, 0, 0);   \
+/* Call walk(X, ..., wendland) with the kernel as a constant: one inlined copy of the walk per
+ * kernel (the density pass evaluates it; the momentum pass reads its factors from the cache). */
+#define FORCES_DISPATCH(walk, X, ...)                   \
+    do {                                                \
+        if ((X)->wendland) walk(X, __VA_ARGS__, 1);     \
+        else walk(X, __VA_ARGS__, 0);                   \
     } while (0)
 
 FORCES_CLONES
@@ -1036,20 +1035,8 @@ FORCES_INLINE void momentum_band_variant(const struct pair_ctx *X, const struct 
                                          struct particles *restrict P, size_t b0, size_t b1, const int stress,
                                          const int friction, const int grains)
 {
-    if (X->visc_w) { /* implicit viscosity: the cache is always there (forces_momentum) */
-        if (X->arithmetic_mean) {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, friction, grains);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_ARITHMETIC, stress, friction, grains);
-        } else {
-            if (X->wendland) momentum_walk(X, NB, P, b0, b1, 1, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, friction, grains);
-            else momentum_walk(X, NB, P, b0, b1, 0, 1, MOMENTUM_IMPLICIT_HARMONIC, stress, friction, grains);
-        }
-        return;
-    }
-#define MOMENTUM_EXPLICIT(X, NB, P, b0, b1, wendland, cached) \
-    momentum_walk(X, NB, P, b0, b1, wendland, cached, MOMENTUM_EXPLICIT_VISCOSITY, stress, friction, grains)
-    FORCES_DISPATCH(MOMENTUM_EXPLICIT, X, NB, P, b0, b1);
-#undef MOMENTUM_EXPLICIT
+    if (X->visc_w) momentum_walk(X, NB, P, b0, b1, MOMENTUM_IMPLICIT_VISCOSITY, stress, friction, grains);
+    else momentum_walk(X, NB, P, b0, b1, MOMENTUM_EXPLICIT_VISCOSITY, stress, friction, grains);
 }
 
 FORCES_CLONES
@@ -1101,7 +1088,8 @@ int forces_viscous_ready(const struct forces *F) { return F->visc_valid; }
  * ranges, reads it instead of evaluating the kernel again (a square root and, for the cubic
  * spline, a division per lane): the same numbers, so results are unchanged. Lanes of particle i
  * start at fk_off[i], FORCES_CHUNK per chunk of each of its ranges (pair_ranges). Returns -1 if the cache
- * cannot be allocated (the passes then evaluate the kernel twice, as without it). */
+ * cannot be allocated (out of memory: the momentum pass has no copy of its walks that evaluates
+ * the kernel, which would double the build time of this file). */
 static int fcache_layout(struct forces *F, const struct pair_ctx *X, const struct neighbours *NB, size_t n)
 {
 #if DIM == 3 /* the list's layout, kept until the list is made again (pair_list_attach) */
@@ -1363,11 +1351,11 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
         X.diffusion = F->diffusion_sum;
     }
     const double *diffusion = X.diffusion;
-    F->fk_valid = fcache_layout(F, &X, S->NB, n) == 0;
-    if (F->fk_valid) {
-        X.fk = F->fk;
-        X.fk_off = F->fk_off;
-    }
+    /* the kernel factors for the momentum pass at these positions (out of memory without them) */
+    if (fcache_layout(F, &X, S->NB, n) != 0) return -1;
+    F->fk_valid = 1;
+    X.fk = F->fk;
+    X.fk_off = F->fk_off;
     struct pass_region R;
     pass_region_init(&R, S, &X, continuity_band, n);
     R.grad = grad;
@@ -1469,9 +1457,12 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
     for (int d = 0; d < DIM; d++) memset(P->acc[d], 0, n * sizeof(double));
     F->visc_valid = 0;
     if (pair_list_attach(F, S, n, &X) != 0) return -1;
+    /* the kernel factors of the density pass of this step, at these positions (the implicit
+     * couplings are stored in their lane layout) */
+    if (!F->fk_valid) return -1;
+    X.fk = F->fk;
+    X.fk_off = F->fk_off;
     if (S->params.implicit_viscosity) {
-        /* the couplings are stored in the cache's lane layout, so the cache must be there */
-        if (!F->fk_valid) return -1;
         const size_t lanes = F->fk_off[n];
         if (F->visc_w_cap < lanes) {
             const size_t cap = lanes + lanes / 4 + FORCES_CHUNK;
@@ -1481,10 +1472,6 @@ int forces_momentum(struct forces *F, const struct pair_system *S)
             if (!F->visc_w) return -1;
         }
         X.visc_w = F->visc_w;
-    }
-    if (F->fk_valid) { /* the density pass of this step filled it, at these positions */
-        X.fk = F->fk;
-        X.fk_off = F->fk_off;
     }
     F->fk_valid = 0;
     const int friction = X.bed_friction;
@@ -1595,19 +1582,21 @@ void forces_pair_for_test(const struct pair_system *S, size_t i, size_t j, doubl
 #else
     const uint32_t pair[2] = {(uint32_t)j, (uint32_t)j + 1}, *idx = NULL;
 #endif
-    momentum_range(&X, P, i, idx, pair, 1, f, NULL, NULL, X.wendland, 0, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0, 0);
+    /* the density pass first: it stores the kernel factor the momentum pass reads */
+    _Alignas(64) double fk[FORCES_CHUNK] = {0};
+    const double delta_h = S->params.diffusion * X.K.h;
+    if (delta_h > 0.0 && diffuses(&X, P, i)) {
+        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, fk, diff, diffusion_hydrostatic(&X, P, i),
+                         X.wendland, 1, 0);
+        *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
+    } else {
+        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, fk, NULL, 0.0, X.wendland, 0, 0);
+        *drho = P->rho[i] * di;
+    }
+    momentum_range(&X, P, i, idx, pair, 1, f, fk, NULL, X.wendland, MOMENTUM_EXPLICIT_VISCOSITY, X.stress, 0, 0);
     for (int d = 0; d < DIM; d++) {
         a[d] = f[d] * P->inv_m[i];
         P->acc[d][j] = save[d];
-    }
-    const double delta_h = S->params.diffusion * X.K.h;
-    if (delta_h > 0.0 && diffuses(&X, P, i)) {
-        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, NULL, diff, diffusion_hydrostatic(&X, P, i),
-                         X.wendland, 0, 1, 0);
-        *drho = P->rho[i] * di + diffusion_rate(delta_h, &S->media[P->medium[i]], ei);
-    } else {
-        continuity_range(&X, P, i, idx, pair, 1, &di, &ni, &ei, count, NULL, NULL, 0.0, X.wendland, 0, 0, 0);
-        *drho = P->rho[i] * di;
     }
     P->drho[j] = save[DIM];
     free(count);

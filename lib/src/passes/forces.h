@@ -83,8 +83,8 @@ void forces_velocity_gradient(const struct pair_system *S, struct velocity_gradi
 int forces_density_rate_gradient(struct forces *F, const struct pair_system *S, struct velocity_gradient *grad);
 
 /** Acceleration P->acc of every particle, gravity included (without the viscous term when
- *  params.implicit_viscosity; the pass then stores the viscous couplings w_ij of the pairs, and
- *  must follow this step's forces_density_rate). Returns 1 if a non-finite value appeared at a
+ *  params.implicit_viscosity; the pass then stores the viscous couplings w_ij of the pairs). It
+ *  reads the kernel factors of this step's forces_density_rate, so it must follow it. Returns 1 if a non-finite value appeared at a
  *  mobile particle, -1 when out of memory or without this step's density pass, 0 otherwise. */
 int forces_momentum(struct forces *F, const struct pair_system *S);
 
