@@ -1352,6 +1352,7 @@ static int density_rate(struct forces *F, const struct pair_system *S, struct ve
     }
     const double *diffusion = X.diffusion;
     /* the kernel factors for the momentum pass at these positions (out of memory without them) */
+    F->fk_valid = 0;
     if (fcache_layout(F, &X, S->NB, n) != 0) return -1;
     F->fk_valid = 1;
     X.fk = F->fk;
